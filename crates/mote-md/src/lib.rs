@@ -1,0 +1,1 @@
+//! Time-stepped dynamics.

@@ -1,0 +1,1 @@
+//! Size distributions and the rod-packing estimator of random close packing.

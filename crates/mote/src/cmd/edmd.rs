@@ -1,0 +1,7 @@
+//! `mote edmd` (placeholder until its crate lands).
+
+use std::process::ExitCode;
+
+pub fn run(_global: &super::GlobalOpts, _args: &[String]) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`mote edmd` is not built yet")
+}

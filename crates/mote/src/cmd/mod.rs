@@ -1,0 +1,33 @@
+//! One module per subcommand.
+
+pub mod edmd;
+pub mod examples;
+pub mod rcp;
+pub mod run;
+
+/// Options every subcommand understands.
+#[derive(clap::Args, Debug, Clone)]
+pub struct GlobalOpts {
+    /// Print nothing but errors (no progress bar, no summary).
+    #[arg(long, short = 'q', global = true)]
+    pub quiet: bool,
+    /// Number of worker threads (default: all cores).
+    #[arg(long, global = true, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Seed of the random number generator (default: chosen and printed).
+    #[arg(long, global = true, value_name = "N")]
+    pub seed: Option<u64>,
+}
+
+impl GlobalOpts {
+    /// Sets up the global rayon pool with the requested thread count.
+    pub fn init_threads(&self) -> anyhow::Result<()> {
+        if let Some(n) = self.threads {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n.max(1))
+                .build_global()
+                .map_err(|e| anyhow::anyhow!("cannot set up {n} threads: {e}"))?;
+        }
+        Ok(())
+    }
+}
