@@ -1,1 +1,14 @@
-//! File formats.
+//! File formats as plain data.
+//!
+//! Readers and writers here know nothing of engines: they take and give plain
+//! numbers and strings. Every reader reports bad input as
+//! `file:line: what is wrong` ([`ParseError`]).
+
+pub mod csv;
+pub mod error;
+pub mod header;
+pub mod plist;
+pub mod xyz;
+
+pub use error::{IoError, ParseError};
+pub use header::Provenance;
