@@ -1,1 +1,36 @@
 //! Event-driven molecular dynamics of hard spheres (D = 3) and disks (D = 2).
+//!
+//! One source for both dimensions: [`System<D>`] holds particles with their
+//! own radius and mass in a box with hard walls or periodic boundaries per
+//! axis, and advances them from event to event (pair collisions, wall
+//! collisions, cell crossings). See [`system`] for the algorithm and its
+//! sources, [`scene`] for the settings a scene file gives, [`theory`] for the
+//! results the tests compare with.
+
+pub mod init;
+pub mod queue;
+pub mod scene;
+pub mod system;
+pub mod theory;
+pub mod vecd;
+
+pub use scene::{Scene, Run};
+pub use system::{pair_time, Boundary, Counters, SimBox, System};
+
+/// Errors of the event-driven engine.
+#[derive(Debug, thiserror::Error)]
+pub enum EdmdError {
+    /// An initial state or setting that cannot be simulated.
+    #[error("{0}")]
+    Invalid(String),
+    /// A scene file that does not parse, with file and line.
+    #[error("{file}:{line}: {message}")]
+    Scene {
+        file: String,
+        line: usize,
+        message: String,
+    },
+    /// Output failed.
+    #[error(transparent)]
+    Io(#[from] mote_io::IoError),
+}

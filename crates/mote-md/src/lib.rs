@@ -1,1 +1,28 @@
-//! Time-stepped dynamics.
+//! Time-stepped particle dynamics.
+//!
+//! A [`System`] holds the state (particles as a structure of arrays, the
+//! time); a [`ForceField`] is a list of [`Interaction`]s that add forces; an
+//! [`Integrator`] advances the state with a fixed time step; [`Simulation`]
+//! is the single run loop, which hands the state to [`Observer`]s on their
+//! schedule. Settings come from a TOML [`scene`] or an MPPphys particle file.
+
+pub mod error;
+pub mod force;
+pub mod init;
+pub mod integrate;
+pub mod observe;
+pub mod output;
+pub mod particles;
+pub mod scene;
+pub mod simulation;
+pub mod units;
+
+pub use error::MdError;
+pub use force::{ForceField, Interaction, State};
+pub use integrate::{Integrator, Stepper};
+pub use observe::Observables;
+pub use particles::{Particles, System};
+pub use simulation::{Observer, RunLength, RunReport, Simulation};
+pub use units::UnitSystem;
+
+pub use glam::DVec3;

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
+mod examples;
 
 /// mote — many-particle simulation toolkit.
 #[derive(Parser, Debug)]

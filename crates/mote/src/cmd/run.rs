@@ -1,13 +1,218 @@
-//! `mote run`.
+//! `mote run`: a scene file, an MPPphys particle file or a built-in example.
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use mote_io::Provenance;
+use mote_md::output::{ObservablesCsv, TrajectoryXyz};
+use mote_md::scene::{PlistSystem, Scene};
+use mote_md::{MdError, RunLength, RunReport};
+
+use crate::examples;
 
 #[derive(clap::Args, Debug)]
 pub struct RunArgs {
-    /// Scene file (.toml), MPPphys particle file, or `example:NAME`.
+    /// Scene file (.toml), MPPphys particle file (.plist or any other name), or `example:NAME`.
     pub input: String,
+    /// Run until this simulated time (overrides the scene).
+    #[arg(long, value_name = "T", conflicts_with = "steps")]
+    pub until: Option<f64>,
+    /// Run this many steps (overrides the scene).
+    #[arg(long, value_name = "N")]
+    pub steps: Option<u64>,
+    /// Time step (overrides the scene or the particle file's `dt`).
+    #[arg(long, value_name = "DT")]
+    pub dt: Option<f64>,
+    /// Model of an MPPphys particle file: nbody (DirectNbody) or springs (MassSpring).
+    #[arg(long, value_name = "MODEL", default_value = "nbody")]
+    pub system: String,
+    /// Integrator: euler, symplectic-euler, rk4 (RK4), leapfrog (LF).
+    #[arg(long, value_name = "NAME")]
+    pub solver: Option<String>,
+    /// Folder for the output files (default: the scene's, or out/NAME).
+    #[arg(long, short = 'o', value_name = "DIR")]
+    pub output: Option<PathBuf>,
 }
 
-pub fn run(_global: &super::GlobalOpts, _args: RunArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not yet")
+/// The input text and the name it goes by in messages and headers.
+struct Input {
+    name: String,
+    label: String,
+    text: String,
+    plist: bool,
+}
+
+fn read_input(spec: &str) -> anyhow::Result<Input> {
+    if let Some(name) = spec.strip_prefix("example:") {
+        let Some(e) = examples::find(name) else {
+            let names: Vec<String> = examples::all().into_iter().map(|e| e.name).collect();
+            bail!("no example called '{name}'; the examples are: {}", names.join(", "));
+        };
+        return Ok(Input { name: name.to_string(), label: spec.to_string(), text: e.text, plist: false });
+    }
+    let path = Path::new(spec);
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {spec}"))?;
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "run".into());
+    let plist = path.extension().and_then(|e| e.to_str()) != Some("toml");
+    Ok(Input { name, label: spec.to_string(), text, plist })
+}
+
+/// A seed from the clock when none is given.
+fn fresh_seed() -> u64 {
+    let t = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+    (t.as_nanos() as u64 ^ (std::process::id() as u64) << 32) % 1_000_000_007
+}
+
+pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode> {
+    global.init_threads()?;
+    let input = read_input(&args.input)?;
+    let scene = if input.plist {
+        let system = match args.system.as_str() {
+            "nbody" => PlistSystem::Nbody,
+            "springs" => PlistSystem::Springs,
+            other => bail!("unknown --system '{other}': expected nbody or springs"),
+        };
+        let pf = mote_io::plist::parse(&input.text, &input.label)?;
+        let solver = args.solver.clone().unwrap_or_else(|| "leapfrog".into());
+        Scene::from_plist(&pf, system, &solver)
+    } else {
+        let mut scene = Scene::parse(&input.text, &input.label)?;
+        if let Some(s) = &args.solver {
+            scene.run.integrator = toml::Spanned::new(0..0, s.clone());
+        }
+        scene
+    };
+    let mut scene = scene;
+    if let Some(dt) = args.dt {
+        scene.run.dt = Some(toml::Spanned::new(0..0, dt));
+    }
+    if scene.run.dt.is_none() {
+        bail!("{}: no time step: give one with --dt (a particle file sets it with a 'dt' line)", input.label);
+    }
+    let seed_given = global.seed.or(scene.seed);
+    let seed = seed_given.unwrap_or_else(fresh_seed);
+    let mut built = scene.build(&input.text, &input.label, seed)?;
+    let length = match (args.steps, args.until, built.length) {
+        (Some(n), _, _) => RunLength::Steps(n),
+        (None, Some(t), _) => RunLength::Until(t),
+        (None, None, Some(l)) => l,
+        (None, None, None) => bail!("{}: no run length: give --until T or --steps N", input.label),
+    };
+
+    let dir = args
+        .output
+        .clone()
+        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create the output folder {}", dir.display()))?;
+    let provenance = Provenance {
+        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
+        scene: input.label.clone(),
+        seed,
+    };
+    let out = &scene.output;
+    let sim = &mut built.simulation;
+    if out.observables_every > 0 {
+        sim.observers.push(Box::new(ObservablesCsv::create(
+            &dir.join("observables.csv"),
+            &provenance,
+            scene.units,
+            out.observables_every,
+            built.probes.clone(),
+        )?));
+    }
+    if out.trajectory_every > 0 {
+        sim.observers.push(Box::new(TrajectoryXyz::create(&dir.join("trajectory.xyz"), provenance.clone(), out.trajectory_every)?));
+    }
+
+    let steps = length.steps_from(sim.system.time, sim.dt);
+    if !global.quiet {
+        let threads = rayon::current_num_threads();
+        eprintln!(
+            "mote run {}: {} particles, {} with dt = {}, {} steps, seed {}{}, {} thread{}",
+            input.label,
+            sim.system.particles.len(),
+            sim.stepper.scheme.name(),
+            sim.dt,
+            steps,
+            seed,
+            if seed_given.is_some() { "" } else { " (chosen)" },
+            threads,
+            if threads == 1 { "" } else { "s" }
+        );
+    }
+    let bar = progress_bar(steps, global.quiet);
+    let started = Instant::now();
+    let mut shown = false;
+    let result = sim.run(length, |sys| {
+        if !shown && started.elapsed() > Duration::from_secs(1) {
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+            shown = true;
+        }
+        if sys.step % 16 == 0 {
+            bar.set_position(sys.step);
+            bar.set_message(format!("t = {:.6e}", sys.time));
+        }
+    });
+    bar.finish_and_clear();
+    match result {
+        Ok(report) => {
+            if !global.quiet {
+                summary(&report, &scene, &dir, steps);
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Err(e @ MdError::Unstable { .. }) => {
+            eprintln!("error: {e}");
+            eprintln!("the files written up to that point are kept in {}", dir.display());
+            Ok(ExitCode::from(3))
+        }
+        Err(e) => Err(e.into()),
+    }
+}
+
+fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} steps  {msg}  {per_sec}  ETA {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+fn summary(report: &RunReport, scene: &Scene, dir: &Path, _steps: u64) {
+    let secs = report.wall.as_secs_f64();
+    let [_, t_unit, _, e_unit] = scene.units.labels();
+    let files = if report.files.is_empty() { "no files (output switched off)".to_string() } else { report.files.join(", ") };
+    println!(
+        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). Total energy went from {:.9e} to {:.9e} {}: \
+         relative drift {:.3e} at the end, {:.3e} at most over the sampled instants. Output in {}: {}.",
+        report.steps,
+        report.last.time,
+        t_unit,
+        secs,
+        report.steps as f64 / secs.max(1e-9),
+        report.initial.total_energy(),
+        report.last.total_energy(),
+        e_unit,
+        rel(report.last.total_energy(), report.initial.total_energy()),
+        report.max_energy_error,
+        dir.display(),
+        files
+    );
+}
+
+fn rel(e: f64, e0: f64) -> f64 {
+    if e0 != 0.0 {
+        (e - e0).abs() / e0.abs()
+    } else {
+        (e - e0).abs()
+    }
 }

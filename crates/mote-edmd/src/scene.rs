@@ -1,0 +1,675 @@
+//! Scene settings (the `[edmd]` TOML a user writes) and the one run loop.
+//!
+//! Every key is documented in docs/edmd.md. Errors in a scene file come back
+//! as `file:line: message` ([`EdmdError::Scene`]).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Deserialize;
+
+use crate::init::{
+    ball_volume, fixed_speed_velocities, lattice, min_pair_distance, random_placement,
+    thermal_velocities,
+};
+use crate::system::{Boundary, SimBox, System};
+use crate::theory;
+use crate::vecd::to3;
+use crate::EdmdError;
+
+/// How the initial positions are made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Placement {
+    /// fcc in 3-D (4 sites per cubic cell), square in 2-D.
+    #[default]
+    Fcc,
+    /// Simple cubic / square lattice.
+    Cubic,
+    /// Random sequential placement without overlap (up to η ≈ 0.35 in 3-D,
+    /// 0.5 in 2-D).
+    Random,
+}
+
+/// One particle given explicitly.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    pub position: Vec<f64>,
+    #[serde(default)]
+    pub velocity: Vec<f64>,
+    pub radius: Option<f64>,
+    pub mass: Option<f64>,
+}
+
+/// Per-axis boundary: one word for all axes or a list.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum BoundarySpec {
+    All(Boundary),
+    PerAxis(Vec<Boundary>),
+}
+
+impl Default for BoundarySpec {
+    fn default() -> Self {
+        BoundarySpec::All(Boundary::Periodic)
+    }
+}
+
+/// The settings of an event-driven run. All keys are optional except what
+/// fixes the particles: `n` (with `packing_fraction` and/or `box`),
+/// `[[particles]]`, or `file`.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// 2 (disks) or 3 (spheres). Default 3.
+    #[serde(default = "default_dim")]
+    pub dimension: usize,
+    /// Number of particles (with `placement`).
+    pub n: Option<usize>,
+    /// Packing fraction η = Σ v_i / V; sets the box (cube/square) when `box`
+    /// is missing, or the radius when both `box` and `n` are given.
+    pub packing_fraction: Option<f64>,
+    /// Box lengths per axis.
+    #[serde(rename = "box")]
+    pub box_size: Option<Vec<f64>>,
+    /// "periodic" or "wall", or one per axis.
+    #[serde(default)]
+    pub boundary: BoundarySpec,
+    /// Particle radius (default 0.5, i.e. diameter 1).
+    pub radius: Option<f64>,
+    /// Particle mass (default 1).
+    pub mass: Option<f64>,
+    /// Bidisperse mixtures: fraction of large particles and their size ratio.
+    pub large_fraction: Option<f64>,
+    pub size_ratio: Option<f64>,
+    #[serde(default)]
+    pub placement: Placement,
+    /// k_B T of Maxwell–Boltzmann initial velocities (default 1).
+    pub temperature: Option<f64>,
+    /// Instead of `temperature`: all speeds equal to this, random directions.
+    pub speed: Option<f64>,
+    /// Random seed (the command line's `--seed` wins).
+    pub seed: Option<u64>,
+    /// Simulated time of the run (after `equilibrate`).
+    #[serde(default = "default_time")]
+    pub time: f64,
+    /// Simulated time run first, without measuring.
+    #[serde(default)]
+    pub equilibrate: f64,
+    /// Time between output rows and frames (default time/100).
+    pub output_interval: Option<f64>,
+    /// Extended XYZ trajectory file (relative to the scene file).
+    pub trajectory: Option<String>,
+    /// CSV of observables per output interval.
+    pub observables: Option<String>,
+    /// CSV of the speed histogram at the end, beside Maxwell–Boltzmann.
+    pub histogram: Option<String>,
+    /// Explicit particles.
+    pub particles: Option<Vec<ParticleSpec>>,
+    /// Initial state from the last frame of an extended XYZ file.
+    pub file: Option<String>,
+    /// Check for overlaps at every output (exact, O(N)); default true.
+    #[serde(default = "yes")]
+    pub check_overlaps: bool,
+}
+
+fn default_dim() -> usize {
+    3
+}
+fn default_time() -> f64 {
+    10.0
+}
+fn yes() -> bool {
+    true
+}
+
+/// Line (1-based) of a byte offset in `text`.
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+/// Line where `key = ` is first set, or 1.
+fn key_line(text: &str, key: &str) -> usize {
+    for (k, l) in text.lines().enumerate() {
+        let t = l.trim_start();
+        if let Some(rest) = t.strip_prefix(key) {
+            if rest.trim_start().starts_with('=') {
+                return k + 1;
+            }
+        }
+        if t.starts_with("[[") && t.contains(key) {
+            return k + 1;
+        }
+    }
+    1
+}
+
+/// The built-in examples: name → scene text (the files under examples/edmd/).
+pub const EXAMPLES: &[(&str, &str)] = &[
+    ("cube", include_str!("../../../examples/edmd/cube.toml")),
+    ("cradle", include_str!("../../../examples/edmd/cradle.toml")),
+    ("cradle-two", include_str!("../../../examples/edmd/cradle-two.toml")),
+    ("cradle-symmetric", include_str!("../../../examples/edmd/cradle-symmetric.toml")),
+    ("cradle-heavy", include_str!("../../../examples/edmd/cradle-heavy.toml")),
+    ("maxwell2d", include_str!("../../../examples/edmd/maxwell2d.toml")),
+    ("eos", include_str!("../../../examples/edmd/eos.toml")),
+];
+
+/// The scene text of a built-in example.
+pub fn example(name: &str) -> Option<&'static str> {
+    EXAMPLES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+}
+
+impl Scene {
+    /// Parses a scene; `file` names it in error messages.
+    pub fn parse(text: &str, file: &str) -> Result<Self, EdmdError> {
+        let scene: Scene = toml::from_str(text).map_err(|e| EdmdError::Scene {
+            file: file.to_string(),
+            line: e.span().map(|s| line_of(text, s.start)).unwrap_or(1),
+            message: e.message().trim().to_string(),
+        })?;
+        scene.validate(text, file)?;
+        Ok(scene)
+    }
+
+    /// Reads and parses a scene file.
+    pub fn read(path: &Path) -> Result<Self, EdmdError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| EdmdError::Io(mote_io::IoError::os(path, e)))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    fn validate(&self, text: &str, file: &str) -> Result<(), EdmdError> {
+        let err = |key: &str, message: String| EdmdError::Scene {
+            file: file.to_string(),
+            line: key_line(text, key),
+            message,
+        };
+        if self.dimension != 2 && self.dimension != 3 {
+            return Err(err(
+                "dimension",
+                format!("dimension = {} is not supported; use 2 (disks) or 3 (spheres)", self.dimension),
+            ));
+        }
+        if let Some(b) = &self.box_size {
+            if b.len() != self.dimension || b.iter().any(|x| !(*x > 0.0 && x.is_finite())) {
+                return Err(err(
+                    "box",
+                    format!("box must list {} positive lengths", self.dimension),
+                ));
+            }
+        }
+        if let BoundarySpec::PerAxis(v) = &self.boundary {
+            if v.len() != self.dimension {
+                return Err(err(
+                    "boundary",
+                    format!("boundary must list {} entries (\"periodic\" or \"wall\")", self.dimension),
+                ));
+            }
+        }
+        if let Some(eta) = self.packing_fraction {
+            let max = if self.dimension == 3 { 0.74 } else { 0.9069 };
+            if !(eta > 0.0 && eta < max) {
+                return Err(err(
+                    "packing_fraction",
+                    format!("packing_fraction = {eta} must lie in (0, {max})"),
+                ));
+            }
+        }
+        for (key, v) in [("radius", self.radius), ("mass", self.mass), ("temperature", self.temperature), ("speed", self.speed), ("size_ratio", self.size_ratio)] {
+            if let Some(x) = v {
+                if !(x > 0.0 && x.is_finite()) {
+                    return Err(err(key, format!("{key} = {x} must be positive")));
+                }
+            }
+        }
+        if let Some(f) = self.large_fraction {
+            if !(0.0..=1.0).contains(&f) {
+                return Err(err("large_fraction", format!("large_fraction = {f} must lie in [0, 1]")));
+            }
+        }
+        if !(self.time >= 0.0 && self.time.is_finite()) {
+            return Err(err("time", format!("time = {} must be ≥ 0", self.time)));
+        }
+        if !(self.equilibrate >= 0.0 && self.equilibrate.is_finite()) {
+            return Err(err("equilibrate", format!("equilibrate = {} must be ≥ 0", self.equilibrate)));
+        }
+        if let Some(dt) = self.output_interval {
+            if !(dt > 0.0) {
+                return Err(err("output_interval", format!("output_interval = {dt} must be positive")));
+            }
+        }
+        let sources = self.n.is_some() as u8 + self.particles.is_some() as u8 + self.file.is_some() as u8;
+        if sources != 1 {
+            return Err(err(
+                "n",
+                "give exactly one of `n` (with packing_fraction and/or box), `[[particles]]` or `file`".into(),
+            ));
+        }
+        if self.n == Some(0) {
+            return Err(err("n", "n must be at least 1".into()));
+        }
+        if self.n.is_some() && self.box_size.is_none() && self.packing_fraction.is_none() {
+            return Err(err("n", "with `n`, give `packing_fraction` or `box` (or both)".into()));
+        }
+        if let Some(ps) = &self.particles {
+            for (k, p) in ps.iter().enumerate() {
+                if p.position.len() != self.dimension
+                    || !(p.velocity.is_empty() || p.velocity.len() == self.dimension)
+                {
+                    return Err(err(
+                        "particles",
+                        format!("particle {k}: position and velocity need {} components", self.dimension),
+                    ));
+                }
+            }
+            if self.box_size.is_none() {
+                return Err(err("particles", "explicit particles need a `box`".into()));
+            }
+        }
+        Ok(())
+    }
+
+    fn boundaries<const D: usize>(&self) -> [Boundary; D] {
+        match &self.boundary {
+            BoundarySpec::All(b) => [*b; D],
+            BoundarySpec::PerAxis(v) => {
+                let mut o = [Boundary::Periodic; D];
+                o.copy_from_slice(&v[..D]);
+                o
+            }
+        }
+    }
+
+    /// Builds the initial system with the given seed. `base` is the folder
+    /// relative file names resolve against.
+    pub fn build<const D: usize>(&self, seed: u64, base: &Path) -> Result<System<D>, EdmdError> {
+        assert_eq!(D, self.dimension, "build::<D> must match the scene's dimension");
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let boundary = self.boundaries::<D>();
+        let periodic = boundary.map(|b| b == Boundary::Periodic);
+        let mass = self.mass.unwrap_or(1.0);
+        let (size, pos, radii, masses, given_vel): (
+            [f64; D],
+            Vec<[f64; D]>,
+            Vec<f64>,
+            Vec<f64>,
+            Option<Vec<[f64; D]>>,
+        ) = if let Some(ps) = &self.particles {
+            let mut size = [0.0; D];
+            size.copy_from_slice(&self.box_size.as_ref().expect("validated")[..D]);
+            let r0 = self.radius.unwrap_or(0.5);
+            let pos = ps.iter().map(|p| vec_d::<D>(&p.position)).collect();
+            let vel = ps
+                .iter()
+                .map(|p| if p.velocity.is_empty() { [0.0; D] } else { vec_d::<D>(&p.velocity) })
+                .collect();
+            let radii = ps.iter().map(|p| p.radius.unwrap_or(r0)).collect();
+            let masses = ps.iter().map(|p| p.mass.unwrap_or(mass)).collect();
+            (size, pos, radii, masses, Some(vel))
+        } else if let Some(f) = &self.file {
+            let path = base.join(f);
+            let frames = mote_io::xyz::read_frames(&path)?;
+            let fr = frames.last().ok_or_else(|| {
+                EdmdError::Invalid(format!("{}: no frames", path.display()))
+            })?;
+            let mut size = [0.0; D];
+            for d in 0..D {
+                size[d] = fr.cell[d][d];
+            }
+            if let Some(b) = &self.box_size {
+                size.copy_from_slice(&b[..D]);
+            }
+            let pos = fr
+                .positions
+                .iter()
+                .map(|p| {
+                    let mut x = [0.0; D];
+                    for d in 0..D {
+                        x[d] = p[d] - fr.origin[d];
+                    }
+                    x
+                })
+                .collect();
+            let vel = fr.velocities.iter().map(|v| vec_d::<D>(&v[..D])).collect();
+            let n = fr.positions.len();
+            let radii = if fr.radii.len() == n { fr.radii.clone() } else { vec![self.radius.unwrap_or(0.5); n] };
+            let v0: Vec<[f64; D]> = vel;
+            let has_v = v0.iter().any(|v| v.iter().any(|x| *x != 0.0));
+            (size, pos, radii, vec![mass; n], if has_v { Some(v0) } else { None })
+        } else {
+            let n = self.n.expect("validated");
+            // radii: monodisperse or bidisperse
+            let ratio = self.size_ratio.unwrap_or(1.0);
+            let n_large = (self.large_fraction.unwrap_or(0.0) * n as f64).round() as usize;
+            let shape: Vec<f64> = (0..n).map(|i| if i < n_large { ratio } else { 1.0 }).collect();
+            let shape_vol: f64 = shape.iter().map(|s| ball_volume(D, *s)).sum();
+            let (size, r0) = match (&self.box_size, self.packing_fraction) {
+                (Some(b), Some(eta)) => {
+                    let mut size = [0.0; D];
+                    size.copy_from_slice(&b[..D]);
+                    let vol: f64 = size.iter().product();
+                    (size, (eta * vol / shape_vol).powf(1.0 / D as f64))
+                }
+                (Some(b), None) => {
+                    let mut size = [0.0; D];
+                    size.copy_from_slice(&b[..D]);
+                    (size, self.radius.unwrap_or(0.5))
+                }
+                (None, Some(eta)) => {
+                    let r0 = self.radius.unwrap_or(0.5);
+                    let vol = shape_vol * r0.powi(D as i32) / eta;
+                    ([vol.powf(1.0 / D as f64); D], r0)
+                }
+                (None, None) => unreachable!("validated"),
+            };
+            let radii: Vec<f64> = shape.iter().map(|s| s * r0).collect();
+            let pos = match self.placement {
+                Placement::Random => random_placement::<D, _>(&radii, size, periodic, &mut rng, 100_000)
+                    .ok_or_else(|| {
+                        EdmdError::Invalid(format!(
+                            "random placement of {n} particles failed at packing fraction {:.4}; use placement = \"fcc\" for dense states",
+                            radii.iter().map(|r| ball_volume(D, *r)).sum::<f64>() / size.iter().product::<f64>()
+                        ))
+                    })?,
+                p => {
+                    let mut pos = lattice::<D>(n, size, p == Placement::Fcc);
+                    if boundary.contains(&Boundary::Wall) || p == Placement::Cubic {
+                        // center the lattice sites in their cells
+                        let sc = lattice::<D>(n, size, false);
+                        if p == Placement::Cubic {
+                            pos = sc;
+                        }
+                        let mut m = [0.0f64; D];
+                        for q in &pos {
+                            for d in 0..D {
+                                m[d] = m[d].max(q[d]);
+                            }
+                        }
+                        let mut lo = [f64::INFINITY; D];
+                        for q in &pos {
+                            for d in 0..D {
+                                lo[d] = lo[d].min(q[d]);
+                            }
+                        }
+                        for q in pos.iter_mut() {
+                            for d in 0..D {
+                                if !periodic[d] {
+                                    q[d] += 0.5 * (size[d] - m[d] - lo[d]);
+                                }
+                            }
+                        }
+                    }
+                    let dmin = min_pair_distance(&pos, size, periodic);
+                    let dmax = 2.0 * radii.iter().cloned().fold(0.0, f64::max);
+                    if dmin < dmax {
+                        return Err(EdmdError::Invalid(format!(
+                            "the lattice does not fit: nearest sites {dmin:.4} apart, particles {dmax:.4} wide; lower n or packing_fraction"
+                        )));
+                    }
+                    pos
+                }
+            };
+            let masses = radii
+                .iter()
+                .map(|r| mass * (r / r0).powi(D as i32))
+                .collect();
+            (size, pos, radii, masses, None)
+        };
+        let vel = match given_vel {
+            Some(v) => v,
+            None => {
+                if let Some(s) = self.speed {
+                    fixed_speed_velocities::<D, _>(pos.len(), s, &mut rng)
+                } else {
+                    thermal_velocities::<D, _>(&masses, self.temperature.unwrap_or(1.0), &mut rng)
+                }
+            }
+        };
+        System::new(SimBox { size, boundary }, pos, vel, radii, masses)
+    }
+}
+
+fn vec_d<const D: usize>(v: &[f64]) -> [f64; D] {
+    let mut x = [0.0; D];
+    x.copy_from_slice(&v[..D]);
+    x
+}
+
+/// What a finished run reports.
+#[derive(Debug, Clone, Default)]
+pub struct Run {
+    pub dimension: usize,
+    pub n: usize,
+    pub packing_fraction: f64,
+    pub seed: u64,
+    /// Pair collisions and wall collisions during the measured time.
+    pub collisions: u64,
+    pub wall_hits: u64,
+    /// All events (including cell crossings and invalid ones), whole run.
+    pub events: u64,
+    pub simulated_time: f64,
+    /// Wall-clock seconds of the event loop.
+    pub wall_seconds: f64,
+    /// Compressibility factor from the collision virial (periodic boxes).
+    pub z: f64,
+    /// Reference equation of state at this packing fraction (CS or Henderson).
+    pub z_reference: f64,
+    pub wall_pressure: f64,
+    pub collision_rate: f64,
+    pub mean_free_time: f64,
+    pub temperature: f64,
+    /// max |E(t) − E(0)| / E(0) at the outputs.
+    pub energy_drift: f64,
+    /// |P(end) − P(0)| / Σ m|v| at the end.
+    pub momentum_drift: f64,
+    /// KS test of the final speeds against Maxwell–Boltzmann: (D_n, p).
+    pub ks: (f64, f64),
+    /// Final speeds.
+    pub speeds: Vec<f64>,
+    pub outputs: Vec<PathBuf>,
+}
+
+/// Output destinations and provenance.
+pub struct Outputs {
+    pub base: PathBuf,
+    pub provenance: mote_io::Provenance,
+}
+
+/// Runs a scene: builds the system, equilibrates, runs `time` with outputs
+/// every `output_interval`; calls `progress(fraction)` now and then.
+pub fn run_scene<const D: usize>(
+    scene: &Scene,
+    seed: u64,
+    out: &Outputs,
+    mut progress: impl FnMut(f64),
+) -> Result<Run, EdmdError> {
+    let mut sys = scene.build::<D>(seed, &out.base)?;
+    let n = sys.len();
+    let e0 = sys.kinetic_energy();
+    let p0 = sys.momentum();
+    let pscale: f64 = sys
+        .velocities()
+        .iter()
+        .zip(sys.masses())
+        .map(|(v, m)| m * crate::vecd::dot(v, v).sqrt())
+        .sum::<f64>()
+        .max(f64::MIN_POSITIVE);
+    let interval = scene.output_interval.unwrap_or(scene.time / 100.0).max(1e-300);
+    let mut xyz = match &scene.trajectory {
+        Some(f) => Some(mote_io::xyz::XyzWriter::create(&out.base.join(f), out.provenance.clone())?),
+        None => None,
+    };
+    let cols: Vec<String> = [
+        "time",
+        "collisions",
+        "collision_rate",
+        "mean_free_time",
+        "temperature",
+        "kinetic_energy",
+        "energy_drift",
+        "compressibility",
+        "pressure",
+        "wall_pressure",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let units: Vec<String> = ["t", "1", "1/t", "t", "kT", "E", "1", "1", "E/V", "E/V"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let mut csv = match &scene.observables {
+        Some(f) => Some(mote_io::csv::CsvWriter::create(&out.base.join(f), &out.provenance, &cols, &units)?),
+        None => None,
+    };
+    let mut result = Run {
+        dimension: D,
+        n,
+        packing_fraction: sys.packing_fraction(),
+        seed,
+        ..Run::default()
+    };
+    let start = Instant::now();
+    let total = scene.equilibrate + scene.time;
+    let mut events = 0u64;
+    // equilibration, in chunks for progress
+    let chunks = 20;
+    for k in 1..=chunks {
+        if scene.equilibrate <= 0.0 {
+            break;
+        }
+        events += sys.run_until(scene.equilibrate * k as f64 / chunks as f64);
+        progress(sys.time() / total.max(1e-300));
+    }
+    sys.reset_counters();
+    let t0 = sys.time();
+    let mut drift: f64 = 0.0;
+    let mut write = |sys: &mut System<D>, drift: &mut f64| -> Result<(), EdmdError> {
+        let e = sys.kinetic_energy();
+        *drift = drift.max(((e - e0) / e0).abs());
+        if let Some(w) = xyz.as_mut() {
+            w.write(&frame(sys))?;
+        }
+        if let Some(c) = csv.as_mut() {
+            let dt = sys.time() - t0;
+            let (rate, mft, z, p) = if dt > 0.0 {
+                (sys.collision_rate(), sys.mean_free_time(), sys.compressibility(), sys.pressure())
+            } else {
+                (f64::NAN, f64::NAN, f64::NAN, f64::NAN)
+            };
+            c.row(&[
+                sys.time(),
+                sys.counters().collisions as f64,
+                rate,
+                mft,
+                sys.temperature(),
+                e,
+                (e - e0) / e0,
+                z,
+                p,
+                sys.wall_pressure(),
+            ])?;
+        }
+        if scene.check_overlaps {
+            if let Some((i, j, gap)) = sys.find_overlap(1e-9) {
+                return Err(EdmdError::Invalid(format!(
+                    "overlap at t = {}: particles {i} and {j} (distance/contact − 1 = {gap:.3e})",
+                    sys.time()
+                )));
+            }
+        }
+        Ok(())
+    };
+    write(&mut sys, &mut drift)?;
+    let mut k = 1u64;
+    loop {
+        let target = (t0 + k as f64 * interval).min(t0 + scene.time);
+        events += sys.run_until(target);
+        write(&mut sys, &mut drift)?;
+        progress((sys.time()) / total.max(1e-300));
+        if target >= t0 + scene.time {
+            break;
+        }
+        k += 1;
+    }
+    result.wall_seconds = start.elapsed().as_secs_f64();
+    let c = *sys.counters();
+    result.collisions = c.collisions;
+    result.wall_hits = c.wall_hits;
+    result.events = events;
+    result.simulated_time = scene.time;
+    let all_periodic = sys.simbox().boundary.iter().all(|b| *b == Boundary::Periodic);
+    result.z = if all_periodic { sys.compressibility() } else { f64::NAN };
+    result.z_reference = if D == 3 {
+        theory::carnahan_starling(result.packing_fraction)
+    } else {
+        theory::henderson(result.packing_fraction)
+    };
+    result.wall_pressure = sys.wall_pressure();
+    result.collision_rate = sys.collision_rate();
+    result.mean_free_time = sys.mean_free_time();
+    result.temperature = sys.temperature();
+    result.energy_drift = drift;
+    let p1 = sys.momentum();
+    result.momentum_drift = (0..D).map(|d| (p1[d] - p0[d]).abs()).fold(0.0, f64::max) / pscale;
+    // KS against Maxwell–Boltzmann with b² = <v²>·2/D (equal masses)
+    let speeds = sys.speeds();
+    let v2 = speeds.iter().map(|v| v * v).sum::<f64>() / n as f64;
+    let b2 = 2.0 * v2 / D as f64;
+    result.ks = if D == 2 {
+        theory::ks_test(&speeds, |v| theory::maxwell2d_cdf(v, b2))
+    } else {
+        theory::ks_test(&speeds, |v| theory::maxwell3d_cdf(v, b2))
+    };
+    if let Some(f) = &scene.histogram {
+        let vmax = 4.0 * b2.sqrt();
+        let bins = ((n as f64).sqrt() as usize).clamp(5, 100);
+        let h = theory::histogram(&speeds, vmax, bins);
+        let cols = vec!["v".to_string(), "density".to_string(), "maxwell_boltzmann".to_string()];
+        let mut w = mote_io::csv::CsvWriter::create(&out.base.join(f), &out.provenance, &cols, &[])?;
+        let dv = vmax / bins as f64;
+        for (k, hk) in h.iter().enumerate() {
+            let v = (k as f64 + 0.5) * dv;
+            let f = if D == 2 {
+                2.0 * v / b2 * (-v * v / b2).exp()
+            } else {
+                4.0 / std::f64::consts::PI.sqrt() * v * v / b2.powf(1.5) * (-v * v / b2).exp()
+            };
+            w.row(&[v, *hk, f])?;
+        }
+        result.outputs.push(w.path().to_path_buf());
+    }
+    result.speeds = speeds;
+    for f in [&scene.trajectory, &scene.observables].into_iter().flatten() {
+        result.outputs.push(out.base.join(f));
+    }
+    Ok(result)
+}
+
+/// The current state as a mote-io frame (z = 0 for disks).
+pub fn frame<const D: usize>(sys: &System<D>) -> mote_io::xyz::Frame {
+    let mut cell = [[0.0; 3]; 3];
+    let mut pbc = [false; 3];
+    for d in 0..3 {
+        cell[d][d] = if d < D { sys.simbox().size[d] } else { 0.0 };
+        pbc[d] = d < D && sys.simbox().boundary[d] == Boundary::Periodic;
+    }
+    if D == 2 {
+        cell[2][2] = 2.0 * sys.max_radius();
+    }
+    let n = sys.len();
+    mote_io::xyz::Frame {
+        time: sys.time(),
+        cell,
+        origin: [0.0; 3],
+        pbc,
+        species: vec!["H".to_string(); n],
+        positions: sys.positions().iter().map(to3).collect(),
+        velocities: sys.velocities().iter().map(to3).collect(),
+        radii: sys.radii().to_vec(),
+    }
+}

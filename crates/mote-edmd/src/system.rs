@@ -1,0 +1,850 @@
+//! The event-driven system: particles in free flight between instantaneous
+//! elastic collisions, one source for disks (D = 2) and spheres (D = 3).
+//!
+//! Collision rule: 002 §2.4, Eq. (9a,b) (elastic, per-particle masses).
+//! Collision prediction: the robust quadratic of Bannerman, Strobl, Lue &
+//! Ziegler, arXiv:1211.6718 (overlapping *and* approaching pairs collide now;
+//! the root is taken in the cancellation-free form `c / (−b + √(b² − ac))`).
+//! Scheduling: one event per particle in an indexed binary heap, invalidated
+//! by per-particle collision counters (Smallenburg, arXiv:2201.01099);
+//! neighbours from a cell list whose cells are at least one largest diameter
+//! wide, with cell-crossing events; free flight is lazy (each particle keeps
+//! its own time `t_i` and is advanced only when it takes part in an event).
+//!
+//! Growth (issue 5) fits in by replacing the contact distance σ_ij with
+//! σ_ij(t) = σ_ij(0)(1 + δt) in [`pair_time`] and widening the cells; the
+//! event loop itself does not change.
+
+use crate::queue::EventQueue;
+use crate::vecd::{add_scaled, dot, sub};
+use crate::EdmdError;
+use serde::{Deserialize, Serialize};
+
+/// What one axis of the box does at its faces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Boundary {
+    /// The axis wraps around.
+    Periodic,
+    /// Hard reflecting walls at 0 and L.
+    Wall,
+}
+
+/// The box `[0, L_0] × … × [0, L_{D-1}]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimBox<const D: usize> {
+    pub size: [f64; D],
+    pub boundary: [Boundary; D],
+}
+
+impl<const D: usize> SimBox<D> {
+    pub fn volume(&self) -> f64 {
+        self.size.iter().product()
+    }
+}
+
+/// The kind of a scheduled event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    None,
+    Collision,
+    /// Leaves its cell along `axis` (`up`: towards larger coordinates).
+    Cell,
+    /// Hits the wall of `axis` (`up`: the wall at L).
+    Wall,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Event {
+    kind: Kind,
+    partner: u32,
+    axis: u8,
+    up: bool,
+    /// The partner's collision counter when the event was predicted.
+    partner_count: u64,
+}
+
+const NO_EVENT: Event = Event {
+    kind: Kind::None,
+    partner: u32::MAX,
+    axis: 0,
+    up: false,
+    partner_count: 0,
+};
+
+const NONE: u32 = u32::MAX;
+
+/// Running totals since the last [`System::reset_counters`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Counters {
+    /// Pair collisions.
+    pub collisions: u64,
+    /// Wall collisions.
+    pub wall_hits: u64,
+    /// Cell crossings.
+    pub cell_crossings: u64,
+    /// Events found invalid when they came up.
+    pub invalid: u64,
+    /// Σ r_ij·Δp_i over pair collisions (the collision virial).
+    pub virial: f64,
+    /// Σ |Δp| over wall collisions, per axis.
+    pub wall_impulse_sum: f64,
+    /// Simulated time at the start of the counting window.
+    pub since: f64,
+}
+
+/// The state of a hard-sphere (D = 3) or hard-disk (D = 2) system.
+///
+/// Positions are stored at each particle's own time `t_i`; use
+/// [`System::position`] for the position at the current time or
+/// [`System::synchronize`] to advance everyone.
+#[derive(Debug, Clone)]
+pub struct System<const D: usize> {
+    pub(crate) simbox: SimBox<D>,
+    pos: Vec<[f64; D]>,
+    vel: Vec<[f64; D]>,
+    t: Vec<f64>,
+    radius: Vec<f64>,
+    mass: Vec<f64>,
+    count: Vec<u64>,
+    // cells
+    ncell: [usize; D],
+    cwidth: [f64; D],
+    stride: [usize; D],
+    cidx: Vec<[u32; D]>,
+    head: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    offsets: Vec<[i32; D]>,
+    // events
+    events: Vec<Event>,
+    queue: EventQueue,
+    now: f64,
+    counters: Counters,
+    max_radius: f64,
+}
+
+/// Time until two particles at relative position `r` with relative velocity
+/// `v` reach the contact distance `sigma`, or +∞.
+///
+/// Bannerman et al., arXiv:1211.6718, Sec. 3: a pair that is (by round-off)
+/// already inside contact and approaching collides now; otherwise the earlier
+/// root of `a t² + 2 b t + c = 0`, `a = v·v`, `b = r·v`, `c = r·r − σ²`, is
+/// computed as `c / (−b + √(b² − ac))`, which has no cancellation for b < 0.
+#[inline]
+pub fn pair_time<const D: usize>(r: &[f64; D], v: &[f64; D], sigma: f64) -> f64 {
+    let b = dot(r, v);
+    if b >= 0.0 {
+        return f64::INFINITY;
+    }
+    let c = dot(r, r) - sigma * sigma;
+    if c <= 0.0 {
+        return 0.0;
+    }
+    let a = dot(v, v);
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return f64::INFINITY;
+    }
+    c / (-b + disc.sqrt())
+}
+
+impl<const D: usize> System<D> {
+    /// Builds a system; checks that particles lie inside the box and do not
+    /// overlap (relative tolerance 1e-9 of the contact distance), and
+    /// schedules the first events.
+    pub fn new(
+        simbox: SimBox<D>,
+        positions: Vec<[f64; D]>,
+        velocities: Vec<[f64; D]>,
+        radii: Vec<f64>,
+        masses: Vec<f64>,
+    ) -> Result<Self, EdmdError> {
+        let n = positions.len();
+        if velocities.len() != n || radii.len() != n || masses.len() != n {
+            return Err(EdmdError::Invalid(
+                "positions, velocities, radii and masses differ in length".into(),
+            ));
+        }
+        if n >= NONE as usize {
+            return Err(EdmdError::Invalid("too many particles".into()));
+        }
+        for (i, (&r, &m)) in radii.iter().zip(&masses).enumerate() {
+            if !(r > 0.0 && r.is_finite()) || !(m > 0.0 && m.is_finite()) {
+                return Err(EdmdError::Invalid(format!(
+                    "particle {i}: radius {r} and mass {m} must be positive and finite"
+                )));
+            }
+            if velocities[i].iter().any(|x| !x.is_finite()) {
+                return Err(EdmdError::Invalid(format!(
+                    "particle {i}: velocity is not finite"
+                )));
+            }
+        }
+        let max_radius = radii.iter().cloned().fold(0.0, f64::max);
+        let dmax = 2.0 * max_radius;
+        let mut ncell = [1usize; D];
+        let mut cwidth = [0.0; D];
+        for d in 0..D {
+            let l = simbox.size[d];
+            if !(l > 0.0 && l.is_finite()) {
+                return Err(EdmdError::Invalid(format!(
+                    "box length {l} on axis {d} must be positive"
+                )));
+            }
+            let nc = if dmax > 0.0 {
+                ((l / (dmax * (1.0 + 1e-9))).floor() as usize).max(1)
+            } else {
+                1
+            };
+            if simbox.boundary[d] == Boundary::Periodic && nc < 3 {
+                return Err(EdmdError::Invalid(format!(
+                    "periodic axis {d}: box length {l} must exceed three largest diameters ({})",
+                    3.0 * dmax
+                )));
+            }
+            // Keep the cell count moderate: at most about 2 cells per particle.
+            ncell[d] = nc.min(1 << 20);
+            cwidth[d] = l / ncell[d] as f64;
+        }
+        let total: usize = ncell.iter().product();
+        // reduce cells if far more cells than particles (dilute gas)
+        let mut ncell = ncell;
+        let mut tot = total;
+        while tot > 4 * n.max(1) + 64 {
+            let (dmx, _) = ncell
+                .iter()
+                .enumerate()
+                .max_by_key(|(_, &c)| c)
+                .expect("D > 0");
+            let keep3 = simbox.boundary[dmx] == Boundary::Periodic;
+            let nn = ncell[dmx] / 2;
+            if nn < 1 || (keep3 && nn < 3) {
+                break;
+            }
+            ncell[dmx] = nn;
+            cwidth[dmx] = simbox.size[dmx] / nn as f64;
+            tot = ncell.iter().product();
+        }
+        let mut stride = [1usize; D];
+        for d in 1..D {
+            stride[d] = stride[d - 1] * ncell[d - 1];
+        }
+        let mut offsets = Vec::new();
+        let n3 = 3usize.pow(D as u32);
+        for k in 0..n3 {
+            let mut o = [0i32; D];
+            let mut kk = k;
+            for item in o.iter_mut() {
+                *item = (kk % 3) as i32 - 1;
+                kk /= 3;
+            }
+            offsets.push(o);
+        }
+        let mut sys = System {
+            simbox,
+            pos: positions,
+            vel: velocities,
+            t: vec![0.0; n],
+            radius: radii,
+            mass: masses,
+            count: vec![0; n],
+            ncell,
+            cwidth,
+            stride,
+            cidx: vec![[0; D]; n],
+            head: vec![NONE; tot],
+            next: vec![NONE; n],
+            prev: vec![NONE; n],
+            offsets,
+            events: vec![NO_EVENT; n],
+            queue: EventQueue::new(n),
+            now: 0.0,
+            counters: Counters::default(),
+            max_radius,
+        };
+        for i in 0..n {
+            for d in 0..D {
+                let x = sys.pos[i][d];
+                let r = sys.radius[i];
+                let l = simbox.size[d];
+                let ok = match simbox.boundary[d] {
+                    Boundary::Periodic => x.is_finite(),
+                    Boundary::Wall => x - r >= -1e-12 * l && x + r <= l * (1.0 + 1e-12),
+                };
+                if !ok {
+                    return Err(EdmdError::Invalid(format!(
+                        "particle {i} at {:?} (radius {r}) is outside the box {:?}",
+                        sys.pos[i], simbox.size
+                    )));
+                }
+                if simbox.boundary[d] == Boundary::Periodic {
+                    sys.pos[i][d] = x.rem_euclid(l);
+                    if sys.pos[i][d] >= l {
+                        sys.pos[i][d] = 0.0;
+                    }
+                }
+            }
+            let c = sys.cell_of(&sys.pos[i]);
+            sys.cidx[i] = c;
+            sys.insert(i);
+        }
+        if let Some((i, j, gap)) = sys.find_overlap(1e-9) {
+            return Err(EdmdError::Invalid(format!(
+                "particles {i} and {j} overlap (distance/contact − 1 = {gap:.3e})"
+            )));
+        }
+        for i in 0..n {
+            sys.predict(i);
+        }
+        Ok(sys)
+    }
+
+    fn cell_of(&self, x: &[f64; D]) -> [u32; D] {
+        let mut c = [0u32; D];
+        for d in 0..D {
+            let k = (x[d] / self.cwidth[d]).floor();
+            c[d] = (k.max(0.0) as usize).min(self.ncell[d] - 1) as u32;
+        }
+        c
+    }
+
+    #[inline]
+    fn flat(&self, c: &[u32; D]) -> usize {
+        let mut f = 0;
+        for d in 0..D {
+            f += c[d] as usize * self.stride[d];
+        }
+        f
+    }
+
+    #[inline]
+    fn insert(&mut self, i: usize) {
+        let f = self.flat(&self.cidx[i]);
+        let h = self.head[f];
+        self.next[i] = h;
+        self.prev[i] = NONE;
+        if h != NONE {
+            self.prev[h as usize] = i as u32;
+        }
+        self.head[f] = i as u32;
+    }
+
+    #[inline]
+    fn remove(&mut self, i: usize) {
+        let (p, nx) = (self.prev[i], self.next[i]);
+        if p != NONE {
+            self.next[p as usize] = nx;
+        } else {
+            let f = self.flat(&self.cidx[i]);
+            self.head[f] = nx;
+        }
+        if nx != NONE {
+            self.prev[nx as usize] = p;
+        }
+    }
+
+    // ----- accessors -----------------------------------------------------
+
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+    /// Current simulated time.
+    pub fn time(&self) -> f64 {
+        self.now
+    }
+    pub fn simbox(&self) -> &SimBox<D> {
+        &self.simbox
+    }
+    pub fn radii(&self) -> &[f64] {
+        &self.radius
+    }
+    pub fn masses(&self) -> &[f64] {
+        &self.mass
+    }
+    pub fn velocities(&self) -> &[[f64; D]] {
+        &self.vel
+    }
+    pub fn counters(&self) -> &Counters {
+        &self.counters
+    }
+    /// Cells per axis of the neighbour grid.
+    pub fn cells(&self) -> [usize; D] {
+        self.ncell
+    }
+    /// Largest radius.
+    pub fn max_radius(&self) -> f64 {
+        self.max_radius
+    }
+
+    /// Position of particle `i` at the current time (inside the box).
+    pub fn position(&self, i: usize) -> [f64; D] {
+        add_scaled(&self.pos[i], &self.vel[i], self.now - self.t[i])
+    }
+
+    /// Positions of all particles at the current time.
+    pub fn positions(&self) -> Vec<[f64; D]> {
+        (0..self.len()).map(|i| self.position(i)).collect()
+    }
+
+    /// Advances every particle to the current time (does not change any
+    /// trajectory or scheduled event).
+    pub fn synchronize(&mut self) {
+        for i in 0..self.len() {
+            self.advance(i);
+        }
+    }
+
+    #[inline]
+    fn advance(&mut self, i: usize) {
+        let dt = self.now - self.t[i];
+        if dt != 0.0 {
+            self.pos[i] = add_scaled(&self.pos[i], &self.vel[i], dt);
+            self.t[i] = self.now;
+        }
+    }
+
+    /// Kinetic energy Σ m v²/2.
+    pub fn kinetic_energy(&self) -> f64 {
+        self.vel
+            .iter()
+            .zip(&self.mass)
+            .map(|(v, m)| 0.5 * m * dot(v, v))
+            .sum()
+    }
+
+    /// Total momentum Σ m v.
+    pub fn momentum(&self) -> [f64; D] {
+        let mut p = [0.0; D];
+        for (v, m) in self.vel.iter().zip(&self.mass) {
+            for d in 0..D {
+                p[d] += m * v[d];
+            }
+        }
+        p
+    }
+
+    /// Temperature k_B T = 2 K / (D N) (no degrees of freedom removed).
+    pub fn temperature(&self) -> f64 {
+        2.0 * self.kinetic_energy() / (D as f64 * self.len() as f64)
+    }
+
+    /// Packing fraction: Σ particle volumes / box volume.
+    pub fn packing_fraction(&self) -> f64 {
+        let unit = if D == 2 {
+            std::f64::consts::PI
+        } else {
+            4.0 / 3.0 * std::f64::consts::PI
+        };
+        self.radius.iter().map(|r| unit * r.powi(D as i32)).sum::<f64>() / self.simbox.volume()
+    }
+
+    /// Speeds |v_i|.
+    pub fn speeds(&self) -> Vec<f64> {
+        self.vel.iter().map(|v| dot(v, v).sqrt()).collect()
+    }
+
+    /// Starts a new window for the collision counters and virial.
+    pub fn reset_counters(&mut self) {
+        self.counters = Counters {
+            since: self.now,
+            ..Counters::default()
+        };
+    }
+
+    /// Compressibility factor Z = PV/(N k_B T) over the current counting
+    /// window, from the collision virial: PV = N k_B T + Σ r_ij·Δp_i /(D t)
+    /// (Alder & Wainwright, J. Chem. Phys. 33, 1439 (1960)); with
+    /// N k_B T = 2K/D this is Z = 1 + Σ r_ij·Δp_i / (2 K t). Walls are not
+    /// counted: for a bulk pressure use periodic axes.
+    pub fn compressibility(&self) -> f64 {
+        let t = self.now - self.counters.since;
+        if t <= 0.0 {
+            return f64::NAN;
+        }
+        1.0 + self.counters.virial / (2.0 * self.kinetic_energy() * t)
+    }
+
+    /// Pressure P = Z N k_B T / V over the current window.
+    pub fn pressure(&self) -> f64 {
+        self.compressibility() * self.len() as f64 * self.temperature() / self.simbox.volume()
+    }
+
+    /// Pressure on the walls: Σ|Δp| / (t · wall area), over the current window
+    /// (NaN if there are no walls).
+    pub fn wall_pressure(&self) -> f64 {
+        let t = self.now - self.counters.since;
+        let mut area = 0.0;
+        for d in 0..D {
+            if self.simbox.boundary[d] == Boundary::Wall {
+                area += 2.0 * self.simbox.volume() / self.simbox.size[d];
+            }
+        }
+        if area == 0.0 || t <= 0.0 {
+            return f64::NAN;
+        }
+        self.counters.wall_impulse_sum / (t * area)
+    }
+
+    /// Pair collisions per particle per unit time over the current window
+    /// (each collision counts for two particles).
+    pub fn collision_rate(&self) -> f64 {
+        let t = self.now - self.counters.since;
+        2.0 * self.counters.collisions as f64 / (self.len() as f64 * t)
+    }
+
+    /// Mean free time: 1 / collision rate per particle.
+    pub fn mean_free_time(&self) -> f64 {
+        1.0 / self.collision_rate()
+    }
+
+    // ----- overlap check -------------------------------------------------
+
+    /// Minimum-image separation r_i − r_j at the current time.
+    pub fn separation(&self, i: usize, j: usize) -> [f64; D] {
+        let mut r = sub(&self.position(i), &self.position(j));
+        for (d, rd) in r.iter_mut().enumerate() {
+            if self.simbox.boundary[d] == Boundary::Periodic {
+                let l = self.simbox.size[d];
+                *rd -= l * (*rd / l).round();
+            }
+        }
+        r
+    }
+
+    /// The first pair whose distance is below its contact distance by more
+    /// than `rel_tol` (relative), as `(i, j, |r|/σ − 1)`; also reports a
+    /// particle outside a wall as `(i, i, depth)`. Exact: it checks every
+    /// pair in neighbouring cells, which holds all pairs that could touch.
+    pub fn find_overlap(&self, rel_tol: f64) -> Option<(usize, usize, f64)> {
+        let n = self.len();
+        let pos = self.positions();
+        for i in 0..n {
+            for d in 0..D {
+                if self.simbox.boundary[d] == Boundary::Wall {
+                    let r = self.radius[i];
+                    let l = self.simbox.size[d];
+                    let depth = (r - pos[i][d]).max(pos[i][d] + r - l);
+                    if depth > rel_tol * r {
+                        return Some((i, i, depth / r));
+                    }
+                }
+            }
+        }
+        for i in 0..n {
+            let ci = self.cidx[i];
+            for off in &self.offsets {
+                let mut cc = [0u32; D];
+                let mut skip = false;
+                for d in 0..D {
+                    let k = ci[d] as i64 + off[d] as i64;
+                    let m = self.ncell[d] as i64;
+                    if (0..m).contains(&k) {
+                        cc[d] = k as u32;
+                    } else if self.simbox.boundary[d] == Boundary::Periodic {
+                        cc[d] = k.rem_euclid(m) as u32;
+                    } else {
+                        skip = true;
+                    }
+                }
+                if skip {
+                    continue;
+                }
+                let mut j = self.head[self.flat(&cc)];
+                while j != NONE {
+                    let ju = j as usize;
+                    if ju > i {
+                        let r = self.separation(i, ju);
+                        let s = self.radius[i] + self.radius[ju];
+                        let dist = dot(&r, &r).sqrt();
+                        if dist < s * (1.0 - rel_tol) {
+                            return Some((i, ju, dist / s - 1.0));
+                        }
+                    }
+                    j = self.next[ju];
+                }
+            }
+        }
+        None
+    }
+
+    /// Like [`System::find_overlap`] but over all N² pairs, without the cell
+    /// list (for tests of the cell list itself).
+    pub fn find_overlap_all_pairs(&self, rel_tol: f64) -> Option<(usize, usize, f64)> {
+        let n = self.len();
+        for i in 0..n {
+            for j in (i + 1)..n {
+                let r = self.separation(i, j);
+                let s = self.radius[i] + self.radius[j];
+                let dist = dot(&r, &r).sqrt();
+                if dist < s * (1.0 - rel_tol) {
+                    return Some((i, j, dist / s - 1.0));
+                }
+            }
+        }
+        None
+    }
+
+    // ----- prediction ----------------------------------------------------
+
+    /// Schedules the next event of particle `i` (advanced to now).
+    fn predict(&mut self, i: usize) {
+        self.advance(i);
+        let xi = self.pos[i];
+        let vi = self.vel[i];
+        let ri = self.radius[i];
+        let ci = self.cidx[i];
+        let mut best = f64::INFINITY;
+        let mut ev = NO_EVENT;
+        // cell crossings and walls
+        for d in 0..D {
+            let v = vi[d];
+            if v == 0.0 {
+                continue;
+            }
+            let up = v > 0.0;
+            let c = ci[d] as usize;
+            let at_edge = if up { c + 1 == self.ncell[d] } else { c == 0 };
+            let (dt, kind) = if at_edge && self.simbox.boundary[d] == Boundary::Wall {
+                let target = if up { self.simbox.size[d] - ri } else { ri };
+                (((target - xi[d]) / v).max(0.0), Kind::Wall)
+            } else {
+                let edge = if up { c + 1 } else { c } as f64 * self.cwidth[d];
+                (((edge - xi[d]) / v).max(0.0), Kind::Cell)
+            };
+            if dt < best {
+                best = dt;
+                ev = Event {
+                    kind,
+                    partner: NONE,
+                    axis: d as u8,
+                    up,
+                    partner_count: 0,
+                };
+            }
+        }
+        // collisions with particles in the 3^D neighbouring cells
+        let now = self.now;
+        for o in 0..self.offsets.len() {
+            let off = self.offsets[o];
+            let mut shift = [0.0; D];
+            let mut cc = [0u32; D];
+            let mut skip = false;
+            for d in 0..D {
+                let k = ci[d] as i64 + off[d] as i64;
+                let n = self.ncell[d] as i64;
+                if k < 0 {
+                    if self.simbox.boundary[d] == Boundary::Periodic {
+                        cc[d] = (n - 1) as u32;
+                        shift[d] = -self.simbox.size[d];
+                    } else {
+                        skip = true;
+                        break;
+                    }
+                } else if k >= n {
+                    if self.simbox.boundary[d] == Boundary::Periodic {
+                        cc[d] = 0;
+                        shift[d] = self.simbox.size[d];
+                    } else {
+                        skip = true;
+                        break;
+                    }
+                } else {
+                    cc[d] = k as u32;
+                }
+            }
+            if skip {
+                continue;
+            }
+            let mut j = self.head[self.flat(&cc)];
+            while j != NONE {
+                let ju = j as usize;
+                if ju != i {
+                    let dtj = now - self.t[ju];
+                    let vj = self.vel[ju];
+                    let mut r = [0.0; D];
+                    let mut v = [0.0; D];
+                    for d in 0..D {
+                        r[d] = xi[d] - (self.pos[ju][d] + vj[d] * dtj + shift[d]);
+                        v[d] = vi[d] - vj[d];
+                    }
+                    let dt = pair_time(&r, &v, ri + self.radius[ju]);
+                    if dt < best {
+                        best = dt;
+                        ev = Event {
+                            kind: Kind::Collision,
+                            partner: j,
+                            axis: 0,
+                            up: false,
+                            partner_count: self.count[ju],
+                        };
+                    }
+                }
+                j = self.next[ju];
+            }
+        }
+        self.events[i] = ev;
+        self.queue.update(i, now + best);
+    }
+
+    // ----- the event loop ------------------------------------------------
+
+    /// Processes the next event if it happens no later than `t_end`;
+    /// returns false (and leaves the time unchanged) otherwise.
+    pub fn step(&mut self, t_end: f64) -> bool {
+        let Some((t, i)) = self.queue.min() else {
+            return false;
+        };
+        if t > t_end || t == f64::INFINITY {
+            return false;
+        }
+        self.now = t;
+        let ev = self.events[i];
+        match ev.kind {
+            Kind::None => {
+                // no event at all (particle at rest, no partner): park it
+                self.queue.update(i, f64::INFINITY);
+            }
+            Kind::Collision => {
+                let j = ev.partner as usize;
+                if self.count[j] != ev.partner_count {
+                    self.counters.invalid += 1;
+                    self.predict(i);
+                } else {
+                    self.collide(i, j);
+                    self.predict(i);
+                    self.predict(j);
+                }
+            }
+            Kind::Cell => {
+                self.advance(i);
+                self.counters.cell_crossings += 1;
+                self.remove(i);
+                let d = ev.axis as usize;
+                let n = self.ncell[d] as u32;
+                let l = self.simbox.size[d];
+                if ev.up {
+                    if self.cidx[i][d] + 1 == n {
+                        self.cidx[i][d] = 0;
+                        self.pos[i][d] -= l;
+                    } else {
+                        self.cidx[i][d] += 1;
+                    }
+                } else if self.cidx[i][d] == 0 {
+                    self.cidx[i][d] = n - 1;
+                    self.pos[i][d] += l;
+                } else {
+                    self.cidx[i][d] -= 1;
+                }
+                self.insert(i);
+                self.predict(i);
+            }
+            Kind::Wall => {
+                self.advance(i);
+                let d = ev.axis as usize;
+                let v = self.vel[i][d];
+                if (v > 0.0) == ev.up {
+                    self.vel[i][d] = -v;
+                    self.counters.wall_hits += 1;
+                    self.counters.wall_impulse_sum += 2.0 * self.mass[i] * v.abs();
+                    self.count[i] += 1;
+                }
+                self.predict(i);
+            }
+        }
+        true
+    }
+
+    /// Elastic collision of i and j at the current time, 002 Eq. (9a,b).
+    fn collide(&mut self, i: usize, j: usize) {
+        self.advance(i);
+        self.advance(j);
+        let mut r = sub(&self.pos[i], &self.pos[j]);
+        // periodic image: pick the nearest (neighbour cells are at most one
+        // box length apart, and periodic axes have at least three cells)
+        for (d, rd) in r.iter_mut().enumerate() {
+            if self.simbox.boundary[d] == Boundary::Periodic {
+                let l = self.simbox.size[d];
+                if *rd > 0.5 * l {
+                    *rd -= l;
+                } else if *rd < -0.5 * l {
+                    *rd += l;
+                }
+            }
+        }
+        let v = sub(&self.vel[i], &self.vel[j]);
+        let b = dot(&r, &v);
+        let r2 = dot(&r, &r);
+        let (mi, mj) = (self.mass[i], self.mass[j]);
+        let mu = mi * mj / (mi + mj);
+        // Δp_i = −2 μ (b / r²) r
+        let f = -2.0 * mu * b / r2;
+        for d in 0..D {
+            self.vel[i][d] += f / mi * r[d];
+            self.vel[j][d] -= f / mj * r[d];
+        }
+        self.counters.virial += -2.0 * mu * b;
+        self.counters.collisions += 1;
+        self.count[i] += 1;
+        self.count[j] += 1;
+    }
+
+    /// Runs until time `t_end` (all events up to and including `t_end`),
+    /// then sets the clock to `t_end`. Returns the number of events.
+    pub fn run_until(&mut self, t_end: f64) -> u64 {
+        let mut k = 0;
+        while self.step(t_end) {
+            k += 1;
+        }
+        if t_end > self.now {
+            self.now = t_end;
+        }
+        k
+    }
+
+    /// Runs until `count` more pair collisions have happened.
+    pub fn run_collisions(&mut self, count: u64) {
+        let target = self.counters.collisions + count;
+        while self.counters.collisions < target {
+            if !self.step(f64::INFINITY) {
+                break;
+            }
+        }
+    }
+
+    /// Scales all velocities by `s` (a thermostat step); trajectories
+    /// change, so every event is predicted again.
+    pub fn scale_velocities(&mut self, s: f64) {
+        self.synchronize();
+        for i in 0..self.len() {
+            for d in 0..D {
+                self.vel[i][d] *= s;
+            }
+            self.count[i] += 1;
+        }
+        for i in 0..self.len() {
+            self.predict(i);
+        }
+        self.counters.since = self.now;
+        self.counters.virial = 0.0;
+        self.counters.collisions = 0;
+        self.counters.wall_hits = 0;
+        self.counters.wall_impulse_sum = 0.0;
+    }
+
+    /// Shifts the clock back to zero (keeps numbers small in long runs):
+    /// positions are synchronized and every event predicted again.
+    pub fn rebase_time(&mut self) {
+        self.synchronize();
+        let t0 = self.now;
+        self.t.iter_mut().for_each(|t| *t = 0.0);
+        self.now = 0.0;
+        self.counters.since -= t0;
+        for i in 0..self.len() {
+            self.predict(i);
+        }
+    }
+}

@@ -1,0 +1,27 @@
+//! Global damping (MPPphys `damp`): F_i = −γ v_i on every particle.
+
+use glam::DVec3;
+
+use super::{Interaction, State};
+
+/// Viscous drag with coefficient γ (force per velocity), the same for all particles.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GlobalDamping {
+    pub gamma: f64,
+}
+
+impl Interaction for GlobalDamping {
+    fn name(&self) -> &'static str {
+        "damping"
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
+        for (f, v) in force.iter_mut().zip(state.velocity) {
+            *f -= *v * self.gamma;
+        }
+    }
+
+    fn potential_energy(&mut self, _state: &State) -> f64 {
+        0.0
+    }
+}

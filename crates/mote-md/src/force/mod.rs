@@ -1,0 +1,85 @@
+//! Forces: an [`Interaction`] adds forces to every particle it acts on; a
+//! [`ForceField`] is the list of interactions of a run. One virtual call per
+//! interaction per evaluation, never per pair: each interaction's pair loop
+//! is a plain generic loop over `#[inline]` kernels.
+
+mod damping;
+mod gravity;
+mod springs;
+mod uniform;
+
+pub use damping::GlobalDamping;
+pub use gravity::DirectGravity;
+pub use springs::{Spring, SpringNetwork};
+pub use uniform::UniformField;
+
+use glam::DVec3;
+
+/// A read-only view of the state at which forces are evaluated (the
+/// integrator's stage, which need not be the system's current state).
+#[derive(Clone, Copy)]
+pub struct State<'a> {
+    pub position: &'a [DVec3],
+    pub velocity: &'a [DVec3],
+    pub mass: &'a [f64],
+    pub time: f64,
+}
+
+/// Something that exerts forces.
+pub trait Interaction: Send {
+    /// A short name for reports (`gravity`, `springs`, ...).
+    fn name(&self) -> &'static str;
+    /// Adds this interaction's force on each particle to `force`.
+    fn add_forces(&mut self, state: &State, force: &mut [DVec3]);
+    /// The potential energy of the interaction; 0 for dissipative forces.
+    fn potential_energy(&mut self, state: &State) -> f64;
+}
+
+/// All interactions of a run.
+#[derive(Default)]
+pub struct ForceField {
+    pub interactions: Vec<Box<dyn Interaction>>,
+    force: Vec<DVec3>,
+}
+
+impl ForceField {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn with(mut self, interaction: impl Interaction + 'static) -> Self {
+        self.push(interaction);
+        self
+    }
+
+    pub fn push(&mut self, interaction: impl Interaction + 'static) {
+        self.interactions.push(Box::new(interaction));
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.interactions.is_empty()
+    }
+
+    /// Accelerations a_i = F_i / m_i, zero along fixed axes (`mobility`).
+    pub fn accelerations(&mut self, state: &State, mobility: &[DVec3], acc: &mut [DVec3]) {
+        let n = state.position.len();
+        self.force.clear();
+        self.force.resize(n, DVec3::ZERO);
+        for interaction in &mut self.interactions {
+            interaction.add_forces(state, &mut self.force);
+        }
+        for i in 0..n {
+            acc[i] = self.force[i] / state.mass[i] * mobility[i];
+        }
+    }
+
+    /// Total potential energy, and its parts by interaction name.
+    pub fn potential_energy(&mut self, state: &State) -> (f64, Vec<(&'static str, f64)>) {
+        let parts: Vec<(&'static str, f64)> = self
+            .interactions
+            .iter_mut()
+            .map(|it| (it.name(), it.potential_energy(state)))
+            .collect();
+        (parts.iter().map(|p| p.1).sum(), parts)
+    }
+}

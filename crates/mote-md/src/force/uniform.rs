@@ -1,0 +1,33 @@
+//! A uniform gravitational field (MPPphys `grav`): F_i = m_i g.
+
+use glam::DVec3;
+
+use super::{Interaction, State};
+
+/// Uniform acceleration g acting on every particle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UniformField {
+    pub g: DVec3,
+}
+
+impl Interaction for UniformField {
+    fn name(&self) -> &'static str {
+        "uniform_field"
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
+        for (f, m) in force.iter_mut().zip(state.mass) {
+            *f += self.g * *m;
+        }
+    }
+
+    /// U = −Σ m_i g·x_i.
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        -state
+            .position
+            .iter()
+            .zip(state.mass)
+            .map(|(x, m)| m * self.g.dot(*x))
+            .sum::<f64>()
+    }
+}

@@ -1,0 +1,197 @@
+//! Fixed-step integrators of m ẍ = F(x, ẋ, t).
+//!
+//! - explicit Euler: x' = x + h v, v' = v + h a(x, v) — first order, not
+//!   symplectic: orbits spiral outwards and energy grows without bound;
+//! - semi-implicit (symplectic) Euler: v' = v + h a(x, v), x' = x + h v' — first order;
+//! - classical Runge–Kutta (RK4) on (x, v) — fourth order, not symplectic;
+//! - leap-frog as kick–drift–kick velocity Verlet: v½ = v + h/2 a(x),
+//!   x' = x + h v½, v' = v½ + h/2 a(x') — second order, symplectic, time
+//!   reversible, one force evaluation per step (MPPphys `LF`).
+//!
+//! For velocity-dependent forces (damping) leap-frog evaluates a(x', v½).
+
+use glam::DVec3;
+
+use crate::force::{ForceField, State};
+use crate::particles::System;
+
+/// The integration scheme, selected by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Integrator {
+    Euler,
+    SymplecticEuler,
+    Rk4,
+    LeapFrog,
+}
+
+impl Integrator {
+    /// Accepts mote's names and MPPphys' (`LF`, `RK4`, `euler`), case-insensitively.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Some(match name.to_ascii_lowercase().as_str() {
+            "euler" | "explicit-euler" | "explicit_euler" => Integrator::Euler,
+            "symplectic-euler" | "symplectic_euler" | "semi-implicit-euler" | "semi_implicit_euler" => {
+                Integrator::SymplecticEuler
+            }
+            "rk4" | "runge-kutta" => Integrator::Rk4,
+            "lf" | "leapfrog" | "leap-frog" | "velocity-verlet" | "velocity_verlet" | "kdk" => Integrator::LeapFrog,
+            _ => return None,
+        })
+    }
+
+    pub const NAMES: &'static str = "euler, symplectic-euler, rk4 (RK4), leapfrog (LF, velocity-verlet)";
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Euler => "euler",
+            Integrator::SymplecticEuler => "symplectic-euler",
+            Integrator::Rk4 => "rk4",
+            Integrator::LeapFrog => "leapfrog",
+        }
+    }
+
+    /// Order of the global error in h.
+    pub fn order(self) -> u32 {
+        match self {
+            Integrator::Euler | Integrator::SymplecticEuler => 1,
+            Integrator::LeapFrog => 2,
+            Integrator::Rk4 => 4,
+        }
+    }
+}
+
+/// An integrator with its scratch space (the state itself lives in [`System`]).
+pub struct Stepper {
+    pub scheme: Integrator,
+    acc: Vec<DVec3>,
+    /// Leap-frog reuses a(x) of the previous step's end while this is true.
+    acc_valid: bool,
+    x0: Vec<DVec3>,
+    v0: Vec<DVec3>,
+    xs: Vec<DVec3>,
+    vs: Vec<DVec3>,
+    dx: Vec<DVec3>,
+    dv: Vec<DVec3>,
+}
+
+impl Stepper {
+    pub fn new(scheme: Integrator) -> Self {
+        Self {
+            scheme,
+            acc: Vec::new(),
+            acc_valid: false,
+            x0: Vec::new(),
+            v0: Vec::new(),
+            xs: Vec::new(),
+            vs: Vec::new(),
+            dx: Vec::new(),
+            dv: Vec::new(),
+        }
+    }
+
+    /// Forget cached forces (after the state or the force field was changed from outside).
+    pub fn invalidate(&mut self) {
+        self.acc_valid = false;
+    }
+
+    fn eval(ff: &mut ForceField, sys: &System, x: &[DVec3], v: &[DVec3], t: f64, acc: &mut Vec<DVec3>) {
+        acc.resize(x.len(), DVec3::ZERO);
+        let state = State {
+            position: x,
+            velocity: v,
+            mass: &sys.particles.mass,
+            time: t,
+        };
+        ff.accelerations(&state, &sys.particles.mobility, acc);
+    }
+
+    /// Advances the system by one step h.
+    pub fn step(&mut self, sys: &mut System, ff: &mut ForceField, h: f64) {
+        let t = sys.time;
+        match self.scheme {
+            Integrator::Euler => {
+                let mut acc = std::mem::take(&mut self.acc);
+                Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t, &mut acc);
+                let p = &mut sys.particles;
+                for i in 0..p.len() {
+                    p.position[i] += p.velocity[i] * h;
+                    p.velocity[i] += acc[i] * h;
+                }
+                self.acc = acc;
+                self.acc_valid = false;
+            }
+            Integrator::SymplecticEuler => {
+                let mut acc = std::mem::take(&mut self.acc);
+                Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t, &mut acc);
+                let p = &mut sys.particles;
+                for i in 0..p.len() {
+                    p.velocity[i] += acc[i] * h;
+                    p.position[i] += p.velocity[i] * h;
+                }
+                self.acc = acc;
+                self.acc_valid = false;
+            }
+            Integrator::LeapFrog => {
+                let mut acc = std::mem::take(&mut self.acc);
+                if !self.acc_valid || acc.len() != sys.particles.len() {
+                    Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t, &mut acc);
+                }
+                let half = 0.5 * h;
+                {
+                    let p = &mut sys.particles;
+                    for i in 0..p.len() {
+                        p.velocity[i] += acc[i] * half;
+                        p.position[i] += p.velocity[i] * h;
+                    }
+                }
+                Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t + h, &mut acc);
+                let p = &mut sys.particles;
+                for i in 0..p.len() {
+                    p.velocity[i] += acc[i] * half;
+                }
+                self.acc = acc;
+                self.acc_valid = true;
+            }
+            Integrator::Rk4 => self.rk4(sys, ff, h),
+        }
+        sys.time = t + h;
+        sys.step += 1;
+    }
+
+    /// Classical RK4 on y = (x, v), y' = (v, a(x, v, t)).
+    fn rk4(&mut self, sys: &mut System, ff: &mut ForceField, h: f64) {
+        let n = sys.particles.len();
+        let t = sys.time;
+        self.x0.clone_from(&sys.particles.position);
+        self.v0.clone_from(&sys.particles.velocity);
+        self.dx.clear();
+        self.dx.resize(n, DVec3::ZERO);
+        self.dv.clear();
+        self.dv.resize(n, DVec3::ZERO);
+        self.xs.clone_from(&self.x0);
+        self.vs.clone_from(&self.v0);
+        let mut acc = std::mem::take(&mut self.acc);
+        // Stage weights: k1 and k4 count 1/6, k2 and k3 count 2/6; the next
+        // stage is evaluated at y0 + c·h·k with c = ½, ½, 1.
+        for (stage, (weight, c_next)) in [(1.0, 0.5), (2.0, 0.5), (2.0, 1.0), (1.0, 0.0)].into_iter().enumerate() {
+            let ts = t + h * [0.0, 0.5, 0.5, 1.0][stage];
+            Self::eval(ff, sys, &self.xs, &self.vs, ts, &mut acc);
+            for i in 0..n {
+                let kx = self.vs[i];
+                let kv = acc[i];
+                self.dx[i] += kx * weight;
+                self.dv[i] += kv * weight;
+                if stage < 3 {
+                    self.xs[i] = self.x0[i] + kx * (c_next * h);
+                    self.vs[i] = self.v0[i] + kv * (c_next * h);
+                }
+            }
+        }
+        let p = &mut sys.particles;
+        for i in 0..n {
+            p.position[i] = self.x0[i] + self.dx[i] * (h / 6.0);
+            p.velocity[i] = self.v0[i] + self.dv[i] * (h / 6.0);
+        }
+        self.acc = acc;
+        self.acc_valid = false;
+    }
+}

@@ -1,0 +1,155 @@
+//! Observables of the whole system and the "particle inspector" (002 §3.2).
+
+use glam::DVec3;
+
+use crate::force::{ForceField, State};
+use crate::particles::System;
+
+/// Whole-system observables at one instant.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Observables {
+    pub time: f64,
+    /// K = Σ ½ m v².
+    pub kinetic: f64,
+    /// U from every interaction with a potential.
+    pub potential: f64,
+    /// Total linear momentum P = Σ m v.
+    pub momentum: DVec3,
+    /// Total angular momentum about the origin L = Σ m r × v.
+    pub angular_momentum: DVec3,
+}
+
+impl Observables {
+    pub fn total_energy(&self) -> f64 {
+        self.kinetic + self.potential
+    }
+
+    /// Measures the system (the potential energy needs the force field).
+    pub fn measure(sys: &System, ff: &mut ForceField) -> Self {
+        let p = &sys.particles;
+        let mut kinetic = 0.0;
+        let mut momentum = DVec3::ZERO;
+        let mut angular_momentum = DVec3::ZERO;
+        for i in 0..p.len() {
+            let mv = p.velocity[i] * p.mass[i];
+            kinetic += 0.5 * mv.dot(p.velocity[i]);
+            momentum += mv;
+            angular_momentum += p.position[i].cross(mv);
+        }
+        let state = State {
+            position: &p.position,
+            velocity: &p.velocity,
+            mass: &p.mass,
+            time: sys.time,
+        };
+        let (potential, _) = ff.potential_energy(&state);
+        Self {
+            time: sys.time,
+            kinetic,
+            potential,
+            momentum,
+            angular_momentum,
+        }
+    }
+
+    /// Column names of [`Observables::values`].
+    pub const COLUMNS: [&'static str; 11] = [
+        "time", "kinetic_energy", "potential_energy", "total_energy", "px", "py", "pz", "Lx", "Ly", "Lz", "step",
+    ];
+
+    pub fn values(&self, step: u64) -> [f64; 11] {
+        [
+            self.time,
+            self.kinetic,
+            self.potential,
+            self.total_energy(),
+            self.momentum.x,
+            self.momentum.y,
+            self.momentum.z,
+            self.angular_momentum.x,
+            self.angular_momentum.y,
+            self.angular_momentum.z,
+            step as f64,
+        ]
+    }
+}
+
+/// A per-particle quantity named in a scene, such as `z[30]` or `speed[1]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Probe {
+    pub quantity: ProbeQuantity,
+    pub particle: usize,
+}
+
+/// What a [`Probe`] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProbeQuantity {
+    X,
+    Y,
+    Z,
+    Vx,
+    Vy,
+    Vz,
+    /// |r|, distance from the origin.
+    R,
+    /// |v|.
+    Speed,
+    /// ½ m v².
+    Kinetic,
+}
+
+impl Probe {
+    pub const QUANTITIES: &'static str = "x, y, z, vx, vy, vz, r, speed, kinetic";
+
+    /// Parses `name[index]`.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let err = || format!("'{text}' is not a particle quantity: write NAME[INDEX] with NAME one of {}", Self::QUANTITIES);
+        let (name, rest) = text.trim().split_once('[').ok_or_else(err)?;
+        let index = rest.strip_suffix(']').ok_or_else(err)?;
+        let particle: usize = index.trim().parse().map_err(|_| err())?;
+        let quantity = match name.trim() {
+            "x" => ProbeQuantity::X,
+            "y" => ProbeQuantity::Y,
+            "z" => ProbeQuantity::Z,
+            "vx" => ProbeQuantity::Vx,
+            "vy" => ProbeQuantity::Vy,
+            "vz" => ProbeQuantity::Vz,
+            "r" => ProbeQuantity::R,
+            "speed" => ProbeQuantity::Speed,
+            "kinetic" => ProbeQuantity::Kinetic,
+            _ => return Err(err()),
+        };
+        Ok(Self { quantity, particle })
+    }
+
+    pub fn label(&self) -> String {
+        let name = match self.quantity {
+            ProbeQuantity::X => "x",
+            ProbeQuantity::Y => "y",
+            ProbeQuantity::Z => "z",
+            ProbeQuantity::Vx => "vx",
+            ProbeQuantity::Vy => "vy",
+            ProbeQuantity::Vz => "vz",
+            ProbeQuantity::R => "r",
+            ProbeQuantity::Speed => "speed",
+            ProbeQuantity::Kinetic => "kinetic",
+        };
+        format!("{name}[{}]", self.particle)
+    }
+
+    pub fn read(&self, sys: &System) -> f64 {
+        let p = &sys.particles;
+        let (r, v) = (p.position[self.particle], p.velocity[self.particle]);
+        match self.quantity {
+            ProbeQuantity::X => r.x,
+            ProbeQuantity::Y => r.y,
+            ProbeQuantity::Z => r.z,
+            ProbeQuantity::Vx => v.x,
+            ProbeQuantity::Vy => v.y,
+            ProbeQuantity::Vz => v.z,
+            ProbeQuantity::R => r.length(),
+            ProbeQuantity::Speed => v.length(),
+            ProbeQuantity::Kinetic => 0.5 * p.mass[self.particle] * v.length_squared(),
+        }
+    }
+}

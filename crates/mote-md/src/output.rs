@@ -1,0 +1,101 @@
+//! Observers that write files through mote-io: observables as CSV (with the
+//! particle inspector's columns) and trajectories as extended XYZ.
+
+use std::path::Path;
+
+use mote_io::csv::CsvWriter;
+use mote_io::xyz::{Frame, XyzWriter};
+use mote_io::Provenance;
+
+use crate::error::MdError;
+use crate::observe::{Observables, Probe};
+use crate::particles::System;
+use crate::simulation::Observer;
+use crate::units::UnitSystem;
+
+/// observables.csv: time, energies, momentum, angular momentum, step, probes.
+pub struct ObservablesCsv {
+    writer: CsvWriter,
+    every: u64,
+    probes: Vec<Probe>,
+}
+
+impl ObservablesCsv {
+    pub fn create(path: &Path, provenance: &Provenance, units: UnitSystem, every: u64, probes: Vec<Probe>) -> Result<Self, MdError> {
+        let [l, t, m, e] = units.labels();
+        let p = format!("{m}*{l}/{t}");
+        let ang = format!("{m}*{l}^2/{t}");
+        let mut columns: Vec<String> = Observables::COLUMNS.iter().map(|s| s.to_string()).collect();
+        let mut unit_row: Vec<String> = vec![t.into(), e.into(), e.into(), e.into(), p.clone(), p.clone(), p, ang.clone(), ang.clone(), ang, "1".into()];
+        for probe in &probes {
+            columns.push(probe.label());
+            let label = probe.label();
+            let unit = match label.split('[').next().unwrap_or("") {
+                "x" | "y" | "z" | "r" => l.to_string(),
+                "kinetic" => e.to_string(),
+                _ => format!("{l}/{t}"),
+            };
+            unit_row.push(unit);
+        }
+        Ok(Self { writer: CsvWriter::create(path, provenance, &columns, &unit_row)?, every, probes })
+    }
+}
+
+impl Observer for ObservablesCsv {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, sys: &System, obs: &Observables) -> Result<(), MdError> {
+        let mut row: Vec<f64> = obs.values(sys.step).to_vec();
+        row.extend(self.probes.iter().map(|p| p.read(sys)));
+        Ok(self.writer.row(&row)?)
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.writer.path().display().to_string()]
+    }
+}
+
+/// trajectory.xyz: every particle's position, velocity and radius.
+pub struct TrajectoryXyz {
+    writer: XyzWriter,
+    every: u64,
+}
+
+impl TrajectoryXyz {
+    pub fn create(path: &Path, provenance: Provenance, every: u64) -> Result<Self, MdError> {
+        Ok(Self { writer: XyzWriter::create(path, provenance)?, every })
+    }
+}
+
+/// The system as a plain frame (open boundaries: the cell encloses the particles).
+pub fn frame_of(sys: &System) -> Frame {
+    let p = &sys.particles;
+    let positions: Vec<[f64; 3]> = p.position.iter().map(|r| r.to_array()).collect();
+    let (cell, origin) = Frame::bounding_cell(&positions, &p.radius, 0.0);
+    Frame {
+        time: sys.time,
+        cell,
+        origin,
+        pbc: [false; 3],
+        species: vec!["X".to_string(); p.len()],
+        positions,
+        velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
+        radii: p.radius.clone(),
+    }
+}
+
+impl Observer for TrajectoryXyz {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, sys: &System, _obs: &Observables) -> Result<(), MdError> {
+        Ok(self.writer.write(&frame_of(sys))?)
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.writer.path().display().to_string()]
+    }
+}

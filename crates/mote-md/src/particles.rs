@@ -1,0 +1,101 @@
+//! Particles as a structure of arrays, and the system that owns them.
+
+use glam::DVec3;
+
+/// Per-particle data, one array per quantity (structure of arrays).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Particles {
+    pub position: Vec<DVec3>,
+    pub velocity: Vec<DVec3>,
+    pub mass: Vec<f64>,
+    pub charge: Vec<f64>,
+    pub radius: Vec<f64>,
+    pub color: Vec<[f64; 3]>,
+    /// Per axis 1.0 where the particle may move, 0.0 where it is fixed
+    /// (MPPphys `vfix`); multiplies accelerations and velocities.
+    pub mobility: Vec<DVec3>,
+}
+
+/// Everything needed to add one particle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParticleInit {
+    pub position: DVec3,
+    pub velocity: DVec3,
+    pub mass: f64,
+    pub charge: f64,
+    pub radius: f64,
+    pub color: [f64; 3],
+    pub free: [bool; 3],
+}
+
+impl Default for ParticleInit {
+    fn default() -> Self {
+        Self {
+            position: DVec3::ZERO,
+            velocity: DVec3::ZERO,
+            mass: 1.0,
+            charge: 0.0,
+            radius: 0.0,
+            color: [1.0, 1.0, 1.0],
+            free: [true; 3],
+        }
+    }
+}
+
+impl Particles {
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Appends a particle; fixed axes get zero velocity.
+    pub fn push(&mut self, p: ParticleInit) {
+        let mobility = DVec3::new(
+            p.free[0] as u8 as f64,
+            p.free[1] as u8 as f64,
+            p.free[2] as u8 as f64,
+        );
+        self.position.push(p.position);
+        self.velocity.push(p.velocity * mobility);
+        self.mass.push(p.mass);
+        self.charge.push(p.charge);
+        self.radius.push(p.radius);
+        self.color.push(p.color);
+        self.mobility.push(mobility);
+    }
+}
+
+/// The state of a run: particles, simulated time and step count.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct System {
+    pub particles: Particles,
+    pub time: f64,
+    pub step: u64,
+}
+
+impl System {
+    pub fn new(particles: Particles) -> Self {
+        Self {
+            particles,
+            time: 0.0,
+            step: 0,
+        }
+    }
+
+    /// Moves to the centre-of-mass frame: subtracts the mass-weighted mean
+    /// position and velocity of the free particles (only if none is fixed).
+    pub fn to_centre_of_mass_frame(&mut self) {
+        let p = &mut self.particles;
+        if p.mobility.iter().any(|m| *m != DVec3::ONE) {
+            return;
+        }
+        let m_tot: f64 = p.mass.iter().sum();
+        let r_cm: DVec3 = p.position.iter().zip(&p.mass).map(|(r, m)| *r * *m).sum::<DVec3>() / m_tot;
+        let v_cm: DVec3 = p.velocity.iter().zip(&p.mass).map(|(v, m)| *v * *m).sum::<DVec3>() / m_tot;
+        p.position.iter_mut().for_each(|r| *r -= r_cm);
+        p.velocity.iter_mut().for_each(|v| *v -= v_cm);
+    }
+}

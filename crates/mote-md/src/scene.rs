@@ -1,0 +1,624 @@
+//! Scene files (TOML) and MPPphys particle files, turned into a [`Simulation`].
+//!
+//! Every key is documented in docs/scene-format.md. Particles are numbered in
+//! this order: `[[particle]]` tables, then `[[lattice]]`, `[[ring]]`,
+//! `[[annulus]]` and `[[random_box]]` generators, each in file order.
+
+use glam::DVec3;
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Deserialize;
+use toml::Spanned;
+
+use mote_io::plist::ParticleFile;
+use mote_io::ParseError;
+
+use crate::force::{DirectGravity, ForceField, GlobalDamping, Spring, SpringNetwork, UniformField};
+use crate::init::{self, Anchor};
+use crate::integrate::{Integrator, Stepper};
+use crate::observe::Probe;
+use crate::particles::{ParticleInit, Particles, System};
+use crate::simulation::{RunLength, Simulation};
+use crate::units::UnitSystem;
+
+/// A whole scene file.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// One line saying what the scene is.
+    #[serde(default)]
+    pub title: String,
+    /// `si` (default), `lj` or `astro`.
+    #[serde(default)]
+    pub units: UnitSystem,
+    /// Seed of the random generators; chosen and printed when absent.
+    pub seed: Option<u64>,
+    #[serde(default)]
+    pub run: RunSettings,
+    pub gravity: Option<GravitySettings>,
+    pub field: Option<FieldSettings>,
+    pub damping: Option<DampingSettings>,
+    #[serde(default)]
+    pub particle: Vec<Spanned<ParticleSpec>>,
+    #[serde(default)]
+    pub lattice: Vec<Spanned<LatticeSpec>>,
+    #[serde(default)]
+    pub ring: Vec<Spanned<RingSpec>>,
+    #[serde(default)]
+    pub annulus: Vec<Spanned<AnnulusSpec>>,
+    #[serde(default)]
+    pub random_box: Vec<Spanned<RandomBoxSpec>>,
+    #[serde(default)]
+    pub spring: Vec<Spanned<SpringSpec>>,
+    #[serde(default)]
+    pub output: OutputSettings,
+}
+
+/// `[run]`: integrator, time step and length.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSettings {
+    pub integrator: Spanned<String>,
+    pub dt: Option<Spanned<f64>>,
+    pub steps: Option<u64>,
+    pub until: Option<f64>,
+    /// Move to the centre-of-mass frame before the run (only if nothing is fixed).
+    #[serde(default)]
+    pub centre_of_mass: bool,
+}
+
+impl Default for RunSettings {
+    fn default() -> Self {
+        Self {
+            integrator: Spanned::new(0..0, "leapfrog".into()),
+            dt: None,
+            steps: None,
+            until: None,
+            centre_of_mass: false,
+        }
+    }
+}
+
+/// `[gravity]`: softened direct-summation Newtonian gravity (002 Eq. 2).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySettings {
+    /// Newton's constant; default: the unit system's (k² in astro units).
+    #[serde(rename = "G")]
+    pub g: Option<f64>,
+    #[serde(default)]
+    pub softening: f64,
+}
+
+/// `[field]`: uniform gravitational acceleration (MPPphys `grav`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldSettings {
+    pub g: [f64; 3],
+}
+
+/// `[damping]`: force −γ v on every particle (MPPphys `damp`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DampingSettings {
+    pub gamma: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn white() -> [f64; 3] {
+    [1.0, 1.0, 1.0]
+}
+fn all_free() -> [bool; 3] {
+    [true; 3]
+}
+
+/// Properties shared by the particles a table makes.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Properties {
+    #[serde(default = "one")]
+    pub mass: f64,
+    #[serde(default)]
+    pub charge: f64,
+    #[serde(default)]
+    pub radius: f64,
+    #[serde(default = "white")]
+    pub color: [f64; 3],
+    /// Per axis: may the particle move? (MPPphys `vfix` 1 1 1 = all free.)
+    #[serde(default = "all_free")]
+    pub free: [bool; 3],
+}
+
+impl Default for Properties {
+    fn default() -> Self {
+        Self {
+            mass: 1.0,
+            charge: 0.0,
+            radius: 0.0,
+            color: white(),
+            free: all_free(),
+        }
+    }
+}
+
+impl Properties {
+    fn template(&self) -> ParticleInit {
+        ParticleInit {
+            mass: self.mass,
+            charge: self.charge,
+            radius: self.radius,
+            color: self.color,
+            free: self.free,
+            ..ParticleInit::default()
+        }
+    }
+}
+
+/// `[[particle]]`: one particle.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    pub position: [f64; 3],
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Displacement applied after spring rest lengths are taken (MPPphys `dis`).
+    #[serde(default)]
+    pub displacement: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[lattice]]`: a rectangular lattice, optionally joined by springs.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatticeSpec {
+    pub n: [usize; 3],
+    pub spacing: [f64; 3],
+    #[serde(default)]
+    pub origin: [f64; 3],
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// `none` (default), `boundary` or `first-column`.
+    #[serde(default)]
+    pub anchor: Option<String>,
+    pub springs: Option<LatticeSprings>,
+    /// Displacement of mode (r, s): u = amplitude · sin(rπx/a) sin(sπy/b) over the lattice (002 Eq. 20).
+    pub mode: Option<ModeSpec>,
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatticeSprings {
+    pub stiffness: f64,
+    #[serde(default)]
+    pub damping: f64,
+    #[serde(default)]
+    pub diagonals: bool,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModeSpec {
+    pub r: u32,
+    pub s: u32,
+    pub amplitude: [f64; 3],
+}
+
+/// The speed of ring bodies: a number or a rule.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum SpeedSpec {
+    Value(f64),
+    Rule(String),
+}
+
+/// `[[ring]]`: N equal bodies on a circle.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RingSpec {
+    pub n: usize,
+    /// Radius R of the circle (the bodies' own size is `radius`).
+    pub orbit_radius: f64,
+    #[serde(default)]
+    pub centre: [f64; 3],
+    #[serde(default = "z_axis")]
+    pub normal: [f64; 3],
+    /// `"choreography"` (002 Eq. 16), `"kepler"` (about `central_mass`) or a number.
+    pub speed: SpeedSpec,
+    #[serde(default)]
+    pub central_mass: f64,
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+fn z_axis() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+/// `[[annulus]]`: ring particles on Kepler orbits about a central mass.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnnulusSpec {
+    pub n: usize,
+    pub inner: f64,
+    pub outer: f64,
+    pub central_mass: f64,
+    #[serde(default)]
+    pub centre: [f64; 3],
+    #[serde(default = "z_axis")]
+    pub normal: [f64; 3],
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[random_box]]`: N particles uniformly at random in a box.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomBoxSpec {
+    pub n: usize,
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    /// Standard deviation of each velocity component.
+    #[serde(default)]
+    pub velocity_sigma: f64,
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[spring]]`: springs between listed particle pairs (002 Eq. 4).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    pub pairs: Vec<[usize; 2]>,
+    pub stiffness: f64,
+    #[serde(default)]
+    pub damping: f64,
+    /// Default: the distance of the pair before displacements.
+    pub rest_length: Option<f64>,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSettings {
+    /// Folder of the output files (default `out/<scene name>`).
+    pub dir: Option<String>,
+    /// Steps between rows of observables.csv; 0 turns it off.
+    #[serde(default = "default_observables_every")]
+    pub observables_every: u64,
+    /// Steps between frames of trajectory.xyz; 0 turns it off.
+    #[serde(default = "default_trajectory_every")]
+    pub trajectory_every: u64,
+    /// Per-particle quantities added to observables.csv, e.g. `["z[30]", "speed[1]"]`.
+    #[serde(default)]
+    pub inspect: Vec<Spanned<String>>,
+}
+
+fn default_observables_every() -> u64 {
+    10
+}
+fn default_trajectory_every() -> u64 {
+    100
+}
+
+impl Default for OutputSettings {
+    fn default() -> Self {
+        Self {
+            dir: None,
+            observables_every: default_observables_every(),
+            trajectory_every: default_trajectory_every(),
+            inspect: Vec::new(),
+        }
+    }
+}
+
+/// A scene turned into its parts, ready to run.
+pub struct Built {
+    pub simulation: Simulation,
+    pub length: Option<RunLength>,
+    pub probes: Vec<Probe>,
+    pub seed: u64,
+}
+
+/// Byte offset → one-based line number.
+pub fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].bytes().filter(|b| *b == b'\n').count() + 1
+}
+
+impl Scene {
+    /// Parses a scene; errors are `file:line: message`.
+    pub fn parse(text: &str, file: &str) -> Result<Scene, ParseError> {
+        toml::from_str::<Scene>(text).map_err(|e| {
+            let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(0);
+            ParseError::new(file, line, e.message().trim().to_string())
+        })
+    }
+
+    /// Builds the simulation. `text` and `file` locate errors; `seed` overrides the scene's.
+    pub fn build(&self, text: &str, file: &str, seed: u64) -> Result<Built, ParseError> {
+        let err = |span: std::ops::Range<usize>, msg: String| ParseError::new(file, if span.is_empty() && span.start == 0 { 0 } else { line_of(text, span.start) }, msg);
+        let g_const = self.gravity.as_ref().and_then(|g| g.g).unwrap_or(self.units.gravitational_constant());
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut inits: Vec<ParticleInit> = Vec::new();
+        let mut displacements: Vec<DVec3> = Vec::new();
+        let mut springs: Vec<Spring> = Vec::new();
+
+        let check_props = |p: &Properties, span: std::ops::Range<usize>| -> Result<(), ParseError> {
+            if !(p.mass > 0.0 && p.mass.is_finite()) {
+                return Err(err(span, format!("mass must be positive, found {}", p.mass)));
+            }
+            if p.radius < 0.0 {
+                return Err(err(span, format!("radius must not be negative, found {}", p.radius)));
+            }
+            Ok(())
+        };
+
+        for spec in &self.particle {
+            let s = spec.get_ref();
+            check_props(&s.props, spec.span())?;
+            let mut p = s.props.template();
+            p.position = DVec3::from(s.position);
+            p.velocity = DVec3::from(s.velocity);
+            inits.push(p);
+            displacements.push(DVec3::from(s.displacement));
+        }
+        for spec in &self.lattice {
+            let s = spec.get_ref();
+            check_props(&s.props, spec.span())?;
+            if s.n.iter().any(|&k| k == 0) {
+                return Err(err(spec.span(), "lattice n needs at least one site per axis".into()));
+            }
+            let anchor = match s.anchor.as_deref() {
+                None | Some("none") => Anchor::None,
+                Some("boundary") => Anchor::Boundary,
+                Some("first-column") => Anchor::FirstColumn,
+                Some(other) => {
+                    return Err(err(
+                        spec.span(),
+                        format!("unknown anchor '{other}': expected none, boundary or first-column"),
+                    ))
+                }
+            };
+            let mut t = s.props.template();
+            t.velocity = DVec3::from(s.velocity);
+            let lat = init::lattice(
+                s.n,
+                DVec3::from(s.origin),
+                DVec3::from(s.spacing),
+                &t,
+                anchor,
+                s.springs.as_ref().map(|sp| (sp.stiffness, sp.damping, sp.diagonals)),
+            );
+            let offset = inits.len();
+            let [nx, ny, _] = s.n;
+            for (k, site) in lat.sites.into_iter().enumerate() {
+                let mut d = DVec3::ZERO;
+                if let Some(m) = &s.mode {
+                    let (i, j) = (k % nx, (k / nx) % ny);
+                    let fx = if nx > 1 { i as f64 / (nx - 1) as f64 } else { 0.5 };
+                    let fy = if ny > 1 { j as f64 / (ny - 1) as f64 } else { 0.5 };
+                    let pi = std::f64::consts::PI;
+                    d = DVec3::from(m.amplitude) * ((m.r as f64 * pi * fx).sin() * (m.s as f64 * pi * fy).sin());
+                }
+                inits.push(site);
+                displacements.push(d);
+            }
+            springs.extend(lat.springs.into_iter().map(|sp| Spring { i: sp.i + offset, j: sp.j + offset, ..sp }));
+        }
+        for spec in &self.ring {
+            let s = spec.get_ref();
+            check_props(&s.props, spec.span())?;
+            if s.n == 0 || !(s.orbit_radius > 0.0) {
+                return Err(err(spec.span(), "a ring needs n ≥ 1 and orbit_radius > 0".into()));
+            }
+            let speed = match &s.speed {
+                SpeedSpec::Value(v) => *v,
+                SpeedSpec::Rule(r) if r == "choreography" => init::choreography_speed(s.n, g_const * s.props.mass, s.orbit_radius),
+                SpeedSpec::Rule(r) if r == "kepler" => (g_const * s.central_mass / s.orbit_radius).sqrt(),
+                SpeedSpec::Rule(r) => {
+                    return Err(err(
+                        spec.span(),
+                        format!("unknown speed '{r}': expected \"choreography\", \"kepler\" or a number"),
+                    ))
+                }
+            };
+            let mut t = s.props.template();
+            t.velocity = DVec3::from(s.velocity);
+            for p in init::ring(s.n, DVec3::from(s.centre), s.orbit_radius, DVec3::from(s.normal), speed, &t) {
+                inits.push(p);
+                displacements.push(DVec3::ZERO);
+            }
+        }
+        for spec in &self.annulus {
+            let s = spec.get_ref();
+            check_props(&s.props, spec.span())?;
+            if !(s.inner > 0.0 && s.outer >= s.inner) {
+                return Err(err(spec.span(), "an annulus needs 0 < inner ≤ outer".into()));
+            }
+            let mut t = s.props.template();
+            t.velocity = DVec3::from(s.velocity);
+            for p in init::annulus(
+                s.n,
+                DVec3::from(s.centre),
+                s.inner,
+                s.outer,
+                DVec3::from(s.normal),
+                g_const * s.central_mass,
+                &t,
+                &mut rng,
+            ) {
+                inits.push(p);
+                displacements.push(DVec3::ZERO);
+            }
+        }
+        for spec in &self.random_box {
+            let s = spec.get_ref();
+            check_props(&s.props, spec.span())?;
+            if (0..3).any(|d| s.max[d] < s.min[d]) {
+                return Err(err(spec.span(), "random_box needs min ≤ max on every axis".into()));
+            }
+            let t = s.props.template();
+            for p in init::random_box(s.n, DVec3::from(s.min), DVec3::from(s.max), s.velocity_sigma, &t, &mut rng) {
+                inits.push(p);
+                displacements.push(DVec3::ZERO);
+            }
+        }
+        let n = inits.len();
+        if n == 0 {
+            return Err(ParseError::new(file, 0, "the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]])"));
+        }
+        for spec in &self.spring {
+            let s = spec.get_ref();
+            if s.stiffness < 0.0 || s.damping < 0.0 {
+                return Err(err(spec.span(), "spring stiffness and damping must not be negative".into()));
+            }
+            for &[i, j] in &s.pairs {
+                if i >= n || j >= n || i == j {
+                    return Err(err(
+                        spec.span(),
+                        format!("spring pair [{i}, {j}] must name two different particles 0..{}", n - 1),
+                    ));
+                }
+                springs.push(Spring {
+                    i,
+                    j,
+                    stiffness: s.stiffness,
+                    damping: s.damping,
+                    rest_length: s.rest_length.unwrap_or_else(|| (inits[i].position - inits[j].position).length()),
+                });
+            }
+        }
+        // Displacements come after rest lengths were taken (MPPphys `dis`).
+        let mut particles = Particles::default();
+        for (mut p, d) in inits.into_iter().zip(displacements) {
+            p.position += d;
+            particles.push(p);
+        }
+
+        let mut forces = ForceField::new();
+        if let Some(g) = &self.gravity {
+            if g.softening < 0.0 {
+                return Err(ParseError::new(file, 0, "[gravity] softening must not be negative"));
+            }
+            forces.push(DirectGravity::new(g_const, g.softening));
+        }
+        if !springs.is_empty() {
+            forces.push(SpringNetwork { springs });
+        }
+        if let Some(f) = &self.field {
+            forces.push(UniformField { g: DVec3::from(f.g) });
+        }
+        if let Some(d) = &self.damping {
+            forces.push(GlobalDamping { gamma: d.gamma });
+        }
+
+        let integrator = Integrator::from_name(self.run.integrator.get_ref()).ok_or_else(|| {
+            err(
+                self.run.integrator.span(),
+                format!("unknown integrator '{}': expected {}", self.run.integrator.get_ref(), Integrator::NAMES),
+            )
+        })?;
+        let dt = match &self.run.dt {
+            Some(dt) if *dt.get_ref() > 0.0 && dt.get_ref().is_finite() => *dt.get_ref(),
+            Some(dt) => return Err(err(dt.span(), format!("dt must be positive, found {}", dt.get_ref()))),
+            None => return Err(ParseError::new(file, 0, "[run] needs a time step: dt = ...")),
+        };
+        let length = match (self.run.steps, self.run.until) {
+            (Some(_), Some(_)) => return Err(ParseError::new(file, 0, "[run] takes steps or until, not both")),
+            (Some(s), None) => Some(RunLength::Steps(s)),
+            (None, Some(t)) => Some(RunLength::Until(t)),
+            (None, None) => None,
+        };
+        let mut probes = Vec::new();
+        for p in &self.output.inspect {
+            let probe = Probe::parse(p.get_ref()).map_err(|m| err(p.span(), m))?;
+            if probe.particle >= n {
+                return Err(err(p.span(), format!("inspect '{}': there are only {n} particles", p.get_ref())));
+            }
+            probes.push(probe);
+        }
+        let mut system = System::new(particles);
+        if self.run.centre_of_mass {
+            system.to_centre_of_mass_frame();
+        }
+        Ok(Built {
+            simulation: Simulation { system, forces, stepper: Stepper::new(integrator), dt, observers: Vec::new() },
+            length,
+            probes,
+            seed,
+        })
+    }
+}
+
+/// Which MPPphys model a particle file is run with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlistSystem {
+    /// DirectNbody: softened gravity with k² (002 §2.2).
+    Nbody,
+    /// MassSpring: the file's springs (002 §2.3).
+    Springs,
+}
+
+impl Scene {
+    /// The scene twin of an MPPphys particle file: the same particles, forces
+    /// and step, so both inputs run identical physics.
+    pub fn from_plist(pf: &ParticleFile, system: PlistSystem, solver: &str) -> Scene {
+        let mut scene = Scene {
+            title: "MPPphys particle file".into(),
+            units: UnitSystem::Astro,
+            ..Scene::default()
+        };
+        scene.run.integrator = Spanned::new(0..0, solver.to_string());
+        scene.run.dt = pf.dt.map(|dt| Spanned::new(0..0, dt));
+        for p in &pf.particles {
+            scene.particle.push(Spanned::new(
+                0..0,
+                ParticleSpec {
+                    position: p.position,
+                    velocity: p.velocity,
+                    displacement: p.displacement,
+                    props: Properties {
+                        mass: p.mass,
+                        charge: p.charge,
+                        radius: p.radius,
+                        color: p.color,
+                        free: p.free,
+                    },
+                },
+            ));
+        }
+        match system {
+            PlistSystem::Nbody => {
+                scene.gravity = Some(GravitySettings {
+                    g: Some(pf.k2.unwrap_or(UnitSystem::Astro.gravitational_constant())),
+                    softening: pf.softening.unwrap_or(0.0),
+                });
+            }
+            PlistSystem::Springs => {
+                for link in &pf.springs {
+                    let kind = pf.spring_types.iter().find(|s| s.id == link.kind).expect("spring types are checked by the reader");
+                    scene.spring.push(Spanned::new(
+                        0..0,
+                        SpringSpec {
+                            pairs: vec![[link.i, link.j]],
+                            stiffness: kind.stiffness,
+                            damping: kind.damping,
+                            rest_length: link.rest_length,
+                        },
+                    ));
+                }
+            }
+        }
+        scene.field = pf.gravity.map(|g| FieldSettings { g });
+        scene.damping = pf.damping.map(|gamma| DampingSettings { gamma });
+        scene
+    }
+}

@@ -1,0 +1,141 @@
+//! The single run loop of the time-stepped engine.
+
+use std::time::{Duration, Instant};
+
+use crate::error::MdError;
+use crate::force::ForceField;
+use crate::integrate::Stepper;
+use crate::observe::Observables;
+use crate::particles::System;
+
+/// How long to run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunLength {
+    /// A number of steps.
+    Steps(u64),
+    /// Until the simulated time reaches T (the last step may end at most
+    /// one step after T only by round-off: steps = ⌈(T − t)/Δt⌉).
+    Until(f64),
+}
+
+impl RunLength {
+    /// Number of steps from time `t` with step `dt`.
+    pub fn steps_from(self, t: f64, dt: f64) -> u64 {
+        match self {
+            RunLength::Steps(n) => n,
+            RunLength::Until(end) => {
+                let n = (end - t) / dt;
+                if n <= 0.0 {
+                    0
+                } else {
+                    (n - 1e-9 * n.max(1.0)).ceil() as u64
+                }
+            }
+        }
+    }
+}
+
+/// Something that samples the run on a schedule (writers, recorders).
+pub trait Observer {
+    /// Sample every this many steps (≥ 1); step 0 and the last step are always sampled.
+    fn every(&self) -> u64;
+    /// Samples the state; `obs` holds the whole-system observables of this instant.
+    fn observe(&mut self, sys: &System, obs: &Observables) -> Result<(), MdError>;
+    /// Files this observer wrote, for the report.
+    fn files(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// What a run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunReport {
+    pub steps: u64,
+    pub wall: Duration,
+    pub initial: Observables,
+    pub last: Observables,
+    /// max |E(t) − E(0)| / |E(0)| over the sampled instants.
+    pub max_energy_error: f64,
+    pub files: Vec<String>,
+}
+
+/// A run: the state, its forces, its integrator and its observers.
+pub struct Simulation {
+    pub system: System,
+    pub forces: ForceField,
+    pub stepper: Stepper,
+    pub dt: f64,
+    pub observers: Vec<Box<dyn Observer>>,
+}
+
+impl Simulation {
+    /// Runs for `length`, calling `progress(system)` after every step.
+    /// On a non-finite position or velocity the run stops with
+    /// [`MdError::Unstable`] naming the step and particle; what the observers
+    /// wrote until then stays on disk.
+    pub fn run(&mut self, length: RunLength, mut progress: impl FnMut(&System)) -> Result<RunReport, MdError> {
+        let start = Instant::now();
+        let steps = length.steps_from(self.system.time, self.dt);
+        let first_step = self.system.step;
+        let initial = Observables::measure(&self.system, &mut self.forces);
+        let e0 = initial.total_energy();
+        let mut max_err: f64 = 0.0;
+        let mut last = initial;
+        self.sample(0, steps, &initial)?;
+        for k in 1..=steps {
+            self.stepper.step(&mut self.system, &mut self.forces, self.dt);
+            self.check_finite()?;
+            let due = k == steps || self.observers.iter().any(|o| k % o.every().max(1) == 0);
+            if due {
+                last = Observables::measure(&self.system, &mut self.forces);
+                let err = if e0 != 0.0 {
+                    (last.total_energy() - e0).abs() / e0.abs()
+                } else {
+                    (last.total_energy() - e0).abs()
+                };
+                max_err = max_err.max(err);
+                self.sample(k, steps, &last)?;
+            }
+            progress(&self.system);
+        }
+        Ok(RunReport {
+            steps: self.system.step - first_step,
+            wall: start.elapsed(),
+            initial,
+            last,
+            max_energy_error: max_err,
+            files: self.observers.iter().flat_map(|o| o.files()).collect(),
+        })
+    }
+
+    fn sample(&mut self, k: u64, steps: u64, obs: &Observables) -> Result<(), MdError> {
+        for o in &mut self.observers {
+            if k == 0 || k == steps || k % o.every().max(1) == 0 {
+                o.observe(&self.system, obs)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn check_finite(&self) -> Result<(), MdError> {
+        let p = &self.system.particles;
+        for i in 0..p.len() {
+            let bad = if !p.position[i].is_finite() {
+                Some("a non-finite position")
+            } else if !p.velocity[i].is_finite() {
+                Some("a non-finite velocity")
+            } else {
+                None
+            };
+            if let Some(what) = bad {
+                return Err(MdError::Unstable {
+                    step: self.system.step,
+                    time: self.system.time,
+                    particle: i,
+                    what: format!("{what} ({} / {})", p.position[i], p.velocity[i]),
+                });
+            }
+        }
+        Ok(())
+    }
+}

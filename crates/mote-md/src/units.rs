@@ -1,0 +1,48 @@
+//! Unit systems. Constants belong to the unit system, not to the code.
+
+use serde::Deserialize;
+
+/// The units a scene is written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum UnitSystem {
+    /// SI: metre, second, kilogram.
+    #[default]
+    Si,
+    /// Lennard-Jones reduced units: σ = ε = m = 1, and G = 1.
+    Lj,
+    /// Astronomical: AU, day, solar mass; G = k² with Gauss' constant
+    /// k = 0.01720209895 AU^{3/2} day⁻¹ M☉^{-1/2} (002 Eq. 2).
+    Astro,
+}
+
+/// Gauss' gravitational constant in AU^{3/2} / day (IAU 1976).
+pub const GAUSS_K: f64 = 0.017_202_098_95;
+
+impl UnitSystem {
+    /// Newton's constant G in this unit system.
+    pub fn gravitational_constant(self) -> f64 {
+        match self {
+            UnitSystem::Si => 6.674_30e-11,
+            UnitSystem::Lj => 1.0,
+            UnitSystem::Astro => GAUSS_K * GAUSS_K,
+        }
+    }
+
+    /// Unit labels for (length, time, mass, energy).
+    pub fn labels(self) -> [&'static str; 4] {
+        match self {
+            UnitSystem::Si => ["m", "s", "kg", "J"],
+            UnitSystem::Lj => ["sigma", "tau", "m", "epsilon"],
+            UnitSystem::Astro => ["AU", "d", "Msun", "Msun*AU^2/d^2"],
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            UnitSystem::Si => "si",
+            UnitSystem::Lj => "lj",
+            UnitSystem::Astro => "astro",
+        }
+    }
+}
