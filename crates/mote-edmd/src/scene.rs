@@ -470,6 +470,8 @@ pub struct Run {
     pub ks: (f64, f64),
     /// Final speeds.
     pub speeds: Vec<f64>,
+    /// Final velocities (3 components, z = 0 for disks), kept for N ≤ 1000.
+    pub final_velocities: Vec<[f64; 3]>,
     pub outputs: Vec<PathBuf>,
 }
 
@@ -644,6 +646,9 @@ pub fn run_scene<const D: usize>(
         result.outputs.push(w.path().to_path_buf());
     }
     result.speeds = speeds;
+    if n <= 1000 {
+        result.final_velocities = sys.velocities().iter().map(to3).collect();
+    }
     for f in [&scene.trajectory, &scene.observables].into_iter().flatten() {
         result.outputs.push(out.base.join(f));
     }

@@ -74,6 +74,16 @@ const NO_EVENT: Event = Event {
 
 const NONE: u32 = u32::MAX;
 
+/// Position `x` at the particle's own time `t`, velocity `v`, radius `r`.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+struct Particle<const D: usize> {
+    x: [f64; D],
+    v: [f64; D],
+    t: f64,
+    r: f64,
+}
+
 /// Running totals since the last [`System::reset_counters`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Counters {
@@ -101,10 +111,8 @@ pub struct Counters {
 #[derive(Debug, Clone)]
 pub struct System<const D: usize> {
     pub(crate) simbox: SimBox<D>,
-    pos: Vec<[f64; D]>,
-    vel: Vec<[f64; D]>,
-    t: Vec<f64>,
-    radius: Vec<f64>,
+    /// Hot per-particle data, one cache line per sphere.
+    p: Vec<Particle<D>>,
     mass: Vec<f64>,
     count: Vec<u64>,
     // cells
@@ -241,12 +249,17 @@ impl<const D: usize> System<D> {
             }
             offsets.push(o);
         }
+        let p = (0..n)
+            .map(|i| Particle {
+                x: positions[i],
+                v: velocities[i],
+                t: 0.0,
+                r: radii[i],
+            })
+            .collect();
         let mut sys = System {
             simbox,
-            pos: positions,
-            vel: velocities,
-            t: vec![0.0; n],
-            radius: radii,
+            p,
             mass: masses,
             count: vec![0; n],
             ncell,
@@ -265,8 +278,8 @@ impl<const D: usize> System<D> {
         };
         for i in 0..n {
             for d in 0..D {
-                let x = sys.pos[i][d];
-                let r = sys.radius[i];
+                let x = sys.p[i].x[d];
+                let r = sys.p[i].r;
                 let l = simbox.size[d];
                 let ok = match simbox.boundary[d] {
                     Boundary::Periodic => x.is_finite(),
@@ -275,17 +288,17 @@ impl<const D: usize> System<D> {
                 if !ok {
                     return Err(EdmdError::Invalid(format!(
                         "particle {i} at {:?} (radius {r}) is outside the box {:?}",
-                        sys.pos[i], simbox.size
+                        sys.p[i].x, simbox.size
                     )));
                 }
                 if simbox.boundary[d] == Boundary::Periodic {
-                    sys.pos[i][d] = x.rem_euclid(l);
-                    if sys.pos[i][d] >= l {
-                        sys.pos[i][d] = 0.0;
+                    sys.p[i].x[d] = x.rem_euclid(l);
+                    if sys.p[i].x[d] >= l {
+                        sys.p[i].x[d] = 0.0;
                     }
                 }
             }
-            let c = sys.cell_of(&sys.pos[i]);
+            let c = sys.cell_of(&sys.p[i].x);
             sys.cidx[i] = c;
             sys.insert(i);
         }
@@ -347,10 +360,10 @@ impl<const D: usize> System<D> {
     // ----- accessors -----------------------------------------------------
 
     pub fn len(&self) -> usize {
-        self.pos.len()
+        self.p.len()
     }
     pub fn is_empty(&self) -> bool {
-        self.pos.is_empty()
+        self.p.is_empty()
     }
     /// Current simulated time.
     pub fn time(&self) -> f64 {
@@ -359,14 +372,20 @@ impl<const D: usize> System<D> {
     pub fn simbox(&self) -> &SimBox<D> {
         &self.simbox
     }
-    pub fn radii(&self) -> &[f64] {
-        &self.radius
+    pub fn radii(&self) -> Vec<f64> {
+        self.p.iter().map(|p| p.r).collect()
+    }
+    pub fn radius(&self, i: usize) -> f64 {
+        self.p[i].r
+    }
+    pub fn velocity(&self, i: usize) -> [f64; D] {
+        self.p[i].v
     }
     pub fn masses(&self) -> &[f64] {
         &self.mass
     }
-    pub fn velocities(&self) -> &[[f64; D]] {
-        &self.vel
+    pub fn velocities(&self) -> Vec<[f64; D]> {
+        self.p.iter().map(|p| p.v).collect()
     }
     pub fn counters(&self) -> &Counters {
         &self.counters
@@ -382,7 +401,7 @@ impl<const D: usize> System<D> {
 
     /// Position of particle `i` at the current time (inside the box).
     pub fn position(&self, i: usize) -> [f64; D] {
-        add_scaled(&self.pos[i], &self.vel[i], self.now - self.t[i])
+        add_scaled(&self.p[i].x, &self.p[i].v, self.now - self.p[i].t)
     }
 
     /// Positions of all particles at the current time.
@@ -400,28 +419,28 @@ impl<const D: usize> System<D> {
 
     #[inline]
     fn advance(&mut self, i: usize) {
-        let dt = self.now - self.t[i];
+        let dt = self.now - self.p[i].t;
         if dt != 0.0 {
-            self.pos[i] = add_scaled(&self.pos[i], &self.vel[i], dt);
-            self.t[i] = self.now;
+            self.p[i].x = add_scaled(&self.p[i].x, &self.p[i].v, dt);
+            self.p[i].t = self.now;
         }
     }
 
     /// Kinetic energy Σ m v²/2.
     pub fn kinetic_energy(&self) -> f64 {
-        self.vel
+        self.p
             .iter()
             .zip(&self.mass)
-            .map(|(v, m)| 0.5 * m * dot(v, v))
+            .map(|(p, m)| 0.5 * m * dot(&p.v, &p.v))
             .sum()
     }
 
     /// Total momentum Σ m v.
     pub fn momentum(&self) -> [f64; D] {
         let mut p = [0.0; D];
-        for (v, m) in self.vel.iter().zip(&self.mass) {
+        for (q, m) in self.p.iter().zip(&self.mass) {
             for d in 0..D {
-                p[d] += m * v[d];
+                p[d] += m * q.v[d];
             }
         }
         p
@@ -439,12 +458,12 @@ impl<const D: usize> System<D> {
         } else {
             4.0 / 3.0 * std::f64::consts::PI
         };
-        self.radius.iter().map(|r| unit * r.powi(D as i32)).sum::<f64>() / self.simbox.volume()
+        self.p.iter().map(|p| unit * p.r.powi(D as i32)).sum::<f64>() / self.simbox.volume()
     }
 
     /// Speeds |v_i|.
     pub fn speeds(&self) -> Vec<f64> {
-        self.vel.iter().map(|v| dot(v, v).sqrt()).collect()
+        self.p.iter().map(|p| dot(&p.v, &p.v).sqrt()).collect()
     }
 
     /// Starts a new window for the collision counters and virial.
@@ -525,7 +544,7 @@ impl<const D: usize> System<D> {
         for i in 0..n {
             for d in 0..D {
                 if self.simbox.boundary[d] == Boundary::Wall {
-                    let r = self.radius[i];
+                    let r = self.p[i].r;
                     let l = self.simbox.size[d];
                     let depth = (r - pos[i][d]).max(pos[i][d] + r - l);
                     if depth > rel_tol * r {
@@ -558,7 +577,7 @@ impl<const D: usize> System<D> {
                     let ju = j as usize;
                     if ju > i {
                         let r = self.separation(i, ju);
-                        let s = self.radius[i] + self.radius[ju];
+                        let s = self.p[i].r + self.p[ju].r;
                         let dist = dot(&r, &r).sqrt();
                         if dist < s * (1.0 - rel_tol) {
                             return Some((i, ju, dist / s - 1.0));
@@ -578,7 +597,7 @@ impl<const D: usize> System<D> {
         for i in 0..n {
             for j in (i + 1)..n {
                 let r = self.separation(i, j);
-                let s = self.radius[i] + self.radius[j];
+                let s = self.p[i].r + self.p[j].r;
                 let dist = dot(&r, &r).sqrt();
                 if dist < s * (1.0 - rel_tol) {
                     return Some((i, j, dist / s - 1.0));
@@ -593,9 +612,9 @@ impl<const D: usize> System<D> {
     /// Schedules the next event of particle `i` (advanced to now).
     fn predict(&mut self, i: usize) {
         self.advance(i);
-        let xi = self.pos[i];
-        let vi = self.vel[i];
-        let ri = self.radius[i];
+        let xi = self.p[i].x;
+        let vi = self.p[i].v;
+        let ri = self.p[i].r;
         let ci = self.cidx[i];
         let mut best = f64::INFINITY;
         let mut ev = NO_EVENT;
@@ -663,15 +682,15 @@ impl<const D: usize> System<D> {
             while j != NONE {
                 let ju = j as usize;
                 if ju != i {
-                    let dtj = now - self.t[ju];
-                    let vj = self.vel[ju];
+                    let dtj = now - self.p[ju].t;
+                    let vj = self.p[ju].v;
                     let mut r = [0.0; D];
                     let mut v = [0.0; D];
                     for d in 0..D {
-                        r[d] = xi[d] - (self.pos[ju][d] + vj[d] * dtj + shift[d]);
+                        r[d] = xi[d] - (self.p[ju].x[d] + vj[d] * dtj + shift[d]);
                         v[d] = vi[d] - vj[d];
                     }
-                    let dt = pair_time(&r, &v, ri + self.radius[ju]);
+                    let dt = pair_time(&r, &v, ri + self.p[ju].r);
                     if dt < best {
                         best = dt;
                         ev = Event {
@@ -729,13 +748,13 @@ impl<const D: usize> System<D> {
                 if ev.up {
                     if self.cidx[i][d] + 1 == n {
                         self.cidx[i][d] = 0;
-                        self.pos[i][d] -= l;
+                        self.p[i].x[d] -= l;
                     } else {
                         self.cidx[i][d] += 1;
                     }
                 } else if self.cidx[i][d] == 0 {
                     self.cidx[i][d] = n - 1;
-                    self.pos[i][d] += l;
+                    self.p[i].x[d] += l;
                 } else {
                     self.cidx[i][d] -= 1;
                 }
@@ -745,9 +764,9 @@ impl<const D: usize> System<D> {
             Kind::Wall => {
                 self.advance(i);
                 let d = ev.axis as usize;
-                let v = self.vel[i][d];
+                let v = self.p[i].v[d];
                 if (v > 0.0) == ev.up {
-                    self.vel[i][d] = -v;
+                    self.p[i].v[d] = -v;
                     self.counters.wall_hits += 1;
                     self.counters.wall_impulse_sum += 2.0 * self.mass[i] * v.abs();
                     self.count[i] += 1;
@@ -762,7 +781,7 @@ impl<const D: usize> System<D> {
     fn collide(&mut self, i: usize, j: usize) {
         self.advance(i);
         self.advance(j);
-        let mut r = sub(&self.pos[i], &self.pos[j]);
+        let mut r = sub(&self.p[i].x, &self.p[j].x);
         // periodic image: pick the nearest (neighbour cells are at most one
         // box length apart, and periodic axes have at least three cells)
         for (d, rd) in r.iter_mut().enumerate() {
@@ -775,7 +794,7 @@ impl<const D: usize> System<D> {
                 }
             }
         }
-        let v = sub(&self.vel[i], &self.vel[j]);
+        let v = sub(&self.p[i].v, &self.p[j].v);
         let b = dot(&r, &v);
         let r2 = dot(&r, &r);
         let (mi, mj) = (self.mass[i], self.mass[j]);
@@ -783,8 +802,8 @@ impl<const D: usize> System<D> {
         // Δp_i = −2 μ (b / r²) r
         let f = -2.0 * mu * b / r2;
         for d in 0..D {
-            self.vel[i][d] += f / mi * r[d];
-            self.vel[j][d] -= f / mj * r[d];
+            self.p[i].v[d] += f / mi * r[d];
+            self.p[j].v[d] -= f / mj * r[d];
         }
         self.counters.virial += -2.0 * mu * b;
         self.counters.collisions += 1;
@@ -821,7 +840,7 @@ impl<const D: usize> System<D> {
         self.synchronize();
         for i in 0..self.len() {
             for d in 0..D {
-                self.vel[i][d] *= s;
+                self.p[i].v[d] *= s;
             }
             self.count[i] += 1;
         }
@@ -840,7 +859,7 @@ impl<const D: usize> System<D> {
     pub fn rebase_time(&mut self) {
         self.synchronize();
         let t0 = self.now;
-        self.t.iter_mut().for_each(|t| *t = 0.0);
+        self.p.iter_mut().for_each(|p| p.t = 0.0);
         self.now = 0.0;
         self.counters.since -= t0;
         for i in 0..self.len() {

@@ -31,7 +31,14 @@ pub fn plane_basis(normal: DVec3) -> (DVec3, DVec3) {
 }
 
 /// N bodies evenly spaced on a circle, moving counter-clockwise about `normal` at `speed`.
-pub fn ring(n: usize, centre: DVec3, radius: f64, normal: DVec3, speed: f64, template: &ParticleInit) -> Vec<ParticleInit> {
+pub fn ring(
+    n: usize,
+    centre: DVec3,
+    radius: f64,
+    normal: DVec3,
+    speed: f64,
+    template: &ParticleInit,
+) -> Vec<ParticleInit> {
     let (e1, e2) = plane_basis(normal);
     (0..n)
         .map(|k| {
@@ -80,7 +87,14 @@ pub fn annulus(
 
 /// Uniformly random positions in the box [lo, hi] and velocities with
 /// components drawn from N(0, σ²) (σ = 0 for particles at rest).
-pub fn random_box(n: usize, lo: DVec3, hi: DVec3, sigma_v: f64, template: &ParticleInit, rng: &mut impl Rng) -> Vec<ParticleInit> {
+pub fn random_box(
+    n: usize,
+    lo: DVec3,
+    hi: DVec3,
+    sigma_v: f64,
+    template: &ParticleInit,
+    rng: &mut impl Rng,
+) -> Vec<ParticleInit> {
     (0..n)
         .map(|_| {
             let u = DVec3::new(rng.gen(), rng.gen(), rng.gen());
@@ -138,7 +152,9 @@ pub fn lattice(
                 let on_boundary = |k: usize, m: usize| m > 1 && (k == 0 || k == m - 1);
                 let fixed = match anchor {
                     Anchor::None => false,
-                    Anchor::Boundary => on_boundary(i, nx) || on_boundary(j, ny) || on_boundary(l, nz),
+                    Anchor::Boundary => {
+                        on_boundary(i, nx) || on_boundary(j, ny) || on_boundary(l, nz)
+                    }
                     Anchor::FirstColumn => i == 0,
                 };
                 let mut p = template.clone();
@@ -155,7 +171,13 @@ pub fn lattice(
     if let Some((stiffness, damping, diagonals)) = springs {
         let mut link = |a: usize, b: usize| {
             let rest_length = (sites[a].position - sites[b].position).length();
-            list.push(Spring { i: a, j: b, stiffness, damping, rest_length });
+            list.push(Spring {
+                i: a,
+                j: b,
+                stiffness,
+                damping,
+                rest_length,
+            });
         };
         for l in 0..nz {
             for j in 0..ny {
@@ -188,7 +210,10 @@ pub fn lattice(
             }
         }
     }
-    Lattice { sites, springs: list }
+    Lattice {
+        sites,
+        springs: list,
+    }
 }
 
 #[cfg(test)]
@@ -197,6 +222,7 @@ mod tests {
 
     /// 002 Table 1, with the N = 8 entry as corrected in shared/seeds/README.md.
     #[test]
+    #[allow(clippy::approx_constant)] // 0.707107 is the table's entry, not 1/√2
     fn choreography_sums_match_table_1() {
         let table = [
             (2, 0.707107),
@@ -218,11 +244,28 @@ mod tests {
     #[test]
     fn lattice_springs_count_and_anchors() {
         let t = ParticleInit::default();
-        let lat = lattice([8, 8, 1], DVec3::ZERO, DVec3::ONE, &t, Anchor::Boundary, Some((1.0, 0.0, false)));
+        let lat = lattice(
+            [8, 8, 1],
+            DVec3::ZERO,
+            DVec3::ONE,
+            &t,
+            Anchor::Boundary,
+            Some((1.0, 0.0, false)),
+        );
         assert_eq!(lat.sites.len(), 64);
         assert_eq!(lat.springs.len(), 2 * 8 * 7);
-        assert_eq!(lat.sites.iter().filter(|p| p.free == [false; 3]).count(), 28);
-        let lat = lattice([4, 2, 1], DVec3::ZERO, DVec3::ONE, &t, Anchor::FirstColumn, Some((1.0, 0.0, true)));
+        assert_eq!(
+            lat.sites.iter().filter(|p| p.free == [false; 3]).count(),
+            28
+        );
+        let lat = lattice(
+            [4, 2, 1],
+            DVec3::ZERO,
+            DVec3::ONE,
+            &t,
+            Anchor::FirstColumn,
+            Some((1.0, 0.0, true)),
+        );
         assert_eq!(lat.springs.len(), 3 * 2 + 4 + 2 * 3);
         assert!(lat.springs.iter().all(|s| s.rest_length > 0.99));
     }

@@ -29,16 +29,20 @@ impl Integrator {
     pub fn from_name(name: &str) -> Option<Self> {
         Some(match name.to_ascii_lowercase().as_str() {
             "euler" | "explicit-euler" | "explicit_euler" => Integrator::Euler,
-            "symplectic-euler" | "symplectic_euler" | "semi-implicit-euler" | "semi_implicit_euler" => {
-                Integrator::SymplecticEuler
-            }
+            "symplectic-euler"
+            | "symplectic_euler"
+            | "semi-implicit-euler"
+            | "semi_implicit_euler" => Integrator::SymplecticEuler,
             "rk4" | "runge-kutta" => Integrator::Rk4,
-            "lf" | "leapfrog" | "leap-frog" | "velocity-verlet" | "velocity_verlet" | "kdk" => Integrator::LeapFrog,
+            "lf" | "leapfrog" | "leap-frog" | "velocity-verlet" | "velocity_verlet" | "kdk" => {
+                Integrator::LeapFrog
+            }
             _ => return None,
         })
     }
 
-    pub const NAMES: &'static str = "euler, symplectic-euler, rk4 (RK4), leapfrog (LF, velocity-verlet)";
+    pub const NAMES: &'static str =
+        "euler, symplectic-euler, rk4 (RK4), leapfrog (LF, velocity-verlet)";
 
     pub fn name(self) -> &'static str {
         match self {
@@ -93,7 +97,14 @@ impl Stepper {
         self.acc_valid = false;
     }
 
-    fn eval(ff: &mut ForceField, sys: &System, x: &[DVec3], v: &[DVec3], t: f64, acc: &mut Vec<DVec3>) {
+    fn eval(
+        ff: &mut ForceField,
+        sys: &System,
+        x: &[DVec3],
+        v: &[DVec3],
+        t: f64,
+        acc: &mut Vec<DVec3>,
+    ) {
         acc.resize(x.len(), DVec3::ZERO);
         let state = State {
             position: x,
@@ -110,7 +121,14 @@ impl Stepper {
         match self.scheme {
             Integrator::Euler => {
                 let mut acc = std::mem::take(&mut self.acc);
-                Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t, &mut acc);
+                Self::eval(
+                    ff,
+                    sys,
+                    &sys.particles.position,
+                    &sys.particles.velocity,
+                    t,
+                    &mut acc,
+                );
                 let p = &mut sys.particles;
                 for i in 0..p.len() {
                     p.position[i] += p.velocity[i] * h;
@@ -121,7 +139,14 @@ impl Stepper {
             }
             Integrator::SymplecticEuler => {
                 let mut acc = std::mem::take(&mut self.acc);
-                Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t, &mut acc);
+                Self::eval(
+                    ff,
+                    sys,
+                    &sys.particles.position,
+                    &sys.particles.velocity,
+                    t,
+                    &mut acc,
+                );
                 let p = &mut sys.particles;
                 for i in 0..p.len() {
                     p.velocity[i] += acc[i] * h;
@@ -133,7 +158,14 @@ impl Stepper {
             Integrator::LeapFrog => {
                 let mut acc = std::mem::take(&mut self.acc);
                 if !self.acc_valid || acc.len() != sys.particles.len() {
-                    Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t, &mut acc);
+                    Self::eval(
+                        ff,
+                        sys,
+                        &sys.particles.position,
+                        &sys.particles.velocity,
+                        t,
+                        &mut acc,
+                    );
                 }
                 let half = 0.5 * h;
                 {
@@ -143,7 +175,14 @@ impl Stepper {
                         p.position[i] += p.velocity[i] * h;
                     }
                 }
-                Self::eval(ff, sys, &sys.particles.position, &sys.particles.velocity, t + h, &mut acc);
+                Self::eval(
+                    ff,
+                    sys,
+                    &sys.particles.position,
+                    &sys.particles.velocity,
+                    t + h,
+                    &mut acc,
+                );
                 let p = &mut sys.particles;
                 for i in 0..p.len() {
                     p.velocity[i] += acc[i] * half;
@@ -172,7 +211,10 @@ impl Stepper {
         let mut acc = std::mem::take(&mut self.acc);
         // Stage weights: k1 and k4 count 1/6, k2 and k3 count 2/6; the next
         // stage is evaluated at y0 + c·h·k with c = ½, ½, 1.
-        for (stage, (weight, c_next)) in [(1.0, 0.5), (2.0, 0.5), (2.0, 1.0), (1.0, 0.0)].into_iter().enumerate() {
+        for (stage, (weight, c_next)) in [(1.0, 0.5), (2.0, 0.5), (2.0, 1.0), (1.0, 0.0)]
+            .into_iter()
+            .enumerate()
+        {
             let ts = t + h * [0.0, 0.5, 0.5, 1.0][stage];
             Self::eval(ff, sys, &self.xs, &self.vs, ts, &mut acc);
             for i in 0..n {

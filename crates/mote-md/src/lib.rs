@@ -6,6 +6,8 @@
 //! is the single run loop, which hands the state to [`Observer`]s on their
 //! schedule. Settings come from a TOML [`scene`] or an MPPphys particle file.
 
+#![allow(clippy::needless_range_loop)] // index loops over parallel arrays read best in numerical code
+
 pub mod error;
 pub mod force;
 pub mod init;

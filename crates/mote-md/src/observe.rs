@@ -54,7 +54,17 @@ impl Observables {
 
     /// Column names of [`Observables::values`].
     pub const COLUMNS: [&'static str; 11] = [
-        "time", "kinetic_energy", "potential_energy", "total_energy", "px", "py", "pz", "Lx", "Ly", "Lz", "step",
+        "time",
+        "kinetic_energy",
+        "potential_energy",
+        "total_energy",
+        "px",
+        "py",
+        "pz",
+        "Lx",
+        "Ly",
+        "Lz",
+        "step",
     ];
 
     pub fn values(&self, step: u64) -> [f64; 11] {
@@ -103,7 +113,12 @@ impl Probe {
 
     /// Parses `name[index]`.
     pub fn parse(text: &str) -> Result<Self, String> {
-        let err = || format!("'{text}' is not a particle quantity: write NAME[INDEX] with NAME one of {}", Self::QUANTITIES);
+        let err = || {
+            format!(
+                "'{text}' is not a particle quantity: write NAME[INDEX] with NAME one of {}",
+                Self::QUANTITIES
+            )
+        };
         let (name, rest) = text.trim().split_once('[').ok_or_else(err)?;
         let index = rest.strip_suffix(']').ok_or_else(err)?;
         let particle: usize = index.trim().parse().map_err(|_| err())?;

@@ -21,12 +21,30 @@ pub struct ObservablesCsv {
 }
 
 impl ObservablesCsv {
-    pub fn create(path: &Path, provenance: &Provenance, units: UnitSystem, every: u64, probes: Vec<Probe>) -> Result<Self, MdError> {
+    pub fn create(
+        path: &Path,
+        provenance: &Provenance,
+        units: UnitSystem,
+        every: u64,
+        probes: Vec<Probe>,
+    ) -> Result<Self, MdError> {
         let [l, t, m, e] = units.labels();
         let p = format!("{m}*{l}/{t}");
         let ang = format!("{m}*{l}^2/{t}");
         let mut columns: Vec<String> = Observables::COLUMNS.iter().map(|s| s.to_string()).collect();
-        let mut unit_row: Vec<String> = vec![t.into(), e.into(), e.into(), e.into(), p.clone(), p.clone(), p, ang.clone(), ang.clone(), ang, "1".into()];
+        let mut unit_row: Vec<String> = vec![
+            t.into(),
+            e.into(),
+            e.into(),
+            e.into(),
+            p.clone(),
+            p.clone(),
+            p,
+            ang.clone(),
+            ang.clone(),
+            ang,
+            "1".into(),
+        ];
         for probe in &probes {
             columns.push(probe.label());
             let label = probe.label();
@@ -37,7 +55,11 @@ impl ObservablesCsv {
             };
             unit_row.push(unit);
         }
-        Ok(Self { writer: CsvWriter::create(path, provenance, &columns, &unit_row)?, every, probes })
+        Ok(Self {
+            writer: CsvWriter::create(path, provenance, &columns, &unit_row)?,
+            every,
+            probes,
+        })
     }
 }
 
@@ -65,7 +87,10 @@ pub struct TrajectoryXyz {
 
 impl TrajectoryXyz {
     pub fn create(path: &Path, provenance: Provenance, every: u64) -> Result<Self, MdError> {
-        Ok(Self { writer: XyzWriter::create(path, provenance)?, every })
+        Ok(Self {
+            writer: XyzWriter::create(path, provenance)?,
+            every,
+        })
     }
 }
 

@@ -93,8 +93,20 @@ impl System {
             return;
         }
         let m_tot: f64 = p.mass.iter().sum();
-        let r_cm: DVec3 = p.position.iter().zip(&p.mass).map(|(r, m)| *r * *m).sum::<DVec3>() / m_tot;
-        let v_cm: DVec3 = p.velocity.iter().zip(&p.mass).map(|(v, m)| *v * *m).sum::<DVec3>() / m_tot;
+        let r_cm: DVec3 = p
+            .position
+            .iter()
+            .zip(&p.mass)
+            .map(|(r, m)| *r * *m)
+            .sum::<DVec3>()
+            / m_tot;
+        let v_cm: DVec3 = p
+            .velocity
+            .iter()
+            .zip(&p.mass)
+            .map(|(v, m)| *v * *m)
+            .sum::<DVec3>()
+            / m_tot;
         p.position.iter_mut().for_each(|r| *r -= r_cm);
         p.velocity.iter_mut().for_each(|v| *v -= v_cm);
     }

@@ -58,6 +58,8 @@ pub struct Scene {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunSettings {
+    /// Default: leapfrog.
+    #[serde(default = "default_integrator")]
     pub integrator: Spanned<String>,
     pub dt: Option<Spanned<f64>>,
     pub steps: Option<u64>,
@@ -67,10 +69,14 @@ pub struct RunSettings {
     pub centre_of_mass: bool,
 }
 
+fn default_integrator() -> Spanned<String> {
+    Spanned::new(0..0, "leapfrog".into())
+}
+
 impl Default for RunSettings {
     fn default() -> Self {
         Self {
-            integrator: Spanned::new(0..0, "leapfrog".into()),
+            integrator: default_integrator(),
             dt: None,
             steps: None,
             until: None,
@@ -330,7 +336,11 @@ pub struct Built {
 
 /// Byte offset → one-based line number.
 pub fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].bytes().filter(|b| *b == b'\n').count() + 1
+    text[..offset.min(text.len())]
+        .bytes()
+        .filter(|b| *b == b'\n')
+        .count()
+        + 1
 }
 
 impl Scene {
@@ -344,22 +354,43 @@ impl Scene {
 
     /// Builds the simulation. `text` and `file` locate errors; `seed` overrides the scene's.
     pub fn build(&self, text: &str, file: &str, seed: u64) -> Result<Built, ParseError> {
-        let err = |span: std::ops::Range<usize>, msg: String| ParseError::new(file, if span.is_empty() && span.start == 0 { 0 } else { line_of(text, span.start) }, msg);
-        let g_const = self.gravity.as_ref().and_then(|g| g.g).unwrap_or(self.units.gravitational_constant());
+        let err = |span: std::ops::Range<usize>, msg: String| {
+            ParseError::new(
+                file,
+                if span.is_empty() && span.start == 0 {
+                    0
+                } else {
+                    line_of(text, span.start)
+                },
+                msg,
+            )
+        };
+        let g_const = self
+            .gravity
+            .as_ref()
+            .and_then(|g| g.g)
+            .unwrap_or(self.units.gravitational_constant());
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let mut inits: Vec<ParticleInit> = Vec::new();
         let mut displacements: Vec<DVec3> = Vec::new();
         let mut springs: Vec<Spring> = Vec::new();
 
-        let check_props = |p: &Properties, span: std::ops::Range<usize>| -> Result<(), ParseError> {
-            if !(p.mass > 0.0 && p.mass.is_finite()) {
-                return Err(err(span, format!("mass must be positive, found {}", p.mass)));
-            }
-            if p.radius < 0.0 {
-                return Err(err(span, format!("radius must not be negative, found {}", p.radius)));
-            }
-            Ok(())
-        };
+        let check_props =
+            |p: &Properties, span: std::ops::Range<usize>| -> Result<(), ParseError> {
+                if !p.mass.is_finite() || p.mass <= 0.0 {
+                    return Err(err(
+                        span,
+                        format!("mass must be positive, found {}", p.mass),
+                    ));
+                }
+                if p.radius < 0.0 {
+                    return Err(err(
+                        span,
+                        format!("radius must not be negative, found {}", p.radius),
+                    ));
+                }
+                Ok(())
+            };
 
         for spec in &self.particle {
             let s = spec.get_ref();
@@ -373,8 +404,11 @@ impl Scene {
         for spec in &self.lattice {
             let s = spec.get_ref();
             check_props(&s.props, spec.span())?;
-            if s.n.iter().any(|&k| k == 0) {
-                return Err(err(spec.span(), "lattice n needs at least one site per axis".into()));
+            if s.n.contains(&0) {
+                return Err(err(
+                    spec.span(),
+                    "lattice n needs at least one site per axis".into(),
+                ));
             }
             let anchor = match s.anchor.as_deref() {
                 None | Some("none") => Anchor::None,
@@ -383,7 +417,9 @@ impl Scene {
                 Some(other) => {
                     return Err(err(
                         spec.span(),
-                        format!("unknown anchor '{other}': expected none, boundary or first-column"),
+                        format!(
+                            "unknown anchor '{other}': expected none, boundary or first-column"
+                        ),
                     ))
                 }
             };
@@ -395,7 +431,9 @@ impl Scene {
                 DVec3::from(s.spacing),
                 &t,
                 anchor,
-                s.springs.as_ref().map(|sp| (sp.stiffness, sp.damping, sp.diagonals)),
+                s.springs
+                    .as_ref()
+                    .map(|sp| (sp.stiffness, sp.damping, sp.diagonals)),
             );
             let offset = inits.len();
             let [nx, ny, _] = s.n;
@@ -403,36 +441,65 @@ impl Scene {
                 let mut d = DVec3::ZERO;
                 if let Some(m) = &s.mode {
                     let (i, j) = (k % nx, (k / nx) % ny);
-                    let fx = if nx > 1 { i as f64 / (nx - 1) as f64 } else { 0.5 };
-                    let fy = if ny > 1 { j as f64 / (ny - 1) as f64 } else { 0.5 };
+                    let fx = if nx > 1 {
+                        i as f64 / (nx - 1) as f64
+                    } else {
+                        0.5
+                    };
+                    let fy = if ny > 1 {
+                        j as f64 / (ny - 1) as f64
+                    } else {
+                        0.5
+                    };
                     let pi = std::f64::consts::PI;
-                    d = DVec3::from(m.amplitude) * ((m.r as f64 * pi * fx).sin() * (m.s as f64 * pi * fy).sin());
+                    d = DVec3::from(m.amplitude)
+                        * ((m.r as f64 * pi * fx).sin() * (m.s as f64 * pi * fy).sin());
                 }
                 inits.push(site);
                 displacements.push(d);
             }
-            springs.extend(lat.springs.into_iter().map(|sp| Spring { i: sp.i + offset, j: sp.j + offset, ..sp }));
+            springs.extend(lat.springs.into_iter().map(|sp| Spring {
+                i: sp.i + offset,
+                j: sp.j + offset,
+                ..sp
+            }));
         }
         for spec in &self.ring {
             let s = spec.get_ref();
             check_props(&s.props, spec.span())?;
-            if s.n == 0 || !(s.orbit_radius > 0.0) {
-                return Err(err(spec.span(), "a ring needs n ≥ 1 and orbit_radius > 0".into()));
+            if s.n == 0 || !s.orbit_radius.is_finite() || s.orbit_radius <= 0.0 {
+                return Err(err(
+                    spec.span(),
+                    "a ring needs n ≥ 1 and orbit_radius > 0".into(),
+                ));
             }
             let speed = match &s.speed {
                 SpeedSpec::Value(v) => *v,
-                SpeedSpec::Rule(r) if r == "choreography" => init::choreography_speed(s.n, g_const * s.props.mass, s.orbit_radius),
-                SpeedSpec::Rule(r) if r == "kepler" => (g_const * s.central_mass / s.orbit_radius).sqrt(),
+                SpeedSpec::Rule(r) if r == "choreography" => {
+                    init::choreography_speed(s.n, g_const * s.props.mass, s.orbit_radius)
+                }
+                SpeedSpec::Rule(r) if r == "kepler" => {
+                    (g_const * s.central_mass / s.orbit_radius).sqrt()
+                }
                 SpeedSpec::Rule(r) => {
                     return Err(err(
                         spec.span(),
-                        format!("unknown speed '{r}': expected \"choreography\", \"kepler\" or a number"),
+                        format!(
+                        "unknown speed '{r}': expected \"choreography\", \"kepler\" or a number"
+                    ),
                     ))
                 }
             };
             let mut t = s.props.template();
             t.velocity = DVec3::from(s.velocity);
-            for p in init::ring(s.n, DVec3::from(s.centre), s.orbit_radius, DVec3::from(s.normal), speed, &t) {
+            for p in init::ring(
+                s.n,
+                DVec3::from(s.centre),
+                s.orbit_radius,
+                DVec3::from(s.normal),
+                speed,
+                &t,
+            ) {
                 inits.push(p);
                 displacements.push(DVec3::ZERO);
             }
@@ -440,8 +507,11 @@ impl Scene {
         for spec in &self.annulus {
             let s = spec.get_ref();
             check_props(&s.props, spec.span())?;
-            if !(s.inner > 0.0 && s.outer >= s.inner) {
-                return Err(err(spec.span(), "an annulus needs 0 < inner ≤ outer".into()));
+            if s.inner.is_nan() || s.inner <= 0.0 || s.outer.is_nan() || s.outer < s.inner {
+                return Err(err(
+                    spec.span(),
+                    "an annulus needs 0 < inner ≤ outer".into(),
+                ));
             }
             let mut t = s.props.template();
             t.velocity = DVec3::from(s.velocity);
@@ -463,10 +533,20 @@ impl Scene {
             let s = spec.get_ref();
             check_props(&s.props, spec.span())?;
             if (0..3).any(|d| s.max[d] < s.min[d]) {
-                return Err(err(spec.span(), "random_box needs min ≤ max on every axis".into()));
+                return Err(err(
+                    spec.span(),
+                    "random_box needs min ≤ max on every axis".into(),
+                ));
             }
             let t = s.props.template();
-            for p in init::random_box(s.n, DVec3::from(s.min), DVec3::from(s.max), s.velocity_sigma, &t, &mut rng) {
+            for p in init::random_box(
+                s.n,
+                DVec3::from(s.min),
+                DVec3::from(s.max),
+                s.velocity_sigma,
+                &t,
+                &mut rng,
+            ) {
                 inits.push(p);
                 displacements.push(DVec3::ZERO);
             }
@@ -478,13 +558,19 @@ impl Scene {
         for spec in &self.spring {
             let s = spec.get_ref();
             if s.stiffness < 0.0 || s.damping < 0.0 {
-                return Err(err(spec.span(), "spring stiffness and damping must not be negative".into()));
+                return Err(err(
+                    spec.span(),
+                    "spring stiffness and damping must not be negative".into(),
+                ));
             }
             for &[i, j] in &s.pairs {
                 if i >= n || j >= n || i == j {
                     return Err(err(
                         spec.span(),
-                        format!("spring pair [{i}, {j}] must name two different particles 0..{}", n - 1),
+                        format!(
+                            "spring pair [{i}, {j}] must name two different particles 0..{}",
+                            n - 1
+                        ),
                     ));
                 }
                 springs.push(Spring {
@@ -492,7 +578,9 @@ impl Scene {
                     j,
                     stiffness: s.stiffness,
                     damping: s.damping,
-                    rest_length: s.rest_length.unwrap_or_else(|| (inits[i].position - inits[j].position).length()),
+                    rest_length: s
+                        .rest_length
+                        .unwrap_or_else(|| (inits[i].position - inits[j].position).length()),
                 });
             }
         }
@@ -506,7 +594,11 @@ impl Scene {
         let mut forces = ForceField::new();
         if let Some(g) = &self.gravity {
             if g.softening < 0.0 {
-                return Err(ParseError::new(file, 0, "[gravity] softening must not be negative"));
+                return Err(ParseError::new(
+                    file,
+                    0,
+                    "[gravity] softening must not be negative",
+                ));
             }
             forces.push(DirectGravity::new(g_const, g.softening));
         }
@@ -514,7 +606,9 @@ impl Scene {
             forces.push(SpringNetwork { springs });
         }
         if let Some(f) = &self.field {
-            forces.push(UniformField { g: DVec3::from(f.g) });
+            forces.push(UniformField {
+                g: DVec3::from(f.g),
+            });
         }
         if let Some(d) = &self.damping {
             forces.push(GlobalDamping { gamma: d.gamma });
@@ -523,16 +617,37 @@ impl Scene {
         let integrator = Integrator::from_name(self.run.integrator.get_ref()).ok_or_else(|| {
             err(
                 self.run.integrator.span(),
-                format!("unknown integrator '{}': expected {}", self.run.integrator.get_ref(), Integrator::NAMES),
+                format!(
+                    "unknown integrator '{}': expected {}",
+                    self.run.integrator.get_ref(),
+                    Integrator::NAMES
+                ),
             )
         })?;
         let dt = match &self.run.dt {
             Some(dt) if *dt.get_ref() > 0.0 && dt.get_ref().is_finite() => *dt.get_ref(),
-            Some(dt) => return Err(err(dt.span(), format!("dt must be positive, found {}", dt.get_ref()))),
-            None => return Err(ParseError::new(file, 0, "[run] needs a time step: dt = ...")),
+            Some(dt) => {
+                return Err(err(
+                    dt.span(),
+                    format!("dt must be positive, found {}", dt.get_ref()),
+                ))
+            }
+            None => {
+                return Err(ParseError::new(
+                    file,
+                    0,
+                    "[run] needs a time step: dt = ...",
+                ))
+            }
         };
         let length = match (self.run.steps, self.run.until) {
-            (Some(_), Some(_)) => return Err(ParseError::new(file, 0, "[run] takes steps or until, not both")),
+            (Some(_), Some(_)) => {
+                return Err(ParseError::new(
+                    file,
+                    0,
+                    "[run] takes steps or until, not both",
+                ))
+            }
             (Some(s), None) => Some(RunLength::Steps(s)),
             (None, Some(t)) => Some(RunLength::Until(t)),
             (None, None) => None,
@@ -541,7 +656,10 @@ impl Scene {
         for p in &self.output.inspect {
             let probe = Probe::parse(p.get_ref()).map_err(|m| err(p.span(), m))?;
             if probe.particle >= n {
-                return Err(err(p.span(), format!("inspect '{}': there are only {n} particles", p.get_ref())));
+                return Err(err(
+                    p.span(),
+                    format!("inspect '{}': there are only {n} particles", p.get_ref()),
+                ));
             }
             probes.push(probe);
         }
@@ -550,7 +668,13 @@ impl Scene {
             system.to_centre_of_mass_frame();
         }
         Ok(Built {
-            simulation: Simulation { system, forces, stepper: Stepper::new(integrator), dt, observers: Vec::new() },
+            simulation: Simulation {
+                system,
+                forces,
+                stepper: Stepper::new(integrator),
+                dt,
+                observers: Vec::new(),
+            },
             length,
             probes,
             seed,
@@ -604,7 +728,11 @@ impl Scene {
             }
             PlistSystem::Springs => {
                 for link in &pf.springs {
-                    let kind = pf.spring_types.iter().find(|s| s.id == link.kind).expect("spring types are checked by the reader");
+                    let kind = pf
+                        .spring_types
+                        .iter()
+                        .find(|s| s.id == link.kind)
+                        .expect("spring types are checked by the reader");
                     scene.spring.push(Spanned::new(
                         0..0,
                         SpringSpec {

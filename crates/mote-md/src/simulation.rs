@@ -73,7 +73,11 @@ impl Simulation {
     /// On a non-finite position or velocity the run stops with
     /// [`MdError::Unstable`] naming the step and particle; what the observers
     /// wrote until then stays on disk.
-    pub fn run(&mut self, length: RunLength, mut progress: impl FnMut(&System)) -> Result<RunReport, MdError> {
+    pub fn run(
+        &mut self,
+        length: RunLength,
+        mut progress: impl FnMut(&System),
+    ) -> Result<RunReport, MdError> {
         let start = Instant::now();
         let steps = length.steps_from(self.system.time, self.dt);
         let first_step = self.system.step;
@@ -83,9 +87,10 @@ impl Simulation {
         let mut last = initial;
         self.sample(0, steps, &initial)?;
         for k in 1..=steps {
-            self.stepper.step(&mut self.system, &mut self.forces, self.dt);
+            self.stepper
+                .step(&mut self.system, &mut self.forces, self.dt);
             self.check_finite()?;
-            let due = k == steps || self.observers.iter().any(|o| k % o.every().max(1) == 0);
+            let due = k == steps || self.observers.iter().any(|o| k.is_multiple_of(o.every().max(1)));
             if due {
                 last = Observables::measure(&self.system, &mut self.forces);
                 let err = if e0 != 0.0 {
@@ -110,7 +115,7 @@ impl Simulation {
 
     fn sample(&mut self, k: u64, steps: u64, obs: &Observables) -> Result<(), MdError> {
         for o in &mut self.observers {
-            if k == 0 || k == steps || k % o.every().max(1) == 0 {
+            if k == 0 || k == steps || k.is_multiple_of(o.every().max(1)) {
                 o.observe(&self.system, obs)?;
             }
         }

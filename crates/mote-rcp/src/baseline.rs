@@ -7,21 +7,7 @@ use crate::erfc::ErfcFlavour;
 
 /// F⁻¹(y) by 100 bisection steps on [0, 10·1.5^k] (spherepack1d's `inverseF`).
 pub fn inverse_cdf_bisection(dist: &SizeDistribution, y: f64, flavour: ErfcFlavour) -> f64 {
-    let mut lo = 0.0;
-    let mut hi = 10.0;
-    while dist.cdf_point(hi, flavour).cdf <= y {
-        hi *= 1.5;
-    }
-    let mut mid = 0.5 * (lo + hi);
-    for _ in 0..100 {
-        mid = 0.5 * (lo + hi);
-        if dist.cdf_point(mid, flavour).cdf > y {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    mid
+    dist.inverse_cdf_bisection(y, flavour)
 }
 
 /// The N rods by bisection.

@@ -459,6 +459,29 @@ impl SizeDistribution {
         self.solve(y, 0.0, hi, guess, flavour, &mut last)
     }
 
+    /// F⁻¹(y) by 100 bisection steps on [0, 10·1.5^k], the smallest such interval with
+    /// F(10·1.5^k) > y, as spherepack1d's `inverseF` does.
+    pub fn inverse_cdf_bisection(&self, y: f64, flavour: ErfcFlavour) -> f64 {
+        let mut lo = 0.0;
+        let mut hi = 10.0;
+        for _ in 0..4096 {
+            if self.cdf_point(hi, flavour).cdf > y || hi >= f64::MAX {
+                break;
+            }
+            hi *= 1.5;
+        }
+        let mut mid = 0.5 * (lo + hi);
+        for _ in 0..100 {
+            mid = 0.5 * (lo + hi);
+            if self.cdf_point(mid, flavour).cdf > y {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        mid
+    }
+
     /// Largest diameter scale of the components: a start for brackets.
     fn scale(&self) -> f64 {
         self.comps
@@ -538,6 +561,8 @@ impl SizeDistribution {
     /// Monodisperse mixtures are inverted in closed form on each quadratic piece of F;
     /// otherwise the targets are swept downwards, each solved by Newton's method with
     /// the density P1, started from a step off the previous rod and bracketed by it.
+    /// With [`ErfcFlavour::AbramowitzStegun`] lognormal input is inverted by bisection
+    /// exactly as spherepack1d does (slower, but the same digits).
     pub fn rod_lengths(&self, n: usize, flavour: ErfcFlavour) -> Result<Vec<f64>, RcpError> {
         if n < 2 {
             return Err(RcpError::TooFewRods { n });
@@ -563,6 +588,16 @@ impl SizeDistribution {
                 let lo = if k == 0 { 0.0 } else { t.d[k - 1] };
                 let x = ((y - t.c[k]) / t.s[k]).max(0.0).sqrt();
                 sink(x.clamp(lo, t.d[k]));
+            }
+            return;
+        }
+        if flavour == ErfcFlavour::AbramowitzStegun {
+            // The A&S erfc makes F slightly non-monotone in its far tails (errors of
+            // 1.5e-7 against values that are smaller), so F(x) = y can have several
+            // roots there; spherepack1d's bisection picks one of them. To reproduce its
+            // digits, compat mode inverts F the same way (100 halvings per rod).
+            for i in 1..=n {
+                sink(self.inverse_cdf_bisection(target(i), flavour));
             }
             return;
         }

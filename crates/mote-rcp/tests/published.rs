@@ -78,3 +78,18 @@ fn fast_algorithm_matches_baseline() {
         }
     }
 }
+
+#[test]
+fn compat_reproduces_reference_for_wide_lognormals() {
+    // spherepack1d -w (one population, sigma from stdin), compiled from seed 003.
+    let compat = RodPacking::default().erfc(ErfcFlavour::AbramowitzStegun);
+    for (sigma, printed) in [
+        (1.5, "0.873683"),
+        (2.0, "0.922095"),
+        (2.5, "0.955554"),
+        (3.0, "0.978153"),
+    ] {
+        let d = SizeDistribution::lognormal(sigma).unwrap();
+        assert_eq!(six(compat.estimate(&d).unwrap().phi), printed, "sigma {sigma}");
+    }
+}

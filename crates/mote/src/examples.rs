@@ -9,24 +9,45 @@ pub struct Example {
 const CHOREOGRAPHY: &str = include_str!("../../../examples/choreography.toml");
 
 const SCENES: [(&str, &str); 6] = [
-    ("sun-earth", include_str!("../../../examples/sun-earth.toml")),
-    ("circumbinary", include_str!("../../../examples/circumbinary.toml")),
-    ("planetary-ring", include_str!("../../../examples/planetary-ring.toml")),
-    ("double-pendulum", include_str!("../../../examples/double-pendulum.toml")),
+    (
+        "sun-earth",
+        include_str!("../../../examples/sun-earth.toml"),
+    ),
+    (
+        "circumbinary",
+        include_str!("../../../examples/circumbinary.toml"),
+    ),
+    (
+        "planetary-ring",
+        include_str!("../../../examples/planetary-ring.toml"),
+    ),
+    (
+        "double-pendulum",
+        include_str!("../../../examples/double-pendulum.toml"),
+    ),
     ("membrane", include_str!("../../../examples/membrane.toml")),
-    ("cantilever", include_str!("../../../examples/cantilever.toml")),
+    (
+        "cantilever",
+        include_str!("../../../examples/cantilever.toml"),
+    ),
 ];
 
 /// All examples, in the order `mote examples` lists them.
 pub fn all() -> Vec<Example> {
     let mut list: Vec<Example> = SCENES
         .iter()
-        .map(|(name, text)| Example { name: name.to_string(), text: text.to_string() })
+        .map(|(name, text)| Example {
+            name: name.to_string(),
+            text: text.to_string(),
+        })
         .collect();
     for n in 2..=9 {
         list.insert(
             2 + n - 2,
-            Example { name: format!("choreography-{n}"), text: CHOREOGRAPHY.replace("@N@", &n.to_string()) },
+            Example {
+                name: format!("choreography-{n}"),
+                text: CHOREOGRAPHY.replace("@N@", &n.to_string()),
+            },
         );
     }
     list

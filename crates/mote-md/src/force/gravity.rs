@@ -81,7 +81,15 @@ impl DirectGravity {
 }
 
 /// Chooses the widest instruction set this CPU has for the row loop.
-fn rows_dispatch(first: usize, rows: &mut [DVec3], xs: &[f64], ys: &[f64], zs: &[f64], ms: &[f64], eps2: f64) {
+fn rows_dispatch(
+    first: usize,
+    rows: &mut [DVec3],
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    ms: &[f64],
+    eps2: f64,
+) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
@@ -100,18 +108,42 @@ fn rows_dispatch(first: usize, rows: &mut [DVec3], xs: &[f64], ys: &[f64], zs: &
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn rows_avx512(first: usize, rows: &mut [DVec3], xs: &[f64], ys: &[f64], zs: &[f64], ms: &[f64], eps2: f64) {
+unsafe fn rows_avx512(
+    first: usize,
+    rows: &mut [DVec3],
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    ms: &[f64],
+    eps2: f64,
+) {
     rows_portable(first, rows, xs, ys, zs, ms, eps2)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn rows_avx2(first: usize, rows: &mut [DVec3], xs: &[f64], ys: &[f64], zs: &[f64], ms: &[f64], eps2: f64) {
+unsafe fn rows_avx2(
+    first: usize,
+    rows: &mut [DVec3],
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    ms: &[f64],
+    eps2: f64,
+) {
     rows_portable(first, rows, xs, ys, zs, ms, eps2)
 }
 
 #[inline(always)]
-fn rows_portable(first: usize, rows: &mut [DVec3], xs: &[f64], ys: &[f64], zs: &[f64], ms: &[f64], eps2: f64) {
+fn rows_portable(
+    first: usize,
+    rows: &mut [DVec3],
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    ms: &[f64],
+    eps2: f64,
+) {
     for (k, out) in rows.iter_mut().enumerate() {
         let i = first + k;
         *out = field_at(xs[i], ys[i], zs[i], xs, ys, zs, ms, eps2);
@@ -122,7 +154,16 @@ fn rows_portable(first: usize, rows: &mut [DVec3], xs: &[f64], ys: &[f64], zs: &
 /// softened distance (the particle itself when ε = 0) contribute nothing.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn field_at(xi: f64, yi: f64, zi: f64, xs: &[f64], ys: &[f64], zs: &[f64], ms: &[f64], eps2: f64) -> DVec3 {
+fn field_at(
+    xi: f64,
+    yi: f64,
+    zi: f64,
+    xs: &[f64],
+    ys: &[f64],
+    zs: &[f64],
+    ms: &[f64],
+    eps2: f64,
+) -> DVec3 {
     let mut ax = [0.0f64; LANES];
     let mut ay = [0.0f64; LANES];
     let mut az = [0.0f64; LANES];
@@ -137,7 +178,11 @@ fn field_at(xi: f64, yi: f64, zi: f64, xs: &[f64], ys: &[f64], zs: &[f64], ms: &
             let dy = cy[l] - yi;
             let dz = cz[l] - zi;
             let r2 = dx * dx + dy * dy + dz * dz + eps2;
-            let s = if r2 > 0.0 { cm[l] / (r2 * r2.sqrt()) } else { 0.0 };
+            let s = if r2 > 0.0 {
+                cm[l] / (r2 * r2.sqrt())
+            } else {
+                0.0
+            };
             ax[l] += s * dx;
             ay[l] += s * dy;
             az[l] += s * dz;
@@ -191,7 +236,12 @@ mod tests {
         let pos = [DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0)];
         let vel = [DVec3::ZERO; 2];
         let mass = [3.0, 5.0];
-        let state = State { position: &pos, velocity: &vel, mass: &mass, time: 0.0 };
+        let state = State {
+            position: &pos,
+            velocity: &vel,
+            mass: &mass,
+            time: 0.0,
+        };
         let mut g = DirectGravity::new(0.5, 0.0);
         let mut f = [DVec3::ZERO; 2];
         g.add_forces(&state, &mut f);
@@ -208,12 +258,21 @@ mod tests {
         let pos: Vec<DVec3> = (0..n)
             .map(|k| {
                 let t = k as f64;
-                DVec3::new((1.3 * t).sin(), (0.7 * t).cos() * 2.0, (0.37 * t).sin() * t * 0.1)
+                DVec3::new(
+                    (1.3 * t).sin(),
+                    (0.7 * t).cos() * 2.0,
+                    (0.37 * t).sin() * t * 0.1,
+                )
             })
             .collect();
         let mass: Vec<f64> = (0..n).map(|k| 1.0 + 0.1 * k as f64).collect();
         let vel = vec![DVec3::ZERO; n];
-        let state = State { position: &pos, velocity: &vel, mass: &mass, time: 0.0 };
+        let state = State {
+            position: &pos,
+            velocity: &vel,
+            mass: &mass,
+            time: 0.0,
+        };
         let mut g = DirectGravity::new(1.0, 0.05);
         let mut f = vec![DVec3::ZERO; n];
         g.add_forces(&state, &mut f);

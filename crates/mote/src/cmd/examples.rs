@@ -17,10 +17,12 @@ pub struct ExamplesArgs {
 pub fn run(global: &super::GlobalOpts, args: ExamplesArgs) -> anyhow::Result<ExitCode> {
     let all = examples::all();
     if let Some(dir) = args.write {
-        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create {}", dir.display()))?;
         for e in &all {
             let path = dir.join(format!("{}.toml", e.name));
-            std::fs::write(&path, &e.text).with_context(|| format!("cannot write {}", path.display()))?;
+            std::fs::write(&path, &e.text)
+                .with_context(|| format!("cannot write {}", path.display()))?;
         }
         if !global.quiet {
             println!("wrote {} scene files to {}", all.len(), dir.display());

@@ -50,20 +50,38 @@ fn read_input(spec: &str) -> anyhow::Result<Input> {
     if let Some(name) = spec.strip_prefix("example:") {
         let Some(e) = examples::find(name) else {
             let names: Vec<String> = examples::all().into_iter().map(|e| e.name).collect();
-            bail!("no example called '{name}'; the examples are: {}", names.join(", "));
+            bail!(
+                "no example called '{name}'; the examples are: {}",
+                names.join(", ")
+            );
         };
-        return Ok(Input { name: name.to_string(), label: spec.to_string(), text: e.text, plist: false });
+        return Ok(Input {
+            name: name.to_string(),
+            label: spec.to_string(),
+            text: e.text,
+            plist: false,
+        });
     }
     let path = Path::new(spec);
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {spec}"))?;
-    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "run".into());
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "run".into());
     let plist = path.extension().and_then(|e| e.to_str()) != Some("toml");
-    Ok(Input { name, label: spec.to_string(), text, plist })
+    Ok(Input {
+        name,
+        label: spec.to_string(),
+        text,
+        plist,
+    })
 }
 
 /// A seed from the clock when none is given.
 fn fresh_seed() -> u64 {
-    let t = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default();
+    let t = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap_or_default();
     (t.as_nanos() as u64 ^ (std::process::id() as u64) << 32) % 1_000_000_007
 }
 
@@ -91,7 +109,10 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         scene.run.dt = Some(toml::Spanned::new(0..0, dt));
     }
     if scene.run.dt.is_none() {
-        bail!("{}: no time step: give one with --dt (a particle file sets it with a 'dt' line)", input.label);
+        bail!(
+            "{}: no time step: give one with --dt (a particle file sets it with a 'dt' line)",
+            input.label
+        );
     }
     let seed_given = global.seed.or(scene.seed);
     let seed = seed_given.unwrap_or_else(fresh_seed);
@@ -100,7 +121,10 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         (Some(n), _, _) => RunLength::Steps(n),
         (None, Some(t), _) => RunLength::Until(t),
         (None, None, Some(l)) => l,
-        (None, None, None) => bail!("{}: no run length: give --until T or --steps N", input.label),
+        (None, None, None) => bail!(
+            "{}: no run length: give --until T or --steps N",
+            input.label
+        ),
     };
 
     let dir = args
@@ -108,7 +132,8 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         .clone()
         .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
         .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create the output folder {}", dir.display()))?;
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
     let provenance = Provenance {
         program: format!("mote {}", env!("CARGO_PKG_VERSION")),
         scene: input.label.clone(),
@@ -126,7 +151,11 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         )?));
     }
     if out.trajectory_every > 0 {
-        sim.observers.push(Box::new(TrajectoryXyz::create(&dir.join("trajectory.xyz"), provenance.clone(), out.trajectory_every)?));
+        sim.observers.push(Box::new(TrajectoryXyz::create(
+            &dir.join("trajectory.xyz"),
+            provenance.clone(),
+            out.trajectory_every,
+        )?));
     }
 
     let steps = length.steps_from(sim.system.time, sim.dt);
@@ -140,7 +169,11 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             sim.dt,
             steps,
             seed,
-            if seed_given.is_some() { "" } else { " (chosen)" },
+            if seed_given.is_some() {
+                ""
+            } else {
+                " (chosen)"
+            },
             threads,
             if threads == 1 { "" } else { "s" }
         );
@@ -168,7 +201,10 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         }
         Err(e @ MdError::Unstable { .. }) => {
             eprintln!("error: {e}");
-            eprintln!("the files written up to that point are kept in {}", dir.display());
+            eprintln!(
+                "the files written up to that point are kept in {}",
+                dir.display()
+            );
             Ok(ExitCode::from(3))
         }
         Err(e) => Err(e.into()),
@@ -190,7 +226,11 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
 fn summary(report: &RunReport, scene: &Scene, dir: &Path, _steps: u64) {
     let secs = report.wall.as_secs_f64();
     let [_, t_unit, _, e_unit] = scene.units.labels();
-    let files = if report.files.is_empty() { "no files (output switched off)".to_string() } else { report.files.join(", ") };
+    let files = if report.files.is_empty() {
+        "no files (output switched off)".to_string()
+    } else {
+        report.files.join(", ")
+    };
     println!(
         "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). Total energy went from {:.9e} to {:.9e} {}: \
          relative drift {:.3e} at the end, {:.3e} at most over the sampled instants. Output in {}: {}.",

@@ -1,0 +1,219 @@
+//! `mote run` and `mote examples` end to end: outputs, and bad input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn mote(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("mote runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn example_runs_and_writes_headed_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &[
+            "run",
+            "example:sun-earth",
+            "--steps",
+            "200",
+            "--seed",
+            "42",
+            "-o",
+            "se",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("Ran 200 steps"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.path().join("se/observables.csv")).unwrap();
+    let first = csv.lines().next().unwrap();
+    assert!(
+        first.contains("mote 0.1.0")
+            && first.contains("example:sun-earth")
+            && first.contains("seed=42"),
+        "{first}"
+    );
+    let table = mote_io::csv::read_table(&dir.path().join("se/observables.csv")).unwrap();
+    let t = table.column("time").unwrap();
+    assert_eq!(*t.last().unwrap(), 100.0); // 200 steps of 0.5 d
+    let frames = mote_io::xyz::read_frames(&dir.path().join("se/trajectory.xyz")).unwrap();
+    assert_eq!(frames.len(), 11); // steps 0, 20, ..., 200
+    assert_eq!(frames[0].positions.len(), 2);
+}
+
+#[test]
+fn until_overrides_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &["run", "example:sun-earth", "--until", "10", "-q", "-o", "x"],
+        dir.path(),
+    );
+    assert!(o.status.success());
+    assert!(
+        o.stdout.is_empty() && o.stderr.is_empty(),
+        "--quiet printed something"
+    );
+    let table = mote_io::csv::read_table(&dir.path().join("x/observables.csv")).unwrap();
+    assert_eq!(*table.column("time").unwrap().last().unwrap(), 10.0);
+}
+
+#[test]
+fn examples_are_listed_and_written_and_each_one_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(&["examples"], dir.path());
+    let list = String::from_utf8_lossy(&o.stdout);
+    for name in [
+        "sun-earth",
+        "circumbinary",
+        "choreography-9",
+        "planetary-ring",
+        "double-pendulum",
+        "membrane",
+        "cantilever",
+    ] {
+        assert!(list.contains(name), "{name} missing from {list}");
+    }
+    let o = mote(&["examples", "--write", "scenes"], dir.path());
+    assert!(o.status.success());
+    for entry in std::fs::read_dir(dir.path().join("scenes")).unwrap() {
+        let path = entry.unwrap().path();
+        let o = mote(
+            &[
+                "run",
+                path.to_str().unwrap(),
+                "--steps",
+                "3",
+                "-q",
+                "-o",
+                "o",
+            ],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+    }
+}
+
+#[test]
+fn plist_file_runs_with_system_and_solver() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("data.plist"),
+        "pos 0 0.0 0.0 0.0 1.0 0.0 0.1 1.0 1.0 0.0\npos 1 1.0 0.0 0.0 3e-6 0.0 0.03 0.3 0.3 1.0\nvel 1 0.0 0.0172 0.0\nvfix 0 1 1 0\nvfix 1 1 1 0\nk2 2.9584e-4\ndt 0.03\n",
+    )
+    .unwrap();
+    let o = mote(
+        &[
+            "run",
+            "data.plist",
+            "--system",
+            "nbody",
+            "--solver",
+            "RK4",
+            "--until",
+            "3",
+            "-o",
+            "p",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = mote(&["run", "data.plist"], dir.path());
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("no run length"), "{}", stderr(&o));
+}
+
+#[test]
+fn malformed_scene_names_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bad.toml"),
+        "units = \"astro\"\n[run]\ndt = 0.1\nintegrater = \"rk4\"\n",
+    )
+    .unwrap();
+    let o = mote(&["run", "bad.toml", "--steps", "1"], dir.path());
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("bad.toml:4:") && e.contains("integrater"), "{e}");
+
+    std::fs::write(
+        dir.path().join("bad2.toml"),
+        "[run]\ndt = 0.1\nintegrator = \"verlet9\"\n[[particle]]\nposition = [0, 0, 0]\n",
+    )
+    .unwrap();
+    let e = stderr(&mote(&["run", "bad2.toml", "--steps", "1"], dir.path()));
+    assert!(
+        e.contains("bad2.toml:3: unknown integrator 'verlet9'"),
+        "{e}"
+    );
+
+    std::fs::write(dir.path().join("bad3.toml"), "[run]\ndt = 0.1\n[[particle]]\nposition = [0, 0, 0]\n\n[[spring]]\npairs = [[0, 5]]\nstiffness = 1.0\n").unwrap();
+    let e = stderr(&mote(&["run", "bad3.toml", "--steps", "1"], dir.path()));
+    assert!(e.contains("bad3.toml:6: spring pair [0, 5]"), "{e}");
+
+    std::fs::write(
+        dir.path().join("bad4.toml"),
+        "[run]\ndt = 0.1\n[[particle]]\nposition = [0, 0]\n",
+    )
+    .unwrap();
+    let e = stderr(&mote(&["run", "bad4.toml", "--steps", "1"], dir.path()));
+    assert!(e.contains("bad4.toml:4:"), "{e}");
+}
+
+#[test]
+fn malformed_plist_names_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bad.plist"),
+        "pos 0 0 0 0 1 0 0\n# fine\nvel 0 1 one 0\n",
+    )
+    .unwrap();
+    let o = mote(&["run", "bad.plist", "--steps", "1"], dir.path());
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("bad.plist:3: the velocity of 'vel' must be a number, found 'one'"),
+        "{e}"
+    );
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn unstable_run_stops_naming_step_and_particle_and_keeps_files() {
+    let dir = tempfile::tempdir().unwrap();
+    // The stiff double pendulum blows up at dt = 0.05 (it needs ~1e-3).
+    let o = mote(
+        &[
+            "run",
+            "example:double-pendulum",
+            "--dt",
+            "0.05",
+            "--until",
+            "1000",
+            "-o",
+            "dp",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("went unstable at step") && e.contains("particle"),
+        "{e}"
+    );
+    assert!(e.contains("kept in dp"), "{e}");
+    let table = mote_io::csv::read_table(&dir.path().join("dp/observables.csv")).unwrap();
+    assert!(
+        table.rows.len() > 1,
+        "the observables written before the blow-up are kept"
+    );
+    assert!(table.rows.iter().all(|r| r.iter().all(|v| v.is_finite())));
+}
