@@ -71,11 +71,11 @@ fn run<const D: usize>(scene: &Scene, seed: u64, eq: f64, t: f64) {
     let el = start.elapsed().as_secs_f64();
     let c = sys.counters();
     println!(
-        "D={D} N={} eta={:.4} t={t} collisions={} cells={} invalid={} loop_seconds={el:.3} coll_per_s={:.4e} ns_per_coll={:.1} Z={:.5} dE/E={:.2e}",
+        "D={D} N={} eta={:.4} t={t} collisions={} rebuilds={} invalid={} loop_seconds={el:.3} coll_per_s={:.4e} ns_per_coll={:.1} Z={:.5} dE/E={:.2e}",
         sys.len(),
         sys.packing_fraction(),
         c.collisions,
-        c.cell_crossings,
+        c.rebuilds,
         c.invalid,
         c.collisions as f64 / el,
         el * 1e9 / c.collisions as f64,

@@ -7,9 +7,14 @@
 //! the root is taken in the cancellation-free form `c / (−b + √(b² − ac))`).
 //! Scheduling: one event per particle in an indexed binary heap, invalidated
 //! by per-particle collision counters (Smallenburg, arXiv:2201.01099);
-//! neighbours from a cell list whose cells are at least one largest diameter
-//! wide, with cell-crossing events; free flight is lazy (each particle keeps
-//! its own time `t_i` and is advanced only when it takes part in an event).
+//! neighbours from symmetric neighbour lists with a shell: particle i lists
+//! every j with |x_i − x_j| < s(r_i + r_j) (s = [`SHELL`]) at the moment it
+//! builds its list, and rebuilds it (a "neighbour-list event", the analogue
+//! of a cell crossing) when it has moved (s − 1) r_i from where it built it,
+//! so two unlisted particles cannot touch. Lists are built from a cell list
+//! of cells at least s·(largest diameter) wide. Free flight is lazy (each
+//! particle keeps its own time `t_i` and is advanced only when it takes part
+//! in an event).
 //!
 //! Growth (issue 5) fits in by replacing the contact distance σ_ij with
 //! σ_ij(t) = σ_ij(0)(1 + δt) in [`pair_time`] and widening the cells; the
@@ -48,8 +53,8 @@ impl<const D: usize> SimBox<D> {
 enum Kind {
     None,
     Collision,
-    /// Leaves its cell along `axis` (`up`: towards larger coordinates).
-    Cell,
+    /// Has moved (s − 1) r_i from where it built its neighbour list.
+    Rebuild,
     /// Hits the wall of `axis` (`up`: the wall at L).
     Wall,
 }
@@ -74,6 +79,10 @@ const NO_EVENT: Event = Event {
 
 const NONE: u32 = u32::MAX;
 
+/// Neighbour shell factor s: pairs closer than s(r_i + r_j) are listed
+/// (Smallenburg's `shellsize`, 1 + α with α = 0.5).
+pub const SHELL: f64 = 1.5;
+
 /// Position `x` at the particle's own time `t`, velocity `v`, radius `r`.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
@@ -91,8 +100,8 @@ pub struct Counters {
     pub collisions: u64,
     /// Wall collisions.
     pub wall_hits: u64,
-    /// Cell crossings.
-    pub cell_crossings: u64,
+    /// Neighbour-list rebuilds.
+    pub rebuilds: u64,
     /// Events found invalid when they came up.
     pub invalid: u64,
     /// Σ r_ij·Δp_i over pair collisions (the collision virial).
@@ -124,6 +133,11 @@ pub struct System<const D: usize> {
     next: Vec<u32>,
     prev: Vec<u32>,
     offsets: Vec<[i32; D]>,
+    // neighbour lists: row i of `nbr` (capacity `cap`) holds nn[i] entries
+    xn: Vec<[f64; D]>,
+    nbr: Vec<u32>,
+    nn: Vec<u32>,
+    cap: usize,
     // events
     events: Vec<Event>,
     queue: EventQueue,
@@ -190,7 +204,7 @@ impl<const D: usize> System<D> {
             }
         }
         let max_radius = radii.iter().cloned().fold(0.0, f64::max);
-        let dmax = 2.0 * max_radius;
+        let dmax = SHELL * 2.0 * max_radius;
         let mut ncell = [1usize; D];
         let mut cwidth = [0.0; D];
         for d in 0..D {
@@ -207,7 +221,8 @@ impl<const D: usize> System<D> {
             };
             if simbox.boundary[d] == Boundary::Periodic && nc < 3 {
                 return Err(EdmdError::Invalid(format!(
-                    "periodic axis {d}: box length {l} must exceed three largest diameters ({})",
+                    "periodic axis {d}: box length {l} must exceed {} largest diameters ({})",
+                    3.0 * SHELL,
                     3.0 * dmax
                 )));
             }
@@ -270,6 +285,10 @@ impl<const D: usize> System<D> {
             next: vec![NONE; n],
             prev: vec![NONE; n],
             offsets,
+            xn: vec![[0.0; D]; n],
+            nbr: vec![0; n * 16],
+            nn: vec![0; n],
+            cap: 16,
             events: vec![NO_EVENT; n],
             queue: EventQueue::new(n),
             now: 0.0,
@@ -300,7 +319,11 @@ impl<const D: usize> System<D> {
             }
             let c = sys.cell_of(&sys.p[i].x);
             sys.cidx[i] = c;
+            sys.xn[i] = sys.p[i].x;
             sys.insert(i);
+        }
+        for i in 0..n {
+            sys.scan_neighbours(i, true);
         }
         if let Some((i, j, gap)) = sys.find_overlap(1e-9) {
             return Err(EdmdError::Invalid(format!(
@@ -609,70 +632,139 @@ impl<const D: usize> System<D> {
 
     // ----- prediction ----------------------------------------------------
 
-    /// Schedules the next event of particle `i` (advanced to now).
+    /// Schedules the next event of particle `i` (advanced to now): the
+    /// earliest of its neighbour-list expiry, wall hits and collisions with
+    /// listed neighbours.
     fn predict(&mut self, i: usize) {
         self.advance(i);
-        let xi = self.p[i].x;
-        let vi = self.p[i].v;
-        let ri = self.p[i].r;
-        let ci = self.cidx[i];
+        let Particle { x: xi, v: vi, r: ri, .. } = self.p[i];
+        let now = self.now;
+        let a = dot(&vi, &vi);
         let mut best = f64::INFINITY;
         let mut ev = NO_EVENT;
-        // cell crossings and walls
+        if a > 0.0 {
+            // |x + v t − x_n| = (s − 1) r_i, the outer root
+            let dr = sub(&xi, &self.xn[i]);
+            let m = (SHELL - 1.0) * ri;
+            let c = dot(&dr, &dr) - m * m;
+            best = if c >= 0.0 {
+                0.0
+            } else {
+                let b = dot(&dr, &vi);
+                let q = (b * b - a * c).sqrt();
+                if b > 0.0 {
+                    -c / (b + q)
+                } else {
+                    (q - b) / a
+                }
+            };
+            ev.kind = Kind::Rebuild;
+        }
         for d in 0..D {
-            let v = vi[d];
-            if v == 0.0 {
+            if self.simbox.boundary[d] != Boundary::Wall {
                 continue;
             }
-            let up = v > 0.0;
-            let c = ci[d] as usize;
-            let at_edge = if up { c + 1 == self.ncell[d] } else { c == 0 };
-            let (dt, kind) = if at_edge && self.simbox.boundary[d] == Boundary::Wall {
-                let target = if up { self.simbox.size[d] - ri } else { ri };
-                (((target - xi[d]) / v).max(0.0), Kind::Wall)
+            let v = vi[d];
+            let dt = if v > 0.0 {
+                (self.simbox.size[d] - ri - xi[d]) / v
+            } else if v < 0.0 {
+                (ri - xi[d]) / v
             } else {
-                let edge = if up { c + 1 } else { c } as f64 * self.cwidth[d];
-                (((edge - xi[d]) / v).max(0.0), Kind::Cell)
-            };
+                continue;
+            }
+            .max(0.0);
             if dt < best {
                 best = dt;
                 ev = Event {
-                    kind,
+                    kind: Kind::Wall,
                     partner: NONE,
                     axis: d as u8,
-                    up,
+                    up: v > 0.0,
                     partner_count: 0,
                 };
             }
         }
-        // collisions with particles in the 3^D neighbouring cells
-        let now = self.now;
+        let mut partner = NONE;
+        let base = i * self.cap;
+        for k in 0..self.nn[i] as usize {
+            let j = self.nbr[base + k];
+            let pj = &self.p[j as usize];
+            let dtj = now - pj.t;
+            let mut r = [0.0; D];
+            let mut v = [0.0; D];
+            for d in 0..D {
+                r[d] = xi[d] - (pj.x[d] + pj.v[d] * dtj);
+                v[d] = vi[d] - pj.v[d];
+            }
+            for d in 0..D {
+                if self.simbox.boundary[d] == Boundary::Periodic {
+                    let l = self.simbox.size[d];
+                    if r[d] > 0.5 * l {
+                        r[d] -= l;
+                    } else if r[d] < -0.5 * l {
+                        r[d] += l;
+                    }
+                }
+            }
+            // Bannerman et al.: approaching pairs only; overlapping ones now
+            let b = dot(&r, &v);
+            if b >= 0.0 {
+                continue;
+            }
+            let sigma = ri + pj.r;
+            let c = dot(&r, &r) - sigma * sigma;
+            let dt = if c <= 0.0 {
+                0.0
+            } else {
+                // t ≥ c/(−2b): cannot beat the current best
+                if c >= -2.0 * b * best {
+                    continue;
+                }
+                let av = dot(&v, &v);
+                let disc = b * b - av * c;
+                if disc < 0.0 {
+                    continue;
+                }
+                c / (-b + disc.sqrt())
+            };
+            if dt < best {
+                best = dt;
+                partner = j;
+            }
+        }
+        if partner != NONE {
+            ev = Event {
+                kind: Kind::Collision,
+                partner,
+                axis: 0,
+                up: false,
+                partner_count: self.count[partner as usize],
+            };
+        }
+        self.events[i] = ev;
+        self.queue.update(i, now + best);
+    }
+
+    /// Adds to the lists of `i` (and symmetrically to theirs) every particle
+    /// within the shell of its list position; with `only_greater`, only
+    /// j > i (for the first build of all lists).
+    fn scan_neighbours(&mut self, i: usize, only_greater: bool) {
+        let ci = self.cidx[i];
+        let xi = self.xn[i];
+        let ri = self.p[i].r;
         for o in 0..self.offsets.len() {
             let off = self.offsets[o];
-            let mut shift = [0.0; D];
             let mut cc = [0u32; D];
             let mut skip = false;
             for d in 0..D {
                 let k = ci[d] as i64 + off[d] as i64;
-                let n = self.ncell[d] as i64;
-                if k < 0 {
-                    if self.simbox.boundary[d] == Boundary::Periodic {
-                        cc[d] = (n - 1) as u32;
-                        shift[d] = -self.simbox.size[d];
-                    } else {
-                        skip = true;
-                        break;
-                    }
-                } else if k >= n {
-                    if self.simbox.boundary[d] == Boundary::Periodic {
-                        cc[d] = 0;
-                        shift[d] = self.simbox.size[d];
-                    } else {
-                        skip = true;
-                        break;
-                    }
-                } else {
+                let m = self.ncell[d] as i64;
+                if (0..m).contains(&k) {
                     cc[d] = k as u32;
+                } else if self.simbox.boundary[d] == Boundary::Periodic {
+                    cc[d] = k.rem_euclid(m) as u32;
+                } else {
+                    skip = true;
                 }
             }
             if skip {
@@ -681,32 +773,77 @@ impl<const D: usize> System<D> {
             let mut j = self.head[self.flat(&cc)];
             while j != NONE {
                 let ju = j as usize;
-                if ju != i {
-                    let dtj = now - self.p[ju].t;
-                    let vj = self.p[ju].v;
-                    let mut r = [0.0; D];
-                    let mut v = [0.0; D];
-                    for d in 0..D {
-                        r[d] = xi[d] - (self.p[ju].x[d] + vj[d] * dtj + shift[d]);
-                        v[d] = vi[d] - vj[d];
+                if ju != i && (!only_greater || ju > i) {
+                    let mut r = sub(&xi, &self.xn[ju]);
+                    for (d, rd) in r.iter_mut().enumerate() {
+                        if self.simbox.boundary[d] == Boundary::Periodic {
+                            let l = self.simbox.size[d];
+                            if *rd > 0.5 * l {
+                                *rd -= l;
+                            } else if *rd < -0.5 * l {
+                                *rd += l;
+                            }
+                        }
                     }
-                    let dt = pair_time(&r, &v, ri + self.p[ju].r);
-                    if dt < best {
-                        best = dt;
-                        ev = Event {
-                            kind: Kind::Collision,
-                            partner: j,
-                            axis: 0,
-                            up: false,
-                            partner_count: self.count[ju],
-                        };
+                    let s = SHELL * (ri + self.p[ju].r);
+                    if dot(&r, &r) < s * s {
+                        if self.nn[i] as usize == self.cap || self.nn[ju] as usize == self.cap {
+                            self.grow_lists();
+                        }
+                        let cap = self.cap;
+                        self.nbr[i * cap + self.nn[i] as usize] = j;
+                        self.nn[i] += 1;
+                        self.nbr[ju * cap + self.nn[ju] as usize] = i as u32;
+                        self.nn[ju] += 1;
                     }
                 }
                 j = self.next[ju];
             }
         }
-        self.events[i] = ev;
-        self.queue.update(i, now + best);
+    }
+
+    fn grow_lists(&mut self) {
+        let n = self.len();
+        let cap = self.cap * 2;
+        let mut nbr = vec![0u32; n * cap];
+        for i in 0..n {
+            let k = self.nn[i] as usize;
+            nbr[i * cap..i * cap + k].copy_from_slice(&self.nbr[i * self.cap..i * self.cap + k]);
+        }
+        self.nbr = nbr;
+        self.cap = cap;
+    }
+
+    /// Rebuilds the neighbour list of `i` at the current time.
+    fn rebuild(&mut self, i: usize) {
+        self.advance(i);
+        for d in 0..D {
+            if self.simbox.boundary[d] == Boundary::Periodic {
+                let l = self.simbox.size[d];
+                let x = &mut self.p[i].x[d];
+                if *x >= l {
+                    *x -= l;
+                } else if *x < 0.0 {
+                    *x += l;
+                }
+            }
+        }
+        self.xn[i] = self.p[i].x;
+        self.remove(i);
+        self.cidx[i] = self.cell_of(&self.xn[i]);
+        self.insert(i);
+        let cap = self.cap;
+        for k in 0..self.nn[i] as usize {
+            let j = self.nbr[i * cap + k] as usize;
+            let row = &mut self.nbr[j * cap..j * cap + self.nn[j] as usize];
+            if let Some(pos) = row.iter().position(|&x| x as usize == i) {
+                let last = row.len() - 1;
+                row[pos] = row[last];
+                self.nn[j] -= 1;
+            }
+        }
+        self.nn[i] = 0;
+        self.scan_neighbours(i, false);
     }
 
     // ----- the event loop ------------------------------------------------
@@ -738,27 +875,9 @@ impl<const D: usize> System<D> {
                     self.predict(j);
                 }
             }
-            Kind::Cell => {
-                self.advance(i);
-                self.counters.cell_crossings += 1;
-                self.remove(i);
-                let d = ev.axis as usize;
-                let n = self.ncell[d] as u32;
-                let l = self.simbox.size[d];
-                if ev.up {
-                    if self.cidx[i][d] + 1 == n {
-                        self.cidx[i][d] = 0;
-                        self.p[i].x[d] -= l;
-                    } else {
-                        self.cidx[i][d] += 1;
-                    }
-                } else if self.cidx[i][d] == 0 {
-                    self.cidx[i][d] = n - 1;
-                    self.p[i].x[d] += l;
-                } else {
-                    self.cidx[i][d] -= 1;
-                }
-                self.insert(i);
+            Kind::Rebuild => {
+                self.counters.rebuilds += 1;
+                self.rebuild(i);
                 self.predict(i);
             }
             Kind::Wall => {

@@ -1,0 +1,77 @@
+//! Scene files: every example parses and builds, and bad input is reported
+//! as `file:line: message`.
+
+use mote_edmd::scene::{example, EXAMPLES};
+use mote_edmd::{EdmdError, Scene, System};
+use std::path::Path;
+
+#[test]
+fn every_example_builds_without_overlap() {
+    for (name, text) in EXAMPLES {
+        let scene = Scene::parse(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        match scene.dimension {
+            2 => {
+                let s: System<2> = scene.build(1, Path::new(".")).unwrap();
+                assert!(s.find_overlap(1e-12).is_none());
+            }
+            _ => {
+                let s: System<3> = scene.build(1, Path::new(".")).unwrap();
+                assert!(s.find_overlap(1e-12).is_none());
+            }
+        }
+    }
+}
+
+#[test]
+fn cube_example_has_the_seed_radius_and_packing_fraction() {
+    // 001: r = w/((30π)^{1/3}·nbs), nbs = 10, so η = (4/3)π nbs³ r³ / w³ = 4/90
+    let scene = Scene::parse(example("cube").unwrap(), "cube").unwrap();
+    let s: System<3> = scene.build(1, Path::new(".")).unwrap();
+    let r = 1.0 / ((30.0 * std::f64::consts::PI).powf(1.0 / 3.0) * 10.0);
+    assert_eq!(s.len(), 1000);
+    assert!((s.radius(0) - r).abs() < 1e-14);
+    assert!((s.packing_fraction() - 4.0 / 90.0).abs() < 1e-12);
+    // all speeds 1
+    assert!(s.speeds().iter().all(|v| (v - 1.0).abs() < 1e-12));
+}
+
+fn scene_error(text: &str) -> (usize, String) {
+    match Scene::parse(text, "bad.toml") {
+        Err(EdmdError::Scene { file, line, message }) => {
+            assert_eq!(file, "bad.toml");
+            (line, message)
+        }
+        other => panic!("expected a scene error, got {other:?}"),
+    }
+}
+
+#[test]
+fn errors_name_the_line() {
+    let (line, msg) = scene_error("dimension = 3\nn = 10\npacking_fraction = 0.9\n");
+    assert_eq!(line, 3);
+    assert!(msg.contains("packing_fraction"), "{msg}");
+    let (line, msg) = scene_error("dimension = 3\nn = 10\npacking_fraction = 0.1\nboundary = \"sticky\"\n");
+    assert_eq!(line, 4);
+    assert!(msg.contains("boundary") || msg.contains("variant") || msg.contains("did not match"), "{msg}");
+    let (line, msg) = scene_error("dimension = 4\nn = 10\npacking_fraction = 0.1\n");
+    assert_eq!(line, 1);
+    assert!(msg.contains("2 (disks) or 3"), "{msg}");
+    let (line, msg) = scene_error("n = 10\npacking_fraction = 0.1\ntemprature = 1.0\n");
+    assert_eq!(line, 3);
+    assert!(msg.contains("temprature"), "{msg}");
+    let (line, _) = scene_error("n = 10\nbox = [1.0, 2.0]\n");
+    assert_eq!(line, 2);
+    let e = Scene::parse("n = 10\npacking_fraction = 0.1\ntime = -1.0\n", "bad.toml").unwrap_err();
+    assert!(e.to_string().starts_with("bad.toml:3: "), "{e}");
+}
+
+#[test]
+fn too_dense_random_placement_is_an_error_not_a_panic() {
+    let scene = Scene::parse(
+        "n = 500\npacking_fraction = 0.55\nplacement = \"random\"\n",
+        "dense.toml",
+    )
+    .unwrap();
+    let e = scene.build::<3>(1, Path::new(".")).unwrap_err();
+    assert!(e.to_string().contains("random placement"), "{e}");
+}
