@@ -66,7 +66,7 @@ fn spheres_follow_carnahan_starling_n4000() {
 #[test]
 fn disks_follow_henderson() {
     for eta in [0.3, 0.5] {
-        eos_check(2, 1600, eta, 5.0, 10, 4.0);
+        eos_check(2, 1600, eta, 5.0, 10, 10.0);
     }
 }
 

@@ -113,6 +113,32 @@ fn rows_dispatch(
     }
 }
 
+/// Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2} for particle i, on the widest instruction set.
+fn potential_dispatch(i: usize, xs: &[f64], ys: &[f64], zs: &[f64], ms: &[f64], eps2: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports AVX-512F (checked above), and the
+            // slices have equal lengths that are multiples of 8 (`load`).
+            return unsafe { avx512::potential_at(i, xs, ys, zs, ms, eps2) };
+        }
+    }
+    potential_at(i, xs, ys, zs, ms, eps2)
+}
+
+/// The portable potential kernel: Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2}.
+fn potential_at(i: usize, xs: &[f64], ys: &[f64], zs: &[f64], ms: &[f64], eps2: f64) -> f64 {
+    let mut u = 0.0;
+    for j in 0..xs.len() {
+        let (dx, dy, dz) = (xs[j] - xs[i], ys[j] - ys[i], zs[j] - zs[i]);
+        let r2 = dx * dx + dy * dy + dz * dz + eps2;
+        if j != i && r2 > 0.0 {
+            u += ms[j] / r2.sqrt();
+        }
+    }
+    u
+}
+
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
     use glam::DVec3;
@@ -173,6 +199,58 @@ mod avx512 {
             _mm512_reduce_add_pd(az),
         )
     }
+
+    /// Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2}, 8 pairs per iteration.
+    ///
+    /// # Safety
+    /// As for [`field_at`]; i < xs.len().
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn potential_at(
+        i: usize,
+        xs: &[f64],
+        ys: &[f64],
+        zs: &[f64],
+        ms: &[f64],
+        eps2: f64,
+    ) -> f64 {
+        let n = xs.len();
+        let (vxi, vyi, vzi) = (
+            _mm512_set1_pd(xs[i]),
+            _mm512_set1_pd(ys[i]),
+            _mm512_set1_pd(zs[i]),
+        );
+        let veps2 = _mm512_set1_pd(eps2);
+        let three_halves = _mm512_set1_pd(1.5);
+        let half = _mm512_set1_pd(0.5);
+        let zero = _mm512_setzero_pd();
+        let vi = _mm512_set1_epi64(i as i64);
+        let mut lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+        let eight = _mm512_set1_epi64(8);
+        let mut u = zero;
+        let mut j = 0;
+        while j < n {
+            // SAFETY (loads): j + 8 ≤ n for every slice.
+            let dx = _mm512_sub_pd(_mm512_loadu_pd(xs.as_ptr().add(j)), vxi);
+            let dy = _mm512_sub_pd(_mm512_loadu_pd(ys.as_ptr().add(j)), vyi);
+            let dz = _mm512_sub_pd(_mm512_loadu_pd(zs.as_ptr().add(j)), vzi);
+            let m = _mm512_loadu_pd(ms.as_ptr().add(j));
+            let r2 = _mm512_fmadd_pd(
+                dx,
+                dx,
+                _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, veps2)),
+            );
+            let live =
+                _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero) & _mm512_cmpneq_epi64_mask(lane, vi);
+            let mut y = _mm512_rsqrt14_pd(r2);
+            let h = _mm512_mul_pd(half, r2);
+            y = _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(h, y), y, three_halves));
+            y = _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(h, y), y, three_halves));
+            u = _mm512_mask3_fmadd_pd(m, y, u, live);
+            lane = _mm512_add_epi64(lane, eight);
+            j += 8;
+        }
+        _mm512_reduce_add_pd(u)
+    }
 }
 
 /// Σ_j m_j d_j / (|d_j|² + ε²)^{3/2} with d_j = r_j − r_i; pairs at zero
@@ -231,24 +309,17 @@ impl Interaction for DirectGravity {
         }
     }
 
+    /// U = −(G/2) Σ_i m_i Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2}, summed in a fixed order.
     fn potential_energy(&mut self, state: &State) -> f64 {
+        self.load(state);
         let eps2 = self.softening * self.softening;
-        let r = state.position;
-        let m = state.mass;
-        let per_i: Vec<f64> = (0..r.len())
+        let (xs, ys, zs, ms) = (&self.x[..], &self.y[..], &self.z[..], &self.m[..]);
+        let per_i: Vec<f64> = (0..state.position.len())
             .into_par_iter()
-            .map(|i| {
-                let mut u = 0.0;
-                for j in i + 1..r.len() {
-                    let r2 = (r[j] - r[i]).length_squared() + eps2;
-                    if r2 > 0.0 {
-                        u += m[j] / r2.sqrt();
-                    }
-                }
-                u * m[i]
-            })
+            .with_min_len(ROWS_PER_TASK)
+            .map(|i| ms[i] * potential_dispatch(i, xs, ys, zs, ms, eps2))
             .collect();
-        -self.g * per_i.iter().sum::<f64>()
+        -0.5 * self.g * per_i.iter().sum::<f64>()
     }
 }
 
