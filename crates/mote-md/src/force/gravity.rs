@@ -418,6 +418,18 @@ mod tests {
                     "particle {i}, ε = {eps}: relative error {err:.2e}"
                 );
             }
+            let mut exact = 0.0;
+            for i in 0..n {
+                for j in i + 1..n {
+                    exact -=
+                        mass[i] * mass[j] / ((pos[j] - pos[i]).length_squared() + eps * eps).sqrt();
+                }
+            }
+            let u = g.potential_energy(&state);
+            assert!(
+                (u - exact).abs() < 1e-14 * exact.abs(),
+                "ε = {eps}: U = {u}, exact {exact}"
+            );
         }
     }
 }
