@@ -1,0 +1,170 @@
+//! AVX-512 kernels: 8 pairs per instruction, 1/√r² from `vrsqrt14pd` refined
+//! by two Newton–Raphson steps y ← y (3/2 − (r²/2) y²) (14 → 28 → 56 bits).
+#![cfg(target_arch = "x86_64")]
+
+use std::arch::x86_64::*;
+
+use glam::DVec3;
+
+use super::Soa;
+
+/// 1/√r² to full double precision (r² > 0 and finite).
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn rsqrt(r2: __m512d) -> __m512d {
+    let three_halves = _mm512_set1_pd(1.5);
+    let h = _mm512_mul_pd(_mm512_set1_pd(0.5), r2);
+    let mut y = _mm512_rsqrt14_pd(r2);
+    y = _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(h, y), y, three_halves));
+    _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(h, y), y, three_halves))
+}
+
+/// See [`super::portable::pairs`].
+///
+/// # Safety
+/// The CPU must support AVX-512F; `j_end` must be a multiple of 8 no larger
+/// than the (equal) lengths of the slices of `p`; `r·` must cover `base..j_end`
+/// with `base ≤ j_start & !7`.
+#[target_feature(enable = "avx512f")]
+#[allow(clippy::too_many_arguments)]
+pub(super) unsafe fn pairs(
+    i: usize,
+    j_start: usize,
+    j_end: usize,
+    p: Soa,
+    eps2: f64,
+    base: usize,
+    rx: &mut [f64],
+    ry: &mut [f64],
+    rz: &mut [f64],
+) -> DVec3 {
+    debug_assert!(j_end % 8 == 0 && j_end <= p.x.len() && base <= j_start & !7);
+    debug_assert!(rx.len() >= j_end - base && ry.len() >= j_end - base && rz.len() >= j_end - base);
+    let (xi, yi, zi) = (
+        _mm512_set1_pd(p.x[i]),
+        _mm512_set1_pd(p.y[i]),
+        _mm512_set1_pd(p.z[i]),
+    );
+    let mi = _mm512_set1_pd(p.m[i]);
+    let veps2 = _mm512_set1_pd(eps2);
+    let zero = _mm512_setzero_pd();
+    let (mut ax, mut ay, mut az) = (zero, zero, zero);
+    let mut j = j_start & !7;
+    // Lanes of the first block below j_start take no part.
+    let mut lanes: __mmask8 = 0xFFu8 << (j_start - j);
+    while j < j_end {
+        // SAFETY: j + 8 ≤ j_end ≤ len for the particle arrays, and
+        // j − base + 8 ≤ j_end − base ≤ len for the reaction arrays.
+        let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), xi);
+        let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), yi);
+        let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), zi);
+        let mj = _mm512_loadu_pd(p.m.as_ptr().add(j));
+        let r2 = _mm512_fmadd_pd(
+            dx,
+            dx,
+            _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, veps2)),
+        );
+        let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero) & lanes;
+        let y = rsqrt(r2);
+        let s = _mm512_maskz_mul_pd(live, _mm512_mul_pd(y, y), y);
+        let sj = _mm512_mul_pd(s, mj);
+        ax = _mm512_fmadd_pd(sj, dx, ax);
+        ay = _mm512_fmadd_pd(sj, dy, ay);
+        az = _mm512_fmadd_pd(sj, dz, az);
+        let si = _mm512_mul_pd(s, mi);
+        let k = j - base;
+        let px = rx.as_mut_ptr().add(k);
+        let py = ry.as_mut_ptr().add(k);
+        let pz = rz.as_mut_ptr().add(k);
+        _mm512_storeu_pd(px, _mm512_fnmadd_pd(si, dx, _mm512_loadu_pd(px)));
+        _mm512_storeu_pd(py, _mm512_fnmadd_pd(si, dy, _mm512_loadu_pd(py)));
+        _mm512_storeu_pd(pz, _mm512_fnmadd_pd(si, dz, _mm512_loadu_pd(pz)));
+        lanes = 0xFF;
+        j += 8;
+    }
+    DVec3::new(
+        _mm512_reduce_add_pd(ax),
+        _mm512_reduce_add_pd(ay),
+        _mm512_reduce_add_pd(az),
+    )
+}
+
+/// See [`super::portable::field_at`].
+///
+/// # Safety
+/// The CPU must support AVX-512F; the slices of `p` have equal lengths, a multiple of 8.
+#[target_feature(enable = "avx512f")]
+pub(super) unsafe fn field_at(i: usize, p: Soa, eps2: f64) -> DVec3 {
+    let n = p.x.len();
+    let (xi, yi, zi) = (
+        _mm512_set1_pd(p.x[i]),
+        _mm512_set1_pd(p.y[i]),
+        _mm512_set1_pd(p.z[i]),
+    );
+    let veps2 = _mm512_set1_pd(eps2);
+    let zero = _mm512_setzero_pd();
+    let (mut ax, mut ay, mut az) = (zero, zero, zero);
+    let mut j = 0;
+    while j < n {
+        // SAFETY: j + 8 ≤ n.
+        let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), xi);
+        let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), yi);
+        let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), zi);
+        let m = _mm512_loadu_pd(p.m.as_ptr().add(j));
+        let r2 = _mm512_fmadd_pd(
+            dx,
+            dx,
+            _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, veps2)),
+        );
+        let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero);
+        let y = rsqrt(r2);
+        let s = _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_mul_pd(y, y), y), m);
+        ax = _mm512_fmadd_pd(s, dx, ax);
+        ay = _mm512_fmadd_pd(s, dy, ay);
+        az = _mm512_fmadd_pd(s, dz, az);
+        j += 8;
+    }
+    DVec3::new(
+        _mm512_reduce_add_pd(ax),
+        _mm512_reduce_add_pd(ay),
+        _mm512_reduce_add_pd(az),
+    )
+}
+
+/// See [`super::portable::potential_at`].
+///
+/// # Safety
+/// As for [`field_at`]; i < the slices' length.
+#[target_feature(enable = "avx512f")]
+pub(super) unsafe fn potential_at(i: usize, p: Soa, eps2: f64) -> f64 {
+    let n = p.x.len();
+    let (xi, yi, zi) = (
+        _mm512_set1_pd(p.x[i]),
+        _mm512_set1_pd(p.y[i]),
+        _mm512_set1_pd(p.z[i]),
+    );
+    let veps2 = _mm512_set1_pd(eps2);
+    let zero = _mm512_setzero_pd();
+    let vi = _mm512_set1_epi64(i as i64);
+    let mut lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+    let eight = _mm512_set1_epi64(8);
+    let mut u = zero;
+    let mut j = 0;
+    while j < n {
+        // SAFETY: j + 8 ≤ n.
+        let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), xi);
+        let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), yi);
+        let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), zi);
+        let m = _mm512_loadu_pd(p.m.as_ptr().add(j));
+        let r2 = _mm512_fmadd_pd(
+            dx,
+            dx,
+            _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, veps2)),
+        );
+        let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero) & _mm512_cmpneq_epi64_mask(lane, vi);
+        u = _mm512_mask3_fmadd_pd(m, rsqrt(r2), u, live);
+        lane = _mm512_add_epi64(lane, eight);
+        j += 8;
+    }
+    _mm512_reduce_add_pd(u)
+}
