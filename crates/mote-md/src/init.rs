@@ -216,6 +216,61 @@ pub fn lattice(
     }
 }
 
+/// A face-centred cubic crystal of cells = (nx, ny, nz) cubic cells at
+/// number density ρ (lattice constant a = (4/ρ)^{1/3}), shifted by a/4 off
+/// the box faces, and the periodic box it fills. Velocities are drawn from
+/// the Maxwell–Boltzmann distribution at k_B T = `kt`, the total momentum
+/// removed and the kinetic energy rescaled to exactly (3N − 3) kT / 2.
+pub fn fcc(
+    cells: [usize; 3],
+    density: f64,
+    origin: DVec3,
+    kt: f64,
+    template: &ParticleInit,
+    rng: &mut impl Rng,
+) -> (Vec<ParticleInit>, crate::boundary::Boundary) {
+    let a = (4.0 / density).cbrt();
+    let basis = [
+        DVec3::ZERO,
+        DVec3::new(0.5, 0.5, 0.0),
+        DVec3::new(0.5, 0.0, 0.5),
+        DVec3::new(0.0, 0.5, 0.5),
+    ];
+    let mut out = Vec::with_capacity(4 * cells[0] * cells[1] * cells[2]);
+    for k in 0..cells[2] {
+        for j in 0..cells[1] {
+            for i in 0..cells[0] {
+                for b in basis {
+                    let cell = DVec3::new(i as f64, j as f64, k as f64);
+                    let sigma = (kt / template.mass).sqrt();
+                    out.push(ParticleInit {
+                        position: origin + (cell + b + DVec3::splat(0.25)) * a,
+                        velocity: DVec3::new(gaussian(rng), gaussian(rng), gaussian(rng)) * sigma,
+                        ..template.clone()
+                    });
+                }
+            }
+        }
+    }
+    let n = out.len() as f64;
+    let p: DVec3 = out.iter().map(|q| q.velocity * q.mass).sum();
+    let m: f64 = out.iter().map(|q| q.mass).sum();
+    out.iter_mut().for_each(|q| q.velocity -= p / m);
+    let k: f64 = out
+        .iter()
+        .map(|q| 0.5 * q.mass * q.velocity.length_squared())
+        .sum();
+    if k > 0.0 && n > 1.0 {
+        let scale = (0.5 * (3.0 * n - 3.0) * kt / k).sqrt();
+        out.iter_mut().for_each(|q| q.velocity *= scale);
+    }
+    let size = DVec3::new(cells[0] as f64, cells[1] as f64, cells[2] as f64) * a;
+    (
+        out,
+        crate::boundary::Boundary::periodic(origin, origin + size),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -192,6 +192,7 @@ impl Stepper {
             }
             Integrator::Rk4 => self.rk4(sys, ff, h),
         }
+        sys.wrap_positions();
         sys.time = t + h;
         sys.step += 1;
     }

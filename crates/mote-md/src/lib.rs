@@ -8,17 +8,21 @@
 
 #![allow(clippy::needless_range_loop)] // index loops over parallel arrays read best in numerical code
 
+pub mod boundary;
 pub mod error;
 pub mod force;
 pub mod init;
 pub mod integrate;
+pub mod neighbor;
 pub mod observe;
 pub mod output;
 pub mod particles;
 pub mod scene;
 pub mod simulation;
+pub mod thermostat;
 pub mod units;
 
+pub use boundary::Boundary;
 pub use error::MdError;
 pub use force::{ForceField, Interaction, State};
 pub use integrate::{Integrator, Stepper};

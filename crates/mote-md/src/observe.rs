@@ -17,6 +17,10 @@ pub struct Observables {
     pub momentum: DVec3,
     /// Total angular momentum about the origin L = Σ m r × v.
     pub angular_momentum: DVec3,
+    /// k_B T = 2K / N_f in energy units (N_f: free translational degrees of freedom).
+    pub kt: f64,
+    /// P = (2K + W)/(3V) from the virial W of the last force evaluation; NaN without a periodic box.
+    pub pressure: f64,
 }
 
 impl Observables {
@@ -43,17 +47,26 @@ impl Observables {
             time: sys.time,
         };
         let (potential, _) = ff.potential_energy(&state);
+        let nf = sys.degrees_of_freedom();
+        let volume = sys.boundary.volume();
+        let pressure = if sys.boundary.periodic.iter().all(|p| *p) && volume.is_finite() {
+            (2.0 * kinetic + ff.virial()) / (3.0 * volume)
+        } else {
+            f64::NAN
+        };
         Self {
             time: sys.time,
             kinetic,
             potential,
             momentum,
             angular_momentum,
+            kt: if nf > 0.0 { 2.0 * kinetic / nf } else { 0.0 },
+            pressure,
         }
     }
 
     /// Column names of [`Observables::values`].
-    pub const COLUMNS: [&'static str; 11] = [
+    pub const COLUMNS: [&'static str; 13] = [
         "time",
         "kinetic_energy",
         "potential_energy",
@@ -65,9 +78,11 @@ impl Observables {
         "Ly",
         "Lz",
         "step",
+        "kT",
+        "pressure",
     ];
 
-    pub fn values(&self, step: u64) -> [f64; 11] {
+    pub fn values(&self, step: u64) -> [f64; 13] {
         [
             self.time,
             self.kinetic,
@@ -80,6 +95,8 @@ impl Observables {
             self.angular_momentum.y,
             self.angular_momentum.z,
             step as f64,
+            self.kt,
+            self.pressure,
         ]
     }
 }

@@ -44,6 +44,8 @@ impl ObservablesCsv {
             ang.clone(),
             ang,
             "1".into(),
+            e.into(),
+            format!("{e}/{l}^3"),
         ];
         for probe in &probes {
             columns.push(probe.label());

@@ -2,6 +2,8 @@
 
 use glam::DVec3;
 
+use crate::boundary::Boundary;
+
 /// Per-particle data, one array per quantity (structure of arrays).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Particles {
@@ -72,6 +74,7 @@ impl Particles {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct System {
     pub particles: Particles,
+    pub boundary: Boundary,
     pub time: f64,
     pub step: u64,
 }
@@ -80,8 +83,32 @@ impl System {
     pub fn new(particles: Particles) -> Self {
         Self {
             particles,
+            boundary: Boundary::open(),
             time: 0.0,
             step: 0,
+        }
+    }
+
+    /// Maps positions back into the box on periodic axes.
+    pub fn wrap_positions(&mut self) {
+        if self.boundary.is_periodic() {
+            let b = self.boundary;
+            self.particles
+                .position
+                .iter_mut()
+                .for_each(|r| *r = b.wrap(*r));
+        }
+    }
+
+    /// Degrees of freedom of translation: the free axes, less the three of
+    /// total momentum when nothing is fixed.
+    pub fn degrees_of_freedom(&self) -> f64 {
+        let p = &self.particles;
+        let free: f64 = p.mobility.iter().map(|m| m.x + m.y + m.z).sum();
+        if free == 3.0 * p.len() as f64 && p.len() > 1 {
+            free - 3.0
+        } else {
+            free
         }
     }
 

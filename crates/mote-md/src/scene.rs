@@ -2,7 +2,7 @@
 //!
 //! Every key is documented in docs/scene-format.md. Particles are numbered in
 //! this order: `[[particle]]` tables, then `[[lattice]]`, `[[ring]]`,
-//! `[[annulus]]` and `[[random_box]]` generators, each in file order.
+//! `[[annulus]]`, `[[random_box]]` and `[[fcc]]` generators, each in file order.
 
 use glam::DVec3;
 use rand::SeedableRng;
@@ -13,12 +13,15 @@ use toml::Spanned;
 use mote_io::plist::ParticleFile;
 use mote_io::ParseError;
 
-use crate::force::{DirectGravity, ForceField, GlobalDamping, Spring, SpringNetwork, UniformField};
+use crate::force::{
+    DirectGravity, ForceField, GlobalDamping, LennardJones, Spring, SpringNetwork, UniformField,
+};
 use crate::init::{self, Anchor};
 use crate::integrate::{Integrator, Stepper};
 use crate::observe::Probe;
 use crate::particles::{ParticleInit, Particles, System};
 use crate::simulation::{RunLength, Simulation};
+use crate::thermostat::Thermostat;
 use crate::units::UnitSystem;
 
 /// A whole scene file.
@@ -38,6 +41,10 @@ pub struct Scene {
     pub gravity: Option<GravitySettings>,
     pub field: Option<FieldSettings>,
     pub damping: Option<DampingSettings>,
+    pub lennard_jones: Option<Spanned<LennardJonesSettings>>,
+    pub thermostat: Option<Spanned<ThermostatSettings>>,
+    #[serde(rename = "box")]
+    pub bounds: Option<Spanned<BoxSettings>>,
     #[serde(default)]
     pub particle: Vec<Spanned<ParticleSpec>>,
     #[serde(default)]
@@ -48,6 +55,8 @@ pub struct Scene {
     pub annulus: Vec<Spanned<AnnulusSpec>>,
     #[serde(default)]
     pub random_box: Vec<Spanned<RandomBoxSpec>>,
+    #[serde(default)]
+    pub fcc: Vec<Spanned<FccSpec>>,
     #[serde(default)]
     pub spring: Vec<Spanned<SpringSpec>>,
     #[serde(default)]
@@ -108,6 +117,73 @@ pub struct FieldSettings {
 #[serde(deny_unknown_fields)]
 pub struct DampingSettings {
     pub gamma: f64,
+}
+
+/// `[box]`: an orthorhombic simulation box.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSettings {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+    #[serde(default = "all_free")]
+    pub periodic: [bool; 3],
+}
+
+/// `[lennard_jones]`: LJ or WCA between all particles through a Verlet list.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LennardJonesSettings {
+    #[serde(default = "one")]
+    pub epsilon: f64,
+    #[serde(default = "one")]
+    pub sigma: f64,
+    /// Cut-off r_c in units of length (default 2.5 σ; WCA: 2^{1/6} σ).
+    pub cutoff: Option<f64>,
+    /// Subtract U(r_c) (default true).
+    #[serde(default = "yes")]
+    pub shifted: bool,
+    /// Purely repulsive WCA: cut at 2^{1/6} σ and shifted.
+    #[serde(default)]
+    pub wca: bool,
+    /// Verlet-list skin (default 0.3 σ).
+    pub skin: Option<f64>,
+    /// Also rebuild the list every this many steps (0: only on displacement).
+    #[serde(default)]
+    pub rebuild_every: u64,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// `[thermostat]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThermostatSettings {
+    /// `langevin` or `bussi`.
+    pub kind: String,
+    /// Temperature as k_B T in energy units (in LJ units: T*).
+    pub kt: f64,
+    /// Langevin friction γ (per time).
+    pub gamma: Option<f64>,
+    /// Bussi relaxation time τ.
+    pub tau: Option<f64>,
+}
+
+/// `[[fcc]]`: a face-centred cubic crystal at a number density, with
+/// Maxwell–Boltzmann velocities at temperature kT (zero total momentum,
+/// rescaled to exactly kT); sets a periodic `[box]` when the scene has none.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FccSpec {
+    pub cells: [usize; 3],
+    pub density: f64,
+    #[serde(default)]
+    pub kt: f64,
+    #[serde(default)]
+    pub origin: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
 }
 
 fn one() -> f64 {
@@ -551,6 +627,30 @@ impl Scene {
                 displacements.push(DVec3::ZERO);
             }
         }
+        let mut fcc_box: Option<crate::boundary::Boundary> = None;
+        for spec in &self.fcc {
+            let s = spec.get_ref();
+            check_props(&s.props, spec.span())?;
+            if s.cells.contains(&0) || s.density.is_nan() || s.density <= 0.0 || s.kt < 0.0 {
+                return Err(err(
+                    spec.span(),
+                    "fcc needs cells ≥ 1 on every axis, density > 0 and kt ≥ 0".into(),
+                ));
+            }
+            let lat = init::fcc(
+                s.cells,
+                s.density,
+                DVec3::from(s.origin),
+                s.kt,
+                &s.props.template(),
+                &mut rng,
+            );
+            fcc_box = Some(lat.1);
+            for p in lat.0 {
+                inits.push(p);
+                displacements.push(DVec3::ZERO);
+            }
+        }
         let n = inits.len();
         if n == 0 {
             return Err(ParseError::new(file, 0, "the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]])"));
@@ -591,6 +691,20 @@ impl Scene {
             particles.push(p);
         }
 
+        let boundary = match &self.bounds {
+            Some(b) => {
+                let v = b.get_ref();
+                if (0..3).any(|k| v.hi[k].is_nan() || v.lo[k].is_nan() || v.hi[k] <= v.lo[k]) {
+                    return Err(err(b.span(), "[box] needs lo < hi on every axis".into()));
+                }
+                crate::boundary::Boundary {
+                    lo: DVec3::from(v.lo),
+                    hi: DVec3::from(v.hi),
+                    periodic: v.periodic,
+                }
+            }
+            None => fcc_box.unwrap_or_default(),
+        };
         let mut forces = ForceField::new();
         if let Some(g) = &self.gravity {
             if g.softening < 0.0 {
@@ -613,6 +727,68 @@ impl Scene {
         if let Some(d) = &self.damping {
             forces.push(GlobalDamping { gamma: d.gamma });
         }
+        if let Some(lj) = &self.lennard_jones {
+            let v = lj.get_ref();
+            if v.epsilon <= 0.0 || v.sigma <= 0.0 {
+                return Err(err(
+                    lj.span(),
+                    "[lennard_jones] needs epsilon > 0 and sigma > 0".into(),
+                ));
+            }
+            let skin = v.skin.unwrap_or(0.3 * v.sigma);
+            let mut pair = if v.wca {
+                LennardJones::wca(v.epsilon, v.sigma, skin, boundary)
+            } else {
+                let rc = v.cutoff.unwrap_or(2.5 * v.sigma);
+                LennardJones::new(v.epsilon, v.sigma, rc, v.shifted, skin, boundary)
+            };
+            if pair.cutoff <= 0.0 || skin < 0.0 {
+                return Err(err(
+                    lj.span(),
+                    "[lennard_jones] needs cutoff > 0 and skin ≥ 0".into(),
+                ));
+            }
+            let reach = pair.cutoff + skin;
+            let l = boundary.lengths();
+            if (0..3).any(|k| boundary.periodic[k] && l[k] < 2.0 * reach) {
+                return Err(err(
+                    lj.span(),
+                    format!("the periodic box ({} × {} × {}) must be at least twice cutoff + skin = {reach} on every periodic axis", l.x, l.y, l.z),
+                ));
+            }
+            pair.list.every = v.rebuild_every;
+            forces.push(pair);
+        }
+        let thermostat = match &self.thermostat {
+            None => None,
+            Some(t) => {
+                let v = t.get_ref();
+                if v.kt.is_nan() || v.kt < 0.0 {
+                    return Err(err(t.span(), "[thermostat] needs kt ≥ 0".into()));
+                }
+                Some(match (v.kind.as_str(), v.gamma, v.tau) {
+                    ("langevin", Some(gamma), _) if gamma > 0.0 => {
+                        Thermostat::Langevin { kt: v.kt, gamma }
+                    }
+                    ("bussi", _, Some(tau)) if tau > 0.0 => Thermostat::Bussi { kt: v.kt, tau },
+                    ("langevin", _, _) => {
+                        return Err(err(
+                            t.span(),
+                            "a langevin thermostat needs gamma > 0".into(),
+                        ))
+                    }
+                    ("bussi", _, _) => {
+                        return Err(err(t.span(), "a bussi thermostat needs tau > 0".into()))
+                    }
+                    (other, _, _) => {
+                        return Err(err(
+                            t.span(),
+                            format!("unknown thermostat '{other}': expected langevin or bussi"),
+                        ))
+                    }
+                })
+            }
+        };
 
         let integrator = Integrator::from_name(self.run.integrator.get_ref()).ok_or_else(|| {
             err(
@@ -664,6 +840,8 @@ impl Scene {
             probes.push(probe);
         }
         let mut system = System::new(particles);
+        system.boundary = boundary;
+        system.wrap_positions();
         if self.run.centre_of_mass {
             system.to_centre_of_mass_frame();
         }
@@ -674,6 +852,8 @@ impl Scene {
                 stepper: Stepper::new(integrator),
                 dt,
                 observers: Vec::new(),
+                thermostat,
+                rng: Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x9E37_79B9_7F4A_7C15),
             },
             length,
             probes,

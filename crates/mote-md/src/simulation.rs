@@ -7,6 +7,8 @@ use crate::force::ForceField;
 use crate::integrate::Stepper;
 use crate::observe::Observables;
 use crate::particles::System;
+use crate::thermostat::Thermostat;
+use rand_xoshiro::Xoshiro256PlusPlus;
 
 /// How long to run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,6 +68,10 @@ pub struct Simulation {
     pub stepper: Stepper,
     pub dt: f64,
     pub observers: Vec<Box<dyn Observer>>,
+    /// Applied after every step (NVE when `None`).
+    pub thermostat: Option<Thermostat>,
+    /// The run's random stream (thermostat noise), seeded from the run's seed.
+    pub rng: Xoshiro256PlusPlus,
 }
 
 impl Simulation {
@@ -90,7 +96,11 @@ impl Simulation {
             self.stepper
                 .step(&mut self.system, &mut self.forces, self.dt);
             self.check_finite()?;
-            let due = k == steps || self.observers.iter().any(|o| k.is_multiple_of(o.every().max(1)));
+            let due = k == steps
+                || self
+                    .observers
+                    .iter()
+                    .any(|o| k.is_multiple_of(o.every().max(1)));
             if due {
                 last = Observables::measure(&self.system, &mut self.forces);
                 let err = if e0 != 0.0 {

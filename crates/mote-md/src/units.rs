@@ -29,6 +29,20 @@ impl UnitSystem {
         }
     }
 
+    /// Boltzmann's constant k_B in this unit system's energy per kelvin
+    /// (reduced units: 1, temperatures are k_B T/ε).
+    pub fn boltzmann(self) -> f64 {
+        const K_B: f64 = 1.380_649e-23;
+        match self {
+            UnitSystem::Si => K_B,
+            UnitSystem::Lj => 1.0,
+            // J → M☉ AU² / day².
+            UnitSystem::Astro => {
+                K_B / (1.988_409_87e30 * 1.495_978_707e11f64.powi(2) / 86_400f64.powi(2))
+            }
+        }
+    }
+
     /// Unit labels for (length, time, mass, energy).
     pub fn labels(self) -> [&'static str; 4] {
         match self {

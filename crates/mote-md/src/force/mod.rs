@@ -5,11 +5,13 @@
 
 mod damping;
 mod gravity;
+mod lennard_jones;
 mod springs;
 mod uniform;
 
 pub use damping::GlobalDamping;
 pub use gravity::DirectGravity;
+pub use lennard_jones::LennardJones;
 pub use springs::{Spring, SpringNetwork};
 pub use uniform::UniformField;
 
@@ -33,6 +35,11 @@ pub trait Interaction: Send {
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]);
     /// The potential energy of the interaction; 0 for dissipative forces.
     fn potential_energy(&mut self, state: &State) -> f64;
+    /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation, for
+    /// the pressure P V = N k T + W/3 of periodic systems (0 if not tracked).
+    fn virial(&self) -> f64 {
+        0.0
+    }
 }
 
 /// All interactions of a run.
@@ -71,6 +78,11 @@ impl ForceField {
         for i in 0..n {
             acc[i] = self.force[i] / state.mass[i] * mobility[i];
         }
+    }
+
+    /// Total virial of the last force evaluation.
+    pub fn virial(&self) -> f64 {
+        self.interactions.iter().map(|i| i.virial()).sum()
     }
 
     /// Total potential energy, and its parts by interaction name.

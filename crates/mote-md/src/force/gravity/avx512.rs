@@ -38,7 +38,7 @@ pub(super) unsafe fn pairs(
     ry: &mut [f64],
     rz: &mut [f64],
 ) -> DVec3 {
-    debug_assert!(j_end % 8 == 0 && j_end <= p.x.len() && base <= j_start & !7);
+    debug_assert!(j_end.is_multiple_of(8) && j_end <= p.x.len() && base <= j_start & !7);
     debug_assert!(rx.len() >= j_end - base && ry.len() >= j_end - base && rz.len() >= j_end - base);
     let (xi, yi, zi) = (
         _mm512_set1_pd(p.x[i]),

@@ -1,0 +1,219 @@
+//! Neighbour search: cell lists feeding a Verlet list with a skin.
+//!
+//! The list holds, for every particle, all others within r_c + skin (a full
+//! list: each pair appears twice, so force loops run in parallel over
+//! particles without write conflicts and give the same bits for every thread
+//! count). It is rebuilt when any particle has moved more than half the skin
+//! since the last build (then no pair can have crossed r_c unseen), or after
+//! a fixed number of steps if one is set. Building bins the particles into
+//! cells of edge ≥ r_c + skin and scans the 27 surrounding cells, O(N).
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::boundary::Boundary;
+
+/// A Verlet neighbour list in compressed rows.
+#[derive(Debug, Clone, Default)]
+pub struct VerletList {
+    /// Interaction cut-off r_c.
+    pub cutoff: f64,
+    /// Skin: the list holds pairs within r_c + skin.
+    pub skin: f64,
+    /// Rebuild at least every this many updates (0: only on displacement).
+    pub every: u64,
+    /// `neighbors[start[i]..start[i + 1]]` are the neighbours of i.
+    pub start: Vec<u32>,
+    pub neighbors: Vec<u32>,
+    reference: Vec<DVec3>,
+    since_build: u64,
+    /// Number of builds so far.
+    pub builds: u64,
+}
+
+impl VerletList {
+    pub fn new(cutoff: f64, skin: f64) -> Self {
+        Self {
+            cutoff,
+            skin,
+            ..Self::default()
+        }
+    }
+
+    /// Neighbours of particle i.
+    #[inline]
+    pub fn of(&self, i: usize) -> &[u32] {
+        &self.neighbors[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// Rebuilds the list if needed; returns whether it did.
+    pub fn update(&mut self, pos: &[DVec3], boundary: &Boundary) -> bool {
+        self.since_build += 1;
+        let stale = self.reference.len() != pos.len()
+            || (self.every > 0 && self.since_build >= self.every)
+            || {
+                let limit = 0.25 * self.skin * self.skin;
+                pos.par_iter()
+                    .zip(&self.reference)
+                    .any(|(r, r0)| boundary.minimum_image(*r - *r0).length_squared() > limit)
+            };
+        if stale {
+            self.build(pos, boundary);
+        }
+        stale
+    }
+
+    /// Builds the list from scratch.
+    pub fn build(&mut self, pos: &[DVec3], boundary: &Boundary) {
+        let reach = self.cutoff + self.skin;
+        let reach2 = reach * reach;
+        let cells = CellGrid::new(pos, boundary, reach);
+        let lists: Vec<Vec<u32>> = (0..pos.len())
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|i| {
+                let mut near = Vec::new();
+                cells.for_each_candidate(pos[i], |j| {
+                    if j != i && boundary.minimum_image(pos[j] - pos[i]).length_squared() < reach2 {
+                        near.push(j as u32);
+                    }
+                });
+                near.sort_unstable();
+                near
+            })
+            .collect();
+        self.start.clear();
+        self.neighbors.clear();
+        self.start.push(0);
+        for near in &lists {
+            self.neighbors.extend_from_slice(near);
+            self.start.push(self.neighbors.len() as u32);
+        }
+        self.reference.clear();
+        self.reference.extend_from_slice(pos);
+        self.since_build = 0;
+        self.builds += 1;
+    }
+}
+
+/// Particles binned into cells of edge ≥ `reach`.
+pub struct CellGrid {
+    lo: DVec3,
+    edge: DVec3,
+    dims: [usize; 3],
+    periodic: [bool; 3],
+    /// Particle indices sorted by cell; `first[c]..first[c + 1]` is cell c.
+    order: Vec<usize>,
+    first: Vec<usize>,
+}
+
+impl CellGrid {
+    pub fn new(pos: &[DVec3], boundary: &Boundary, reach: f64) -> Self {
+        // Periodic axes use the box; open axes the particles' extent.
+        let mut lo = DVec3::ZERO;
+        let mut len = DVec3::ZERO;
+        let mut dims = [1usize; 3];
+        for k in 0..3 {
+            if boundary.periodic[k] {
+                lo[k] = boundary.lo[k];
+                len[k] = boundary.hi[k] - boundary.lo[k];
+                dims[k] = ((len[k] / reach).floor() as usize).max(1);
+                // Fewer than 3 cells would visit the same cell twice.
+                if dims[k] < 3 {
+                    dims[k] = 1;
+                }
+            } else {
+                let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+                for r in pos {
+                    a = a.min(r[k]);
+                    b = b.max(r[k]);
+                }
+                if pos.is_empty() {
+                    (a, b) = (0.0, 1.0);
+                }
+                lo[k] = a;
+                len[k] = (b - a).max(reach);
+                dims[k] = ((len[k] / reach).floor() as usize).clamp(1, 1 << 10);
+            }
+        }
+        let edge = DVec3::new(
+            len.x / dims[0] as f64,
+            len.y / dims[1] as f64,
+            len.z / dims[2] as f64,
+        );
+        let mut grid = Self {
+            lo,
+            edge,
+            dims,
+            periodic: boundary.periodic,
+            order: Vec::new(),
+            first: Vec::new(),
+        };
+        let ncell = dims[0] * dims[1] * dims[2];
+        let cell_of: Vec<usize> = pos
+            .iter()
+            .map(|r| grid.cell_index(grid.coords(*r)))
+            .collect();
+        let mut count = vec![0usize; ncell + 1];
+        for &c in &cell_of {
+            count[c + 1] += 1;
+        }
+        for c in 0..ncell {
+            count[c + 1] += count[c];
+        }
+        let mut fill = count.clone();
+        let mut order = vec![0usize; pos.len()];
+        for (i, &c) in cell_of.iter().enumerate() {
+            order[fill[c]] = i;
+            fill[c] += 1;
+        }
+        grid.order = order;
+        grid.first = count;
+        grid
+    }
+
+    fn coords(&self, r: DVec3) -> [isize; 3] {
+        let mut c = [0isize; 3];
+        for k in 0..3 {
+            let mut x = ((r[k] - self.lo[k]) / self.edge[k]).floor() as isize;
+            let d = self.dims[k] as isize;
+            if self.periodic[k] {
+                x = x.rem_euclid(d);
+            } else {
+                x = x.clamp(0, d - 1);
+            }
+            c[k] = x;
+        }
+        c
+    }
+
+    fn cell_index(&self, c: [isize; 3]) -> usize {
+        (c[0] as usize) + self.dims[0] * ((c[1] as usize) + self.dims[1] * (c[2] as usize))
+    }
+
+    /// Calls `f(j)` for every particle in the cells around position r.
+    pub fn for_each_candidate(&self, r: DVec3, mut f: impl FnMut(usize)) {
+        let c = self.coords(r);
+        let range = |k: usize| -> Vec<isize> {
+            let d = self.dims[k] as isize;
+            if d == 1 {
+                vec![0]
+            } else if self.periodic[k] {
+                vec![(c[k] - 1).rem_euclid(d), c[k], (c[k] + 1).rem_euclid(d)]
+            } else {
+                ((c[k] - 1).max(0)..=(c[k] + 1).min(d - 1)).collect()
+            }
+        };
+        let (xs, ys, zs) = (range(0), range(1), range(2));
+        for &z in &zs {
+            for &y in &ys {
+                for &x in &xs {
+                    let cell = self.cell_index([x, y, z]);
+                    for &j in &self.order[self.first[cell]..self.first[cell + 1]] {
+                        f(j);
+                    }
+                }
+            }
+        }
+    }
+}
