@@ -9,6 +9,7 @@
 #![allow(clippy::needless_range_loop)] // index loops over parallel arrays read best in numerical code
 
 pub mod boundary;
+pub mod eos;
 pub mod error;
 pub mod force;
 pub mod init;
