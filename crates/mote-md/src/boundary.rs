@@ -62,6 +62,11 @@ impl Boundary {
         d
     }
 
+    /// The fast minimum image for separations of wrapped positions.
+    pub fn image(&self) -> MinimumImage {
+        MinimumImage::new(self)
+    }
+
     /// Maps a position back into [lo, hi) on periodic axes.
     #[inline]
     pub fn wrap(&self, mut r: DVec3) -> DVec3 {
@@ -78,6 +83,36 @@ impl Boundary {
     }
 }
 
+/// Minimum image for separations of wrapped positions (|d| < L on periodic
+/// axes): one compare-and-shift per axis instead of a rounding; open axes get
+/// an infinite half-length and are left alone.
+pub struct MinimumImage {
+    length: DVec3,
+    half: DVec3,
+}
+
+impl MinimumImage {
+    pub fn new(b: &Boundary) -> Self {
+        let l = b.lengths();
+        let mut length = DVec3::ZERO;
+        let mut half = DVec3::INFINITY;
+        for k in 0..3 {
+            if b.periodic[k] {
+                length[k] = l[k];
+                half[k] = 0.5 * l[k];
+            }
+        }
+        Self { length, half }
+    }
+
+    #[inline(always)]
+    pub fn apply(&self, d: DVec3) -> DVec3 {
+        let up = DVec3::select(d.cmplt(-self.half), self.length, DVec3::ZERO);
+        let down = DVec3::select(d.cmpgt(self.half), self.length, DVec3::ZERO);
+        d + up - down
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,6 +124,14 @@ mod tests {
         assert_eq!(d, DVec3::new(-1.0, 2.0, 0.5));
         let r = b.wrap(DVec3::new(-0.5, 12.0, 2.0));
         assert!((r - DVec3::new(9.5, 2.0, 0.0)).length() < 1e-12);
+        let fast = b.image();
+        for d in [
+            DVec3::new(9.0, -3.0, 0.5),
+            DVec3::new(-9.9, 4.9, -1.5),
+            DVec3::new(0.1, 2.6, 1.01),
+        ] {
+            assert_eq!(fast.apply(d), b.minimum_image(d), "{d}");
+        }
         let open = Boundary::open();
         assert_eq!(open.minimum_image(DVec3::new(1e9, 0.0, 0.0)).x, 1e9);
     }

@@ -68,13 +68,14 @@ impl VerletList {
         let reach = self.cutoff + self.skin;
         let reach2 = reach * reach;
         let cells = CellGrid::new(pos, boundary, reach);
+        let image = boundary.image();
         let lists: Vec<Vec<u32>> = (0..pos.len())
             .into_par_iter()
             .with_min_len(256)
             .map(|i| {
                 let mut near = Vec::new();
                 cells.for_each_candidate(pos[i], |j| {
-                    if j != i && boundary.minimum_image(pos[j] - pos[i]).length_squared() < reach2 {
+                    if j != i && image.apply(pos[j] - pos[i]).length_squared() < reach2 {
                         near.push(j as u32);
                     }
                 });

@@ -102,6 +102,7 @@ impl Interaction for LennardJones {
         self.list.update(pos, &self.boundary);
         let rc2 = self.cutoff * self.cutoff;
         let this = &*self;
+        let image = self.boundary.image();
         let virials: Vec<f64> = force
             .par_chunks_mut(512)
             .enumerate()
@@ -112,7 +113,7 @@ impl Interaction for LennardJones {
                     let ri = pos[i];
                     let mut fi = DVec3::ZERO;
                     for &j in this.list.of(i) {
-                        let d = this.boundary.minimum_image(ri - pos[j as usize]);
+                        let d = image.apply(ri - pos[j as usize]);
                         let r2 = d.length_squared();
                         if r2 < rc2 {
                             let (f_over_r, _) = this.pair(r2);
@@ -135,16 +136,14 @@ impl Interaction for LennardJones {
         let rc2 = self.cutoff * self.cutoff;
         let shift = self.shift();
         let this = &*self;
+        let image = self.boundary.image();
         let per_i: Vec<f64> = (0..pos.len())
             .into_par_iter()
             .with_min_len(512)
             .map(|i| {
                 let mut u = 0.0;
                 for &j in this.list.of(i) {
-                    let r2 = this
-                        .boundary
-                        .minimum_image(pos[i] - pos[j as usize])
-                        .length_squared();
+                    let r2 = image.apply(pos[i] - pos[j as usize]).length_squared();
                     if r2 < rc2 {
                         u += this.pair(r2).1 - shift;
                     }
