@@ -15,7 +15,7 @@ for n in 4096 16384; do
     done
   done
 done
-if python3 -c "import rebound" 2>/dev/null; then
+if [ "${1:-}" != "--mote-only" ] && python3 -c "import rebound" 2>/dev/null; then
   python3 ../shared/bench/rebound_bench.py
 else
   echo "REBOUND not installed: pip install rebound numpy"

@@ -51,10 +51,12 @@ fn main() {
             }
             let el = start.elapsed().as_secs_f64();
             println!(
-                "nbs={nbs} N={} setup={setup:.4}s frames={frames} mean_frame={:.6}s worst_frame={worst:.6}s collisions/frame={:.1}",
+                "nbs={nbs} N={} setup={setup:.4}s frames={frames} mean_frame={:.6}s worst_frame={worst:.6}s collisions/frame={:.1} rebuilds/frame={:.1} shell={:.3}",
                 sys.len(),
                 el / frames as f64,
-                sys.counters().collisions as f64 / frames as f64
+                sys.counters().collisions as f64 / frames as f64,
+                sys.counters().rebuilds as f64 / frames as f64,
+                sys.shell()
             );
         }
         _ => eprintln!("usage: edmd_bench eos D N ETA T [EQUIL] [SEED] | cube NBS [FRAMES]"),

@@ -19,7 +19,12 @@ pub fn ball_volume(dim: usize, r: f64) -> f64 {
 pub fn lattice<const D: usize>(n: usize, size: [f64; D], fcc: bool) -> Vec<[f64; D]> {
     let basis: Vec<[f64; D]> = if fcc && D == 3 {
         let mut b = vec![[0.0; D]; 4];
-        let half = [[0.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]];
+        let half = [
+            [0.0, 0.0, 0.0],
+            [0.5, 0.5, 0.0],
+            [0.5, 0.0, 0.5],
+            [0.0, 0.5, 0.5],
+        ];
         for (k, h) in half.iter().enumerate() {
             b[k][..3].copy_from_slice(h);
         }
@@ -68,7 +73,11 @@ pub fn lattice<const D: usize>(n: usize, size: [f64; D], fcc: bool) -> Vec<[f64;
 
 /// Smallest distance between lattice sites produced by [`lattice`] (for
 /// checking that the radii fit).
-pub fn min_pair_distance<const D: usize>(p: &[[f64; D]], size: [f64; D], periodic: [bool; D]) -> f64 {
+pub fn min_pair_distance<const D: usize>(
+    p: &[[f64; D]],
+    size: [f64; D],
+    periodic: [bool; D],
+) -> f64 {
     let mut best = f64::INFINITY;
     let n = p.len().min(600);
     for i in 0..n {
@@ -192,7 +201,11 @@ pub fn normal<R: Rng>(rng: &mut R) -> f64 {
 /// Maxwell–Boltzmann velocities at temperature `kt` (k_B T), with the
 /// centre-of-mass momentum removed and the kinetic energy set exactly to
 /// D N kT / 2.
-pub fn thermal_velocities<const D: usize, R: Rng>(masses: &[f64], kt: f64, rng: &mut R) -> Vec<[f64; D]> {
+pub fn thermal_velocities<const D: usize, R: Rng>(
+    masses: &[f64],
+    kt: f64,
+    rng: &mut R,
+) -> Vec<[f64; D]> {
     let n = masses.len();
     let mut v: Vec<[f64; D]> = masses
         .iter()
@@ -234,7 +247,11 @@ pub fn thermal_velocities<const D: usize, R: Rng>(masses: &[f64], kt: f64, rng: 
 
 /// Velocities of equal magnitude `speed` in uniformly random directions
 /// (002 §4.9).
-pub fn fixed_speed_velocities<const D: usize, R: Rng>(n: usize, speed: f64, rng: &mut R) -> Vec<[f64; D]> {
+pub fn fixed_speed_velocities<const D: usize, R: Rng>(
+    n: usize,
+    speed: f64,
+    rng: &mut R,
+) -> Vec<[f64; D]> {
     (0..n)
         .map(|_| loop {
             let mut x = [0.0; D];

@@ -3,9 +3,12 @@
 //! One source for both dimensions: [`System<D>`] holds particles with their
 //! own radius and mass in a box with hard walls or periodic boundaries per
 //! axis, and advances them from event to event (pair collisions, wall
-//! collisions, cell crossings). See [`system`] for the algorithm and its
+//! collisions, neighbour-list renewals). See [`system`] for the algorithm and its
 //! sources, [`scene`] for the settings a scene file gives, [`theory`] for the
 //! results the tests compare with.
+
+// Component loops `for d in 0..D` over several arrays read as the math does.
+#![allow(clippy::needless_range_loop)]
 
 pub mod init;
 pub mod queue;
@@ -14,8 +17,8 @@ pub mod system;
 pub mod theory;
 pub mod vecd;
 
-pub use scene::{Scene, Run};
-pub use system::{pair_time, Boundary, Counters, SimBox, System};
+pub use scene::{Run, Scene};
+pub use system::{pair_time, shell_factor, Boundary, Counters, SimBox, System};
 
 /// Errors of the event-driven engine.
 #[derive(Debug, thiserror::Error)]

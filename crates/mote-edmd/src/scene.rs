@@ -151,10 +151,22 @@ fn key_line(text: &str, key: &str) -> usize {
 pub const EXAMPLES: &[(&str, &str)] = &[
     ("cube", include_str!("../../../examples/edmd/cube.toml")),
     ("cradle", include_str!("../../../examples/edmd/cradle.toml")),
-    ("cradle-two", include_str!("../../../examples/edmd/cradle-two.toml")),
-    ("cradle-symmetric", include_str!("../../../examples/edmd/cradle-symmetric.toml")),
-    ("cradle-heavy", include_str!("../../../examples/edmd/cradle-heavy.toml")),
-    ("maxwell2d", include_str!("../../../examples/edmd/maxwell2d.toml")),
+    (
+        "cradle-two",
+        include_str!("../../../examples/edmd/cradle-two.toml"),
+    ),
+    (
+        "cradle-symmetric",
+        include_str!("../../../examples/edmd/cradle-symmetric.toml"),
+    ),
+    (
+        "cradle-heavy",
+        include_str!("../../../examples/edmd/cradle-heavy.toml"),
+    ),
+    (
+        "maxwell2d",
+        include_str!("../../../examples/edmd/maxwell2d.toml"),
+    ),
     ("eos", include_str!("../../../examples/edmd/eos.toml")),
 ];
 
@@ -191,7 +203,10 @@ impl Scene {
         if self.dimension != 2 && self.dimension != 3 {
             return Err(err(
                 "dimension",
-                format!("dimension = {} is not supported; use 2 (disks) or 3 (spheres)", self.dimension),
+                format!(
+                    "dimension = {} is not supported; use 2 (disks) or 3 (spheres)",
+                    self.dimension
+                ),
             ));
         }
         if let Some(b) = &self.box_size {
@@ -206,7 +221,10 @@ impl Scene {
             if v.len() != self.dimension {
                 return Err(err(
                     "boundary",
-                    format!("boundary must list {} entries (\"periodic\" or \"wall\")", self.dimension),
+                    format!(
+                        "boundary must list {} entries (\"periodic\" or \"wall\")",
+                        self.dimension
+                    ),
                 ));
             }
         }
@@ -219,7 +237,13 @@ impl Scene {
                 ));
             }
         }
-        for (key, v) in [("radius", self.radius), ("mass", self.mass), ("temperature", self.temperature), ("speed", self.speed), ("size_ratio", self.size_ratio)] {
+        for (key, v) in [
+            ("radius", self.radius),
+            ("mass", self.mass),
+            ("temperature", self.temperature),
+            ("speed", self.speed),
+            ("size_ratio", self.size_ratio),
+        ] {
             if let Some(x) = v {
                 if !(x > 0.0 && x.is_finite()) {
                     return Err(err(key, format!("{key} = {x} must be positive")));
@@ -228,21 +252,31 @@ impl Scene {
         }
         if let Some(f) = self.large_fraction {
             if !(0.0..=1.0).contains(&f) {
-                return Err(err("large_fraction", format!("large_fraction = {f} must lie in [0, 1]")));
+                return Err(err(
+                    "large_fraction",
+                    format!("large_fraction = {f} must lie in [0, 1]"),
+                ));
             }
         }
         if !(self.time >= 0.0 && self.time.is_finite()) {
             return Err(err("time", format!("time = {} must be ≥ 0", self.time)));
         }
         if !(self.equilibrate >= 0.0 && self.equilibrate.is_finite()) {
-            return Err(err("equilibrate", format!("equilibrate = {} must be ≥ 0", self.equilibrate)));
+            return Err(err(
+                "equilibrate",
+                format!("equilibrate = {} must be ≥ 0", self.equilibrate),
+            ));
         }
         if let Some(dt) = self.output_interval {
-            if !(dt > 0.0) {
-                return Err(err("output_interval", format!("output_interval = {dt} must be positive")));
+            if dt.is_nan() || dt <= 0.0 {
+                return Err(err(
+                    "output_interval",
+                    format!("output_interval = {dt} must be positive"),
+                ));
             }
         }
-        let sources = self.n.is_some() as u8 + self.particles.is_some() as u8 + self.file.is_some() as u8;
+        let sources =
+            self.n.is_some() as u8 + self.particles.is_some() as u8 + self.file.is_some() as u8;
         if sources != 1 {
             return Err(err(
                 "n",
@@ -253,7 +287,10 @@ impl Scene {
             return Err(err("n", "n must be at least 1".into()));
         }
         if self.n.is_some() && self.box_size.is_none() && self.packing_fraction.is_none() {
-            return Err(err("n", "with `n`, give `packing_fraction` or `box` (or both)".into()));
+            return Err(err(
+                "n",
+                "with `n`, give `packing_fraction` or `box` (or both)".into(),
+            ));
         }
         if let Some(ps) = &self.particles {
             for (k, p) in ps.iter().enumerate() {
@@ -262,7 +299,10 @@ impl Scene {
                 {
                     return Err(err(
                         "particles",
-                        format!("particle {k}: position and velocity need {} components", self.dimension),
+                        format!(
+                            "particle {k}: position and velocity need {} components",
+                            self.dimension
+                        ),
                     ));
                 }
             }
@@ -287,25 +327,28 @@ impl Scene {
     /// Builds the initial system with the given seed. `base` is the folder
     /// relative file names resolve against.
     pub fn build<const D: usize>(&self, seed: u64, base: &Path) -> Result<System<D>, EdmdError> {
-        assert_eq!(D, self.dimension, "build::<D> must match the scene's dimension");
+        assert_eq!(
+            D, self.dimension,
+            "build::<D> must match the scene's dimension"
+        );
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let boundary = self.boundaries::<D>();
         let periodic = boundary.map(|b| b == Boundary::Periodic);
         let mass = self.mass.unwrap_or(1.0);
-        let (size, pos, radii, masses, given_vel): (
-            [f64; D],
-            Vec<[f64; D]>,
-            Vec<f64>,
-            Vec<f64>,
-            Option<Vec<[f64; D]>>,
-        ) = if let Some(ps) = &self.particles {
+        let (size, pos, radii, masses, given_vel): Initial<D> = if let Some(ps) = &self.particles {
             let mut size = [0.0; D];
             size.copy_from_slice(&self.box_size.as_ref().expect("validated")[..D]);
             let r0 = self.radius.unwrap_or(0.5);
             let pos = ps.iter().map(|p| vec_d::<D>(&p.position)).collect();
             let vel = ps
                 .iter()
-                .map(|p| if p.velocity.is_empty() { [0.0; D] } else { vec_d::<D>(&p.velocity) })
+                .map(|p| {
+                    if p.velocity.is_empty() {
+                        [0.0; D]
+                    } else {
+                        vec_d::<D>(&p.velocity)
+                    }
+                })
                 .collect();
             let radii = ps.iter().map(|p| p.radius.unwrap_or(r0)).collect();
             let masses = ps.iter().map(|p| p.mass.unwrap_or(mass)).collect();
@@ -313,9 +356,9 @@ impl Scene {
         } else if let Some(f) = &self.file {
             let path = base.join(f);
             let frames = mote_io::xyz::read_frames(&path)?;
-            let fr = frames.last().ok_or_else(|| {
-                EdmdError::Invalid(format!("{}: no frames", path.display()))
-            })?;
+            let fr = frames
+                .last()
+                .ok_or_else(|| EdmdError::Invalid(format!("{}: no frames", path.display())))?;
             let mut size = [0.0; D];
             for d in 0..D {
                 size[d] = fr.cell[d][d];
@@ -336,16 +379,28 @@ impl Scene {
                 .collect();
             let vel = fr.velocities.iter().map(|v| vec_d::<D>(&v[..D])).collect();
             let n = fr.positions.len();
-            let radii = if fr.radii.len() == n { fr.radii.clone() } else { vec![self.radius.unwrap_or(0.5); n] };
+            let radii = if fr.radii.len() == n {
+                fr.radii.clone()
+            } else {
+                vec![self.radius.unwrap_or(0.5); n]
+            };
             let v0: Vec<[f64; D]> = vel;
             let has_v = v0.iter().any(|v| v.iter().any(|x| *x != 0.0));
-            (size, pos, radii, vec![mass; n], if has_v { Some(v0) } else { None })
+            (
+                size,
+                pos,
+                radii,
+                vec![mass; n],
+                if has_v { Some(v0) } else { None },
+            )
         } else {
             let n = self.n.expect("validated");
             // radii: monodisperse or bidisperse
             let ratio = self.size_ratio.unwrap_or(1.0);
             let n_large = (self.large_fraction.unwrap_or(0.0) * n as f64).round() as usize;
-            let shape: Vec<f64> = (0..n).map(|i| if i < n_large { ratio } else { 1.0 }).collect();
+            let shape: Vec<f64> = (0..n)
+                .map(|i| if i < n_large { ratio } else { 1.0 })
+                .collect();
             let shape_vol: f64 = shape.iter().map(|s| ball_volume(D, *s)).sum();
             let (size, r0) = match (&self.box_size, self.packing_fraction) {
                 (Some(b), Some(eta)) => {
@@ -433,6 +488,15 @@ impl Scene {
     }
 }
 
+/// Box, positions, radii, masses and (if given) velocities.
+type Initial<const D: usize> = (
+    [f64; D],
+    Vec<[f64; D]>,
+    Vec<f64>,
+    Vec<f64>,
+    Option<Vec<[f64; D]>>,
+);
+
 fn vec_d<const D: usize>(v: &[f64]) -> [f64; D] {
     let mut x = [0.0; D];
     x.copy_from_slice(&v[..D]);
@@ -500,9 +564,15 @@ pub fn run_scene<const D: usize>(
         .map(|(v, m)| m * crate::vecd::dot(v, v).sqrt())
         .sum::<f64>()
         .max(f64::MIN_POSITIVE);
-    let interval = scene.output_interval.unwrap_or(scene.time / 100.0).max(1e-300);
+    let interval = scene
+        .output_interval
+        .unwrap_or(scene.time / 100.0)
+        .max(1e-300);
     let mut xyz = match &scene.trajectory {
-        Some(f) => Some(mote_io::xyz::XyzWriter::create(&out.base.join(f), out.provenance.clone())?),
+        Some(f) => Some(mote_io::xyz::XyzWriter::create(
+            &out.base.join(f),
+            out.provenance.clone(),
+        )?),
         None => None,
     };
     let cols: Vec<String> = [
@@ -525,7 +595,12 @@ pub fn run_scene<const D: usize>(
         .map(|s| s.to_string())
         .collect();
     let mut csv = match &scene.observables {
-        Some(f) => Some(mote_io::csv::CsvWriter::create(&out.base.join(f), &out.provenance, &cols, &units)?),
+        Some(f) => Some(mote_io::csv::CsvWriter::create(
+            &out.base.join(f),
+            &out.provenance,
+            &cols,
+            &units,
+        )?),
         None => None,
     };
     let mut result = Run {
@@ -559,7 +634,12 @@ pub fn run_scene<const D: usize>(
         if let Some(c) = csv.as_mut() {
             let dt = sys.time() - t0;
             let (rate, mft, z, p) = if dt > 0.0 {
-                (sys.collision_rate(), sys.mean_free_time(), sys.compressibility(), sys.pressure())
+                (
+                    sys.collision_rate(),
+                    sys.mean_free_time(),
+                    sys.compressibility(),
+                    sys.pressure(),
+                )
             } else {
                 (f64::NAN, f64::NAN, f64::NAN, f64::NAN)
             };
@@ -604,8 +684,16 @@ pub fn run_scene<const D: usize>(
     result.wall_hits = c.wall_hits;
     result.events = events;
     result.simulated_time = scene.time;
-    let all_periodic = sys.simbox().boundary.iter().all(|b| *b == Boundary::Periodic);
-    result.z = if all_periodic { sys.compressibility() } else { f64::NAN };
+    let all_periodic = sys
+        .simbox()
+        .boundary
+        .iter()
+        .all(|b| *b == Boundary::Periodic);
+    result.z = if all_periodic {
+        sys.compressibility()
+    } else {
+        f64::NAN
+    };
     result.z_reference = if D == 3 {
         theory::carnahan_starling(result.packing_fraction)
     } else {
@@ -636,8 +724,13 @@ pub fn run_scene<const D: usize>(
         let vmax = 4.0 * b2.sqrt();
         let bins = ((n as f64).sqrt() as usize).clamp(5, 100);
         let h = theory::histogram(&speeds, vmax, bins);
-        let cols = vec!["v".to_string(), "density".to_string(), "maxwell_boltzmann".to_string()];
-        let mut w = mote_io::csv::CsvWriter::create(&out.base.join(f), &out.provenance, &cols, &[])?;
+        let cols = vec![
+            "v".to_string(),
+            "density".to_string(),
+            "maxwell_boltzmann".to_string(),
+        ];
+        let mut w =
+            mote_io::csv::CsvWriter::create(&out.base.join(f), &out.provenance, &cols, &[])?;
         let dv = vmax / bins as f64;
         for (k, hk) in h.iter().enumerate() {
             let v = (k as f64 + 0.5) * dv;
@@ -654,7 +747,10 @@ pub fn run_scene<const D: usize>(
     if n <= 1000 {
         result.final_velocities = sys.velocities().iter().map(to3).collect();
     }
-    for f in [&scene.trajectory, &scene.observables].into_iter().flatten() {
+    for f in [&scene.trajectory, &scene.observables]
+        .into_iter()
+        .flatten()
+    {
         result.outputs.push(out.base.join(f));
     }
     Ok(result)

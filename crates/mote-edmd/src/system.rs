@@ -8,7 +8,7 @@
 //! Scheduling: one event per particle in an indexed binary heap, invalidated
 //! by per-particle collision counters (Smallenburg, arXiv:2201.01099);
 //! neighbours from symmetric neighbour lists with a shell: particle i lists
-//! every j with |x_i − x_j| < s(r_i + r_j) (s = [`SHELL`]) at the moment it
+//! every j with |x_i − x_j| < s(r_i + r_j) (s from [`shell_factor`]) at the moment it
 //! builds its list, and rebuilds it (a "neighbour-list event", the analogue
 //! of a cell crossing) when it has moved (s − 1) r_i from where it built it,
 //! so two unlisted particles cannot touch. Lists are built from a cell list
@@ -99,9 +99,25 @@ struct ListPos<const D: usize> {
     r: f64,
 }
 
-/// Neighbour shell factor s: pairs closer than s(r_i + r_j) are listed
-/// (Smallenburg's `shellsize`, 1 + α with α = 0.5).
-pub const SHELL: f64 = 1.65;
+/// Neighbour shell factor s at packing fraction η: pairs closer than
+/// s(r_i + r_j) are listed (Smallenburg's `shellsize`, 1.5 in his code).
+/// Chosen so that a particle has about 16 (3-D) or 10 (2-D) listed
+/// neighbours — 8ηs³ = 16, 4ηs² = 10 — which gives s ≈ 1.65 at η = 0.45
+/// (measured slightly faster than 1.5 here) and a wide shell in dilute gases,
+/// where a narrow one would be renewed many times per free path. Clamped to
+/// [1.3, 4].
+pub fn shell_factor(dim: usize, eta: f64) -> f64 {
+    let s = if dim == 2 {
+        (2.5 / eta).sqrt()
+    } else {
+        (2.0 / eta).cbrt()
+    };
+    if s.is_finite() {
+        s.clamp(1.3, 4.0)
+    } else {
+        4.0
+    }
+}
 
 /// Position `x` at the particle's own time `t`, velocity `v`, radius `r`.
 #[derive(Debug, Clone, Copy)]
@@ -140,9 +156,12 @@ pub struct Counters {
 #[derive(Debug, Clone)]
 pub struct System<const D: usize> {
     pub(crate) simbox: SimBox<D>,
-    /// Hot per-particle data, one cache line per sphere.
+    /// Hot per-particle data, one cache line per sphere (internal order).
     p: Vec<Particle<D>>,
     mass: Vec<f64>,
+    /// Caller's index of internal particle k, and internal index of caller's i.
+    id: Vec<u32>,
+    slot: Vec<u32>,
     count: Vec<u64>,
     // cells
     ncell: [usize; D],
@@ -159,6 +178,7 @@ pub struct System<const D: usize> {
     nbr: Vec<u32>,
     nn: Vec<u32>,
     cap: usize,
+    shell: f64,
     // events
     events: Vec<Event>,
     queue: EventQueue,
@@ -213,7 +233,7 @@ impl<const D: usize> System<D> {
             return Err(EdmdError::Invalid("too many particles".into()));
         }
         for (i, (&r, &m)) in radii.iter().zip(&masses).enumerate() {
-            if !(r > 0.0 && r.is_finite()) || !(m > 0.0 && m.is_finite()) {
+            if !(r > 0.0 && r.is_finite() && m > 0.0 && m.is_finite()) {
                 return Err(EdmdError::Invalid(format!(
                     "particle {i}: radius {r} and mass {m} must be positive and finite"
                 )));
@@ -225,7 +245,28 @@ impl<const D: usize> System<D> {
             }
         }
         let max_radius = radii.iter().cloned().fold(0.0, f64::max);
-        let dmax = SHELL * 2.0 * max_radius;
+        let unit = if D == 2 {
+            std::f64::consts::PI
+        } else {
+            4.0 / 3.0 * std::f64::consts::PI
+        };
+        let eta = radii.iter().map(|r| unit * r.powi(D as i32)).sum::<f64>() / simbox.volume();
+        let mut shell = shell_factor(D, eta);
+        // periodic axes need three cells of width s·(largest diameter)
+        for d in 0..D {
+            if simbox.boundary[d] == Boundary::Periodic && max_radius > 0.0 {
+                let smax = simbox.size[d] / (3.0 * 2.0 * max_radius * (1.0 + 1e-9));
+                shell = shell.min(smax);
+            }
+        }
+        if shell < 1.05 {
+            return Err(EdmdError::Invalid(format!(
+                "periodic box {:?} too small for diameter {}: each periodic length must exceed 3.15 largest diameters",
+                simbox.size,
+                2.0 * max_radius
+            )));
+        }
+        let dmax = shell * 2.0 * max_radius;
         let mut ncell = [1usize; D];
         let mut cwidth = [0.0; D];
         for d in 0..D {
@@ -243,7 +284,7 @@ impl<const D: usize> System<D> {
             if simbox.boundary[d] == Boundary::Periodic && nc < 3 {
                 return Err(EdmdError::Invalid(format!(
                     "periodic axis {d}: box length {l} must exceed {} largest diameters ({})",
-                    3.0 * SHELL,
+                    3.0 * shell,
                     3.0 * dmax
                 )));
             }
@@ -253,7 +294,6 @@ impl<const D: usize> System<D> {
         }
         let total: usize = ncell.iter().product();
         // reduce cells if far more cells than particles (dilute gas)
-        let mut ncell = ncell;
         let mut tot = total;
         while tot > 4 * n.max(1) + 64 {
             let (dmx, _) = ncell
@@ -285,18 +325,49 @@ impl<const D: usize> System<D> {
             }
             offsets.push(o);
         }
-        let p = (0..n)
-            .map(|i| Particle {
+        // Store particles in Morton (Z) order of their cells, so that
+        // neighbours in space are mostly neighbours in memory; the public
+        // API keeps the caller's numbering (`id`, `slot`).
+        let key = |x: &[f64; D]| -> u64 {
+            let mut k = 0u64;
+            let bits = 64 / D;
+            for d in 0..D {
+                let l = simbox.size[d];
+                let xd = if x[d].is_finite() {
+                    x[d].rem_euclid(l)
+                } else {
+                    0.0
+                };
+                let c = ((xd / cwidth[d]) as u64).min(ncell[d] as u64 - 1);
+                for b in 0..bits {
+                    k |= ((c >> b) & 1) << (b * D + d);
+                }
+            }
+            k
+        };
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by_key(|&i| key(&positions[i]));
+        let mut slot = vec![0u32; n];
+        for (k, &i) in order.iter().enumerate() {
+            slot[i] = k as u32;
+        }
+        let p = order
+            .iter()
+            .map(|&i| Particle {
                 x: positions[i],
                 v: velocities[i],
                 t: 0.0,
                 r: radii[i],
             })
             .collect();
+        let mass = order.iter().map(|&i| masses[i]).collect();
+        let id = order.iter().map(|&i| i as u32).collect();
         let mut sys = System {
             simbox,
             p,
-            mass: masses,
+            mass,
+            id,
+            slot,
             count: vec![0; n],
             ncell,
             cwidth,
@@ -306,12 +377,19 @@ impl<const D: usize> System<D> {
             next: vec![NONE; n],
             prev: vec![NONE; n],
             offsets,
-            xn: vec![ListPos { x: [0.0; D], r: 0.0 }; n],
+            xn: vec![
+                ListPos {
+                    x: [0.0; D],
+                    r: 0.0
+                };
+                n
+            ],
             nbr: vec![0; n * 16],
             nn: vec![0; n],
             cap: 16,
+            shell,
             events: vec![NO_EVENT; n],
-            queue: EventQueue::new(n),
+            queue: EventQueue::new(n, 0.0, 1.0),
             now: 0.0,
             counters: Counters::default(),
             max_radius,
@@ -327,8 +405,8 @@ impl<const D: usize> System<D> {
                 };
                 if !ok {
                     return Err(EdmdError::Invalid(format!(
-                        "particle {i} at {:?} (radius {r}) is outside the box {:?}",
-                        sys.p[i].x, simbox.size
+                        "particle {} at {:?} (radius {r}) is outside the box {:?}",
+                        sys.id[i], sys.p[i].x, simbox.size
                     )));
                 }
                 if simbox.boundary[d] == Boundary::Periodic {
@@ -340,7 +418,10 @@ impl<const D: usize> System<D> {
             }
             let c = sys.cell_of(&sys.p[i].x);
             sys.cidx[i] = c;
-            sys.xn[i] = ListPos { x: sys.p[i].x, r: sys.p[i].r };
+            sys.xn[i] = ListPos {
+                x: sys.p[i].x,
+                r: sys.p[i].r,
+            };
             sys.insert(i);
         }
         for i in 0..n {
@@ -354,7 +435,30 @@ impl<const D: usize> System<D> {
         for i in 0..n {
             sys.predict(i);
         }
+        sys.tune_queue();
         Ok(sys)
+    }
+
+    /// Chooses the calendar's block length so that a block holds about 32
+    /// events: with τ̄ the mean time to each particle's next event, events
+    /// come at a rate ≈ N/τ̄.
+    fn tune_queue(&mut self) {
+        let n = self.len();
+        let (mut sum, mut k) = (0.0, 0usize);
+        for i in 0..n {
+            let t = self.queue.time(i) - self.now;
+            if t.is_finite() {
+                sum += t;
+                k += 1;
+            }
+        }
+        let tau = if k > 0 && sum > 0.0 {
+            sum / k as f64
+        } else {
+            1.0
+        };
+        let dt = 32.0 * tau / n.max(1) as f64;
+        self.queue.retune(self.now, dt);
     }
 
     fn cell_of(&self, x: &[f64; D]) -> [u32; D] {
@@ -416,20 +520,21 @@ impl<const D: usize> System<D> {
     pub fn simbox(&self) -> &SimBox<D> {
         &self.simbox
     }
+    /// Radii in the caller's numbering (as are all per-particle accessors).
     pub fn radii(&self) -> Vec<f64> {
-        self.p.iter().map(|p| p.r).collect()
+        self.slot.iter().map(|&k| self.p[k as usize].r).collect()
     }
     pub fn radius(&self, i: usize) -> f64 {
-        self.p[i].r
+        self.p[self.slot[i] as usize].r
     }
     pub fn velocity(&self, i: usize) -> [f64; D] {
-        self.p[i].v
+        self.p[self.slot[i] as usize].v
     }
-    pub fn masses(&self) -> &[f64] {
-        &self.mass
+    pub fn masses(&self) -> Vec<f64> {
+        self.slot.iter().map(|&k| self.mass[k as usize]).collect()
     }
     pub fn velocities(&self) -> Vec<[f64; D]> {
-        self.p.iter().map(|p| p.v).collect()
+        self.slot.iter().map(|&k| self.p[k as usize].v).collect()
     }
     pub fn counters(&self) -> &Counters {
         &self.counters
@@ -438,14 +543,24 @@ impl<const D: usize> System<D> {
     pub fn cells(&self) -> [usize; D] {
         self.ncell
     }
+    /// The neighbour shell factor s in use.
+    pub fn shell(&self) -> f64 {
+        self.shell
+    }
     /// Largest radius.
     pub fn max_radius(&self) -> f64 {
         self.max_radius
     }
 
-    /// Position of particle `i` at the current time (inside the box).
+    /// Position of particle `i` at the current time (inside the box, up to
+    /// a quarter diameter beyond a periodic face).
     pub fn position(&self, i: usize) -> [f64; D] {
-        add_scaled(&self.p[i].x, &self.p[i].v, self.now - self.p[i].t)
+        self.pos_int(self.slot[i] as usize)
+    }
+
+    #[inline]
+    fn pos_int(&self, k: usize) -> [f64; D] {
+        add_scaled(&self.p[k].x, &self.p[k].v, self.now - self.p[k].t)
     }
 
     /// Positions of all particles at the current time.
@@ -502,12 +617,19 @@ impl<const D: usize> System<D> {
         } else {
             4.0 / 3.0 * std::f64::consts::PI
         };
-        self.p.iter().map(|p| unit * p.r.powi(D as i32)).sum::<f64>() / self.simbox.volume()
+        self.p
+            .iter()
+            .map(|p| unit * p.r.powi(D as i32))
+            .sum::<f64>()
+            / self.simbox.volume()
     }
 
     /// Speeds |v_i|.
     pub fn speeds(&self) -> Vec<f64> {
-        self.p.iter().map(|p| dot(&p.v, &p.v).sqrt()).collect()
+        self.slot
+            .iter()
+            .map(|&k| dot(&self.p[k as usize].v, &self.p[k as usize].v).sqrt())
+            .collect()
     }
 
     /// Starts a new window for the collision counters and virial.
@@ -568,7 +690,11 @@ impl<const D: usize> System<D> {
 
     /// Minimum-image separation r_i − r_j at the current time.
     pub fn separation(&self, i: usize, j: usize) -> [f64; D] {
-        let mut r = sub(&self.position(i), &self.position(j));
+        self.sep_int(self.slot[i] as usize, self.slot[j] as usize)
+    }
+
+    fn sep_int(&self, k: usize, l: usize) -> [f64; D] {
+        let mut r = sub(&self.pos_int(k), &self.pos_int(l));
         for (d, rd) in r.iter_mut().enumerate() {
             if self.simbox.boundary[d] == Boundary::Periodic {
                 let l = self.simbox.size[d];
@@ -584,7 +710,7 @@ impl<const D: usize> System<D> {
     /// pair in neighbouring cells, which holds all pairs that could touch.
     pub fn find_overlap(&self, rel_tol: f64) -> Option<(usize, usize, f64)> {
         let n = self.len();
-        let pos = self.positions();
+        let pos: Vec<[f64; D]> = (0..n).map(|k| self.pos_int(k)).collect();
         for i in 0..n {
             for d in 0..D {
                 if self.simbox.boundary[d] == Boundary::Wall {
@@ -592,7 +718,8 @@ impl<const D: usize> System<D> {
                     let l = self.simbox.size[d];
                     let depth = (r - pos[i][d]).max(pos[i][d] + r - l);
                     if depth > rel_tol * r {
-                        return Some((i, i, depth / r));
+                        let e = self.id[i] as usize;
+                        return Some((e, e, depth / r));
                     }
                 }
             }
@@ -620,11 +747,12 @@ impl<const D: usize> System<D> {
                 while j != NONE {
                     let ju = j as usize;
                     if ju > i {
-                        let r = self.separation(i, ju);
+                        let r = self.sep_int(i, ju);
                         let s = self.p[i].r + self.p[ju].r;
                         let dist = dot(&r, &r).sqrt();
                         if dist < s * (1.0 - rel_tol) {
-                            return Some((i, ju, dist / s - 1.0));
+                            let (a, b) = (self.id[i] as usize, self.id[ju] as usize);
+                            return Some((a.min(b), a.max(b), dist / s - 1.0));
                         }
                     }
                     j = self.next[ju];
@@ -641,7 +769,7 @@ impl<const D: usize> System<D> {
         for i in 0..n {
             for j in (i + 1)..n {
                 let r = self.separation(i, j);
-                let s = self.p[i].r + self.p[j].r;
+                let s = self.radius(i) + self.radius(j);
                 let dist = dot(&r, &r).sqrt();
                 if dist < s * (1.0 - rel_tol) {
                     return Some((i, j, dist / s - 1.0));
@@ -658,7 +786,12 @@ impl<const D: usize> System<D> {
     /// listed neighbours.
     fn predict(&mut self, i: usize) {
         self.advance(i);
-        let Particle { x: xi, v: vi, r: ri, .. } = self.p[i];
+        let Particle {
+            x: xi,
+            v: vi,
+            r: ri,
+            ..
+        } = self.p[i];
         let now = self.now;
         let a = dot(&vi, &vi);
         let mut best = f64::INFINITY;
@@ -666,7 +799,7 @@ impl<const D: usize> System<D> {
         if a > 0.0 {
             // |x + v t − x_n| = (s − 1) r_i, the outer root
             let dr = sub(&xi, &self.xn[i].x);
-            let m = (SHELL - 1.0) * ri;
+            let m = (self.shell - 1.0) * ri;
             let c = dot(&dr, &dr) - m * m;
             best = if c >= 0.0 {
                 0.0
@@ -814,7 +947,7 @@ impl<const D: usize> System<D> {
                             }
                         }
                     }
-                    let s = SHELL * (ri + rj);
+                    let s = self.shell * (ri + rj);
                     if dot(&r, &r) < s * s {
                         if self.nn[i] as usize == self.cap || self.nn[ju] as usize == self.cap {
                             self.grow_lists();
@@ -857,7 +990,10 @@ impl<const D: usize> System<D> {
                 }
             }
         }
-        self.xn[i] = ListPos { x: self.p[i].x, r: self.p[i].r };
+        self.xn[i] = ListPos {
+            x: self.p[i].x,
+            r: self.p[i].r,
+        };
         self.remove(i);
         self.cidx[i] = self.cell_of(&self.xn[i].x);
         self.insert(i);
@@ -995,6 +1131,7 @@ impl<const D: usize> System<D> {
         for i in 0..self.len() {
             self.predict(i);
         }
+        self.tune_queue();
         self.counters.since = self.now;
         self.counters.virial = 0.0;
         self.counters.collisions = 0;
@@ -1013,5 +1150,6 @@ impl<const D: usize> System<D> {
         for i in 0..self.len() {
             self.predict(i);
         }
+        self.tune_queue();
     }
 }

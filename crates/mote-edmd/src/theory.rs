@@ -47,7 +47,9 @@ pub fn ks_test(sample: &[f64], cdf: impl Fn(f64) -> f64) -> (f64, f64) {
     let mut dmax: f64 = 0.0;
     for (k, &v) in x.iter().enumerate() {
         let f = cdf(v);
-        dmax = dmax.max((f - k as f64 / n).abs()).max(((k + 1) as f64 / n - f).abs());
+        dmax = dmax
+            .max((f - k as f64 / n).abs())
+            .max(((k + 1) as f64 / n - f).abs());
     }
     let sn = n.sqrt();
     let lambda = (sn + 0.12 + 0.11 / sn) * dmax;
@@ -90,14 +92,16 @@ pub fn maxwell3d_cdf(v: f64, b2: f64) -> f64 {
 pub fn erf(x: f64) -> f64 {
     let z = x.abs();
     let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t * (-z * z - 1.26551223
-        + t * (1.00002368
-            + t * (0.37409196
-                + t * (0.09678418
-                    + t * (-0.18628806
-                        + t * (0.27886807
-                            + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-        .exp();
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398
+                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
     if x >= 0.0 {
         1.0 - r
     } else {

@@ -31,7 +31,11 @@ fn spheres_conserve_energy_and_momentum_over_a_million_collisions() {
     for _ in 0..10 {
         sys.run_collisions(100_000);
         max_de = max_de.max(((sys.kinetic_energy() - e0) / e0).abs());
-        assert!(sys.find_overlap(1e-9).is_none(), "overlap at t = {}", sys.time());
+        assert!(
+            sys.find_overlap(1e-9).is_none(),
+            "overlap at t = {}",
+            sys.time()
+        );
     }
     let dp = rel_momentum_change(p0, &sys);
     println!(
@@ -58,7 +62,11 @@ fn disks_with_walls_conserve_energy_and_periodic_momentum() {
     let px0 = sys.momentum()[0];
     for _ in 0..5 {
         sys.run_collisions(100_000);
-        assert!(sys.find_overlap(1e-9).is_none(), "overlap at t = {}", sys.time());
+        assert!(
+            sys.find_overlap(1e-9).is_none(),
+            "overlap at t = {}",
+            sys.time()
+        );
     }
     let de = ((sys.kinetic_energy() - e0) / e0).abs();
     let scale: f64 = sys
@@ -68,7 +76,10 @@ fn disks_with_walls_conserve_energy_and_periodic_momentum() {
         .map(|(v, m)| m * (v[0] * v[0] + v[1] * v[1]).sqrt())
         .sum();
     let dpx = (sys.momentum()[0] - px0).abs() / scale;
-    println!("disks: |dE/E| = {de:.2e}, |dPx|/sum m|v| = {dpx:.2e}, wall hits = {}", sys.counters().wall_hits);
+    println!(
+        "disks: |dE/E| = {de:.2e}, |dPx|/sum m|v| = {dpx:.2e}, wall hits = {}",
+        sys.counters().wall_hits
+    );
     assert!(sys.counters().wall_hits > 0);
     assert!(de < 1e-12);
     assert!(dpx < 1e-12);

@@ -8,11 +8,20 @@ fn touching_and_overlapping_pairs() {
     // at contact and approaching: collide now
     assert_eq!(pair_time(&[1.0, 0.0, 0.0], &[-1.0, 0.0, 0.0], 1.0), 0.0);
     // overlapping by round-off and approaching: collide now
-    assert_eq!(pair_time(&[1.0 - 1e-15, 0.0, 0.0], &[-1.0, 0.0, 0.0], 1.0), 0.0);
+    assert_eq!(
+        pair_time(&[1.0 - 1e-15, 0.0, 0.0], &[-1.0, 0.0, 0.0], 1.0),
+        0.0
+    );
     // overlapping but separating: no event (it is leaving)
-    assert_eq!(pair_time(&[1.0 - 1e-15, 0.0, 0.0], &[1.0, 0.0, 0.0], 1.0), f64::INFINITY);
+    assert_eq!(
+        pair_time(&[1.0 - 1e-15, 0.0, 0.0], &[1.0, 0.0, 0.0], 1.0),
+        f64::INFINITY
+    );
     // grazing miss
-    assert_eq!(pair_time(&[-5.0, 1.0 + 1e-12], &[1.0, 0.0], 1.0), f64::INFINITY);
+    assert_eq!(
+        pair_time(&[-5.0, 1.0 + 1e-12], &[1.0, 0.0], 1.0),
+        f64::INFINITY
+    );
     // head-on from far: exact
     assert_eq!(pair_time(&[-4.0, 0.0], &[1.0, 0.0], 1.0), 3.0);
 }
@@ -43,7 +52,10 @@ fn predicted_time_reaches_contact() {
             hits += 1;
             let rc: Vec<f64> = (0..3).map(|d| r[d] + v[d] * t).collect();
             let dist = rc.iter().map(|a| a * a).sum::<f64>().sqrt();
-            assert!((dist - 1.0).abs() < 1e-9 * (1.0 + t), "dist {dist} at t {t}");
+            assert!(
+                (dist - 1.0).abs() < 1e-9 * (1.0 + t),
+                "dist {dist} at t {t}"
+            );
         }
     }
     assert!(hits > 1000);
@@ -85,4 +97,45 @@ fn overlapping_initial_state_is_rejected() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("overlap"), "{e}");
+}
+
+/// Particles are stored in spatial (Morton) order inside; every accessor
+/// keeps the caller's numbering.
+#[test]
+fn numbering_is_the_callers() {
+    let simbox = SimBox {
+        size: [20.0, 20.0],
+        boundary: [Boundary::Periodic, Boundary::Wall],
+    };
+    // a reversed, interleaved order so that the internal order differs
+    let mut pos = Vec::new();
+    for k in (0..50).rev() {
+        pos.push([(k % 10) as f64 * 2.0 + 1.0, (k / 10) as f64 * 3.0 + 1.5]);
+    }
+    let vel: Vec<[f64; 2]> = (0..50)
+        .map(|k| [k as f64 * 0.01, -(k as f64) * 0.02])
+        .collect();
+    let radii: Vec<f64> = (0..50).map(|k| 0.3 + 0.001 * k as f64).collect();
+    let masses: Vec<f64> = (0..50).map(|k| 1.0 + k as f64).collect();
+    let sys = System::<2>::new(
+        simbox,
+        pos.clone(),
+        vel.clone(),
+        radii.clone(),
+        masses.clone(),
+    )
+    .unwrap();
+    assert_eq!(sys.positions(), pos);
+    assert_eq!(sys.velocities(), vel);
+    assert_eq!(sys.radii(), radii);
+    assert_eq!(sys.masses(), masses);
+    for i in 0..50 {
+        assert_eq!(sys.velocity(i), vel[i]);
+        assert_eq!(sys.radius(i), radii[i]);
+    }
+    // an overlap is reported with the caller's indices
+    let mut p2 = pos.clone();
+    p2[7] = [p2[3][0] + 0.1, p2[3][1]];
+    let e = System::<2>::new(simbox, p2, vel, radii, masses).unwrap_err();
+    assert!(e.to_string().contains("particles 3 and 7"), "{e}");
 }

@@ -37,7 +37,11 @@ fn cube_example_has_the_seed_radius_and_packing_fraction() {
 
 fn scene_error(text: &str) -> (usize, String) {
     match Scene::parse(text, "bad.toml") {
-        Err(EdmdError::Scene { file, line, message }) => {
+        Err(EdmdError::Scene {
+            file,
+            line,
+            message,
+        }) => {
             assert_eq!(file, "bad.toml");
             (line, message)
         }
@@ -50,9 +54,13 @@ fn errors_name_the_line() {
     let (line, msg) = scene_error("dimension = 3\nn = 10\npacking_fraction = 0.9\n");
     assert_eq!(line, 3);
     assert!(msg.contains("packing_fraction"), "{msg}");
-    let (line, msg) = scene_error("dimension = 3\nn = 10\npacking_fraction = 0.1\nboundary = \"sticky\"\n");
+    let (line, msg) =
+        scene_error("dimension = 3\nn = 10\npacking_fraction = 0.1\nboundary = \"sticky\"\n");
     assert_eq!(line, 4);
-    assert!(msg.contains("boundary") || msg.contains("variant") || msg.contains("did not match"), "{msg}");
+    assert!(
+        msg.contains("boundary") || msg.contains("variant") || msg.contains("did not match"),
+        "{msg}"
+    );
     let (line, msg) = scene_error("dimension = 4\nn = 10\npacking_fraction = 0.1\n");
     assert_eq!(line, 1);
     assert!(msg.contains("2 (disks) or 3"), "{msg}");

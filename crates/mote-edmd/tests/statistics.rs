@@ -11,7 +11,12 @@ use std::path::Path;
 
 /// Compressibility factor: mean and standard error over `blocks` windows of
 /// length `tau` after `equil`.
-fn z_blocks<const D: usize>(sys: &mut System<D>, equil: f64, blocks: usize, tau: f64) -> (f64, f64) {
+fn z_blocks<const D: usize>(
+    sys: &mut System<D>,
+    equil: f64,
+    blocks: usize,
+    tau: f64,
+) -> (f64, f64) {
     sys.run_until(equil);
     let mut z = Vec::new();
     for _ in 0..blocks {
@@ -44,7 +49,10 @@ fn eos_check(dim: usize, n: usize, eta: f64, equil: f64, blocks: usize, tau: f64
         "D={dim} N={n} eta={eta}: Z = {z:.4} ± {se:.4} (s.e.), {name} {reference:.4}, deviation {:+.3} %",
         100.0 * dev
     );
-    assert!(se / reference < 0.0025, "standard error {se} too large for a 1 % test");
+    assert!(
+        se / reference < 0.0025,
+        "standard error {se} too large for a 1 % test"
+    );
     assert!(dev.abs() < 0.01, "Z = {z} vs {reference}");
 }
 

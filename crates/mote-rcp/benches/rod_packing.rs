@@ -42,11 +42,21 @@ fn small(c: &mut Criterion) {
     for (name, d) in cases() {
         for n in [16_000usize, 100_000] {
             g.bench_with_input(BenchmarkId::new(format!("fast/{name}"), n), &n, |b, &n| {
-                b.iter(|| RodPacking::default().rods(n).estimate(black_box(&d)).unwrap().phi)
+                b.iter(|| {
+                    RodPacking::default()
+                        .rods(n)
+                        .estimate(black_box(&d))
+                        .unwrap()
+                        .phi
+                })
             });
-            g.bench_with_input(BenchmarkId::new(format!("baseline/{name}"), n), &n, |b, &n| {
-                b.iter(|| baseline::estimate(black_box(&d), n, 0.7654, ErfcFlavour::Accurate))
-            });
+            g.bench_with_input(
+                BenchmarkId::new(format!("baseline/{name}"), n),
+                &n,
+                |b, &n| {
+                    b.iter(|| baseline::estimate(black_box(&d), n, 0.7654, ErfcFlavour::Accurate))
+                },
+            );
         }
     }
     g.finish();
@@ -58,7 +68,13 @@ fn large(c: &mut Criterion) {
     for (name, d) in cases() {
         for n in [1_000_000usize, 10_000_000] {
             g.bench_with_input(BenchmarkId::new(format!("fast/{name}"), n), &n, |b, &n| {
-                b.iter(|| RodPacking::default().rods(n).estimate(black_box(&d)).unwrap().phi)
+                b.iter(|| {
+                    RodPacking::default()
+                        .rods(n)
+                        .estimate(black_box(&d))
+                        .unwrap()
+                        .phi
+                })
             });
         }
     }

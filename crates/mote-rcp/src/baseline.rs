@@ -14,7 +14,13 @@ pub fn inverse_cdf_bisection(dist: &SizeDistribution, y: f64, flavour: ErfcFlavo
 pub fn rod_lengths_bisection(dist: &SizeDistribution, n: usize, flavour: ErfcFlavour) -> Vec<f64> {
     let nf = n as f64;
     (1..=n)
-        .map(|i| inverse_cdf_bisection(dist, (2.0 * nf - 2.0 * i as f64 + 1.0) / (2.0 * nf), flavour))
+        .map(|i| {
+            inverse_cdf_bisection(
+                dist,
+                (2.0 * nf - 2.0 * i as f64 + 1.0) / (2.0 * nf),
+                flavour,
+            )
+        })
         .collect()
 }
 

@@ -209,8 +209,7 @@ pub fn optimise(
     let nw = if search.widths { lognormal.len() } else { 0 };
     if nv + nw == 0 {
         return Err(RcpError::Design(
-            "nothing to vary: volumes need at least two populations, widths a lognormal one"
-                .into(),
+            "nothing to vary: volumes need at least two populations, widths a lognormal one".into(),
         ));
     }
     // Start: the base volume fractions and widths.
@@ -270,7 +269,9 @@ pub fn optimise(
         }
     }
     let pops = decode(&best);
-    let phi = estimator.estimate(&SizeDistribution::new(pops.iter().copied())?)?.phi;
+    let phi = estimator
+        .estimate(&SizeDistribution::new(pops.iter().copied())?)?
+        .phi;
     evaluations += 1;
     Ok(Optimum {
         populations: pops,
@@ -396,6 +397,9 @@ pub fn nelder_mead(
     (simplex[best].clone(), vals[best], evals)
 }
 
+/// Largest number of grid points of a scan.
+pub const MAX_SCAN_POINTS: usize = 10_000_000;
+
 /// A two-parameter scan: φ on a grid, row by row (y outer, x inner).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scan {
@@ -412,52 +416,68 @@ pub struct Scan {
 }
 
 /// Scans φ over two parameters of `base`; with `inner`, each point is an optimisation
-/// over the volume fractions (003, Fig. 6). `progress(points_done)` after each point.
+/// over the volume fractions (003, Fig. 6). Points are evaluated in parallel on the
+/// rayon pool (the result does not depend on the number of threads);
+/// `progress(points_done)` is called after each point.
 pub fn scan(
     base: &[Population],
     estimator: &RodPacking,
     x: Axis,
     y: Axis,
     inner: Option<&Search>,
-    mut progress: impl FnMut(usize),
+    progress: impl Fn(usize) + Sync,
 ) -> Result<Scan, RcpError> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
     SizeDistribution::new(base.iter().copied())?;
     x.param.apply(base, x.start)?;
     y.param.apply(base, y.start)?;
-    let mut phi = Vec::with_capacity(x.count * y.count);
-    let mut fractions = Vec::new();
-    let mut evaluations = 0;
-    for j in 0..y.count {
-        for i in 0..x.count {
-            let pops = x.param.apply(base, x.value(i))?;
-            let pops = y.param.apply(&pops, y.value(j))?;
-            match inner {
-                None => {
-                    evaluations += 1;
-                    phi.push(
-                        SizeDistribution::new(pops)
-                            .and_then(|d| estimator.estimate(&d))
-                            .map(|p| p.phi)
-                            .unwrap_or(f64::NAN),
-                    );
-                }
+    let points = x
+        .count
+        .checked_mul(y.count)
+        .filter(|&p| p <= MAX_SCAN_POINTS);
+    let Some(points) = points else {
+        return Err(RcpError::Design(format!(
+            "{} × {} points is too many for a scan (at most {MAX_SCAN_POINTS})",
+            x.count, y.count
+        )));
+    };
+    let done = AtomicUsize::new(0);
+    let points: Vec<(f64, Option<Vec<f64>>, usize)> = (0..points)
+        .into_par_iter()
+        .map(|idx| {
+            let (i, j) = (idx % x.count, idx / x.count);
+            let pops = x
+                .param
+                .apply(base, x.value(i))
+                .and_then(|p| y.param.apply(&p, y.value(j)))
+                .expect("indices checked above");
+            let out = match inner {
+                None => (
+                    SizeDistribution::new(pops)
+                        .and_then(|d| estimator.estimate(&d))
+                        .map(|p| p.phi)
+                        .unwrap_or(f64::NAN),
+                    None,
+                    1,
+                ),
                 Some(search) => match optimise(&pops, estimator, Objective::Maximise, search) {
                     Ok(opt) => {
-                        evaluations += opt.evaluations;
-                        phi.push(opt.phi);
                         let total: f64 = opt.populations.iter().map(|q| q.volume()).sum();
-                        fractions
-                            .push(opt.populations.iter().map(|q| q.volume() / total).collect());
+                        let w = opt.populations.iter().map(|q| q.volume() / total).collect();
+                        (opt.phi, Some(w), opt.evaluations)
                     }
-                    Err(_) => {
-                        phi.push(f64::NAN);
-                        fractions.push(vec![f64::NAN; pops.len()]);
-                    }
+                    Err(_) => (f64::NAN, Some(vec![f64::NAN; pops.len()]), 0),
                 },
-            }
-            progress(phi.len());
-        }
-    }
+            };
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1);
+            out
+        })
+        .collect();
+    let evaluations = points.iter().map(|p| p.2).sum();
+    let phi = points.iter().map(|p| p.0).collect();
+    let fractions = points.into_iter().filter_map(|p| p.1).collect();
     Ok(Scan {
         x,
         y,

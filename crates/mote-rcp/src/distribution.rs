@@ -79,7 +79,9 @@ impl Population {
             Population::Monodisperse { diameter, .. } => {
                 Population::Monodisperse { diameter, volume }
             }
-            Population::Lognormal { d43, sigma, .. } => Population::Lognormal { d43, sigma, volume },
+            Population::Lognormal { d43, sigma, .. } => {
+                Population::Lognormal { d43, sigma, volume }
+            }
         }
     }
 
@@ -236,11 +238,9 @@ impl SizeDistribution {
         for (i, p) in populations.into_iter().enumerate() {
             p.validate(i + 1)?;
             if let Population::Monodisperse { diameter, volume } = p {
-                if let Some(Population::Monodisperse { volume: v, .. }) =
-                    merged.iter_mut().find(|q| {
-                        matches!(q, Population::Monodisperse { diameter: d, .. } if *d == diameter)
-                    })
-                {
+                if let Some(Population::Monodisperse { volume: v, .. }) = merged.iter_mut().find(
+                    |q| matches!(q, Population::Monodisperse { diameter: d, .. } if *d == diameter),
+                ) {
                     *v += volume;
                     continue;
                 }
@@ -567,7 +567,7 @@ impl SizeDistribution {
         if n < 2 {
             return Err(RcpError::TooFewRods { n });
         }
-        let mut rods = Vec::with_capacity(n);
+        let mut rods = Vec::with_capacity(n.min(1 << 24));
         self.for_each_rod(n, flavour, |l| rods.push(l));
         Ok(rods)
     }
@@ -596,12 +596,17 @@ impl SizeDistribution {
             // 1.5e-7 against values that are smaller), so F(x) = y can have several
             // roots there; spherepack1d's bisection picks one of them. To reproduce its
             // digits, compat mode inverts F the same way (100 halvings per rod).
+            let mut replay = BisectionReplay::default();
             for i in 1..=n {
-                sink(self.inverse_cdf_bisection(target(i), flavour));
+                sink(replay.solve(self, target(i), flavour));
             }
             return;
         }
-        if self.comps.iter().all(|c| matches!(c.kind, Kind::Lognormal { .. })) {
+        if self
+            .comps
+            .iter()
+            .all(|c| matches!(c.kind, Kind::Lognormal { .. }))
+        {
             self.for_each_rod_hermite(n, sink);
             return;
         }
@@ -640,7 +645,10 @@ impl SizeDistribution {
             }
         }
         let p = 2.0 * x * s / self.norm;
-        (p, p / x - 2.0 * g / (std::f64::consts::PI.sqrt() * self.norm))
+        (
+            p,
+            p / x - 2.0 * g / (std::f64::consts::PI.sqrt() * self.norm),
+        )
     }
 
     /// Rods of a pure lognormal mixture (F analytic): the rods are solved exactly at
@@ -696,7 +704,7 @@ impl SizeDistribution {
                 lm = self.solve(target(im), l1, l0, pm, flavour, &mut last);
                 err = (pm - lm).abs() / lm;
             }
-            if !(err <= HERMITE_TOL) || !c.iter().all(|v| v.is_finite()) {
+            if err.is_nan() || err > HERMITE_TOL || !c.iter().all(|v| v.is_finite()) {
                 m /= 2;
                 continue;
             }
@@ -720,6 +728,86 @@ impl SizeDistribution {
                 m *= 2;
             }
         }
+    }
+}
+
+/// spherepack1d's bisection (see [`SizeDistribution::inverse_cdf_bisection`]) with
+/// the same result, computed with fewer evaluations of F: the bracket [0, 10·1.5^k] is
+/// found from cached values F(10·1.5^j); the halvings of the previous target are
+/// replayed from their cached F(mid) as long as they take the same decisions (nearby
+/// targets share a long prefix); and the loop stops once mid equals an end of the
+/// interval, after which the remaining halvings would not change it.
+#[derive(Debug, Default)]
+struct BisectionReplay {
+    /// F(10·1.5^j), j = 0, 1, ...
+    brackets: Vec<f64>,
+    /// Upper end of the bracket of the cached path.
+    top: f64,
+    /// The cached path: (lo, hi, F(mid)) before each halving.
+    path: Vec<(f64, f64, f64)>,
+    /// The target of the cached path.
+    y: f64,
+}
+
+impl BisectionReplay {
+    fn solve(&mut self, dist: &SizeDistribution, y: f64, flavour: ErfcFlavour) -> f64 {
+        let mut hi = 10.0;
+        let mut j = 0;
+        loop {
+            if j == self.brackets.len() {
+                self.brackets.push(dist.cdf_point(hi, flavour).cdf);
+            }
+            if self.brackets[j] > y || hi >= f64::MAX || j > 4096 {
+                break;
+            }
+            hi *= 1.5;
+            j += 1;
+        }
+        let mut lo = 0.0;
+        let mut k = 0;
+        if hi == self.top {
+            // Replay the shared prefix.
+            while k < self.path.len() {
+                let (l, h, fm) = self.path[k];
+                if (fm > y) != (fm > self.y) {
+                    break;
+                }
+                let mid = 0.5 * (l + h);
+                if fm > y {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+                k += 1;
+            }
+            if k < self.path.len() {
+                (lo, hi) = (self.path[k].0, self.path[k].1);
+            }
+        }
+        self.path.truncate(k);
+        let mut mid = 0.5 * (lo + hi);
+        while k < 100 {
+            mid = 0.5 * (lo + hi);
+            if self.path.len() == k && k > 0 && (mid == lo || mid == hi) {
+                // Fixed point: the remaining halvings keep lo, hi and mid.
+                break;
+            }
+            let fm = dist.cdf_point(mid, flavour).cdf;
+            self.path.push((lo, hi, fm));
+            if fm > y {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+            k += 1;
+        }
+        self.y = y;
+        self.top = if self.path.is_empty() {
+            f64::NAN
+        } else {
+            self.path[0].1
+        };
+        mid
     }
 }
 

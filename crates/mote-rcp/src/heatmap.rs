@@ -172,10 +172,14 @@ pub fn render(scan: &Scan, title: &str) -> Image {
     let hi = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let span = if hi > lo { hi - lo } else { 1.0 };
     let (nx, ny) = (scan.x.count, scan.y.count);
+    // Each pixel shows the nearest grid point, so that ticks sit on cell centres.
+    let nearest = |p: usize, len: usize, n: usize| -> usize {
+        ((p as f64 / (len - 1) as f64 * (n - 1) as f64).round() as usize).min(n - 1)
+    };
     for py in 0..ph {
-        let j = ((ph - 1 - py) * ny / ph).min(ny - 1);
+        let j = nearest(ph - 1 - py, ph, ny);
         for px in 0..pw {
-            let i = (px * nx / pw).min(nx - 1);
+            let i = nearest(px, pw, nx);
             let v = scan.phi[j * nx + i];
             img.set(left + px, top + py, colour((v - lo) / span));
         }
@@ -240,7 +244,12 @@ pub fn render(scan: &Scan, title: &str) -> Image {
             let fy = k as f64 / 4.0;
             let py = top + ph - 1 - (fy * (ph - 1) as f64) as usize;
             img.fill(bx + bw, py, 5, 1, black);
-            img.text(bx + bw + 8, py.saturating_sub(5), s, &format!("{:.4}", lo + fy * span));
+            img.text(
+                bx + bw + 8,
+                py.saturating_sub(5),
+                s,
+                &format!("{:.4}", lo + fy * span),
+            );
         }
     }
     img.text(bx, top - 22, 3, "PHI");

@@ -99,7 +99,8 @@ impl RodPacking {
         if self.rods < 2 {
             return Err(RcpError::TooFewRods { n: self.rods });
         }
-        let mut packer = RodPacker::with_capacity(self.gap_fraction, self.rods);
+        // Pre-allocate at most 2^24 slots; absurd N then fails by running long, not at once.
+        let mut packer = RodPacker::with_capacity(self.gap_fraction, self.rods.min(1 << 24));
         dist.for_each_rod(self.rods, self.erfc, |l| {
             packer.push(l);
             if packer.len() & 0xffff == 0 {

@@ -133,7 +133,8 @@ impl RodPacker {
 
     /// The packing fraction of the rods so far.
     pub fn finish(&self) -> Packing {
-        let gaps = sum(self.snug.iter().copied()) + sum(self.slack.iter().map(|&b| f64::from_bits(b)));
+        let gaps =
+            sum(self.snug.iter().copied()) + sum(self.slack.iter().map(|&b| f64::from_bits(b)));
         Packing {
             phi: self.rod_length / (self.rod_length + gaps),
             rods: self.rods,

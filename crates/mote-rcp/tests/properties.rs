@@ -14,9 +14,8 @@ fn population() -> impl Strategy<Value = Population> {
 }
 
 fn distribution() -> impl Strategy<Value = Vec<Population>> {
-    prop::collection::vec(population(), 1..4).prop_filter("some volume", |p| {
-        p.iter().any(|q| q.volume() > 1e-3)
-    })
+    prop::collection::vec(population(), 1..4)
+        .prop_filter("some volume", |p| p.iter().any(|q| q.volume() > 1e-3))
 }
 
 proptest! {
@@ -89,7 +88,10 @@ fn density_is_derivative_of_cdf() {
     for &x in &[0.05, 0.3, 1.0, 2.0, 3.0, 7.0, 20.0] {
         let h = 1e-6 * x;
         let num = (d.cdf(x + h) - d.cdf(x - h)) / (2.0 * h);
-        assert!((num - d.density(x)).abs() < 1e-6 * (1.0 + d.density(x)), "x = {x}");
+        assert!(
+            (num - d.density(x)).abs() < 1e-6 * (1.0 + d.density(x)),
+            "x = {x}"
+        );
     }
 }
 
@@ -97,7 +99,10 @@ fn density_is_derivative_of_cdf() {
 /// volume in the large spheres is well above monodisperse (003, Fig. 6 trend).
 #[test]
 fn bidisperse_mixture_between_sensible_bounds() {
-    let mono = RodPacking::default().estimate(&SizeDistribution::monodisperse()).unwrap().phi;
+    let mono = RodPacking::default()
+        .estimate(&SizeDistribution::monodisperse())
+        .unwrap()
+        .phi;
     let est = RodPacking::default();
     let mut best: f64 = 0.0;
     for k in 1..10 {
@@ -137,7 +142,10 @@ fn erfc_flavours_differ_as_documented() {
     let acc = RodPacking::default();
     let compat = RodPacking::default().erfc(ErfcFlavour::AbramowitzStegun);
     let mono = SizeDistribution::monodisperse();
-    assert_eq!(acc.estimate(&mono).unwrap().phi, compat.estimate(&mono).unwrap().phi);
+    assert_eq!(
+        acc.estimate(&mono).unwrap().phi,
+        compat.estimate(&mono).unwrap().phi
+    );
     let diff = |s: f64| {
         let d = SizeDistribution::lognormal(s).unwrap();
         (acc.estimate(&d).unwrap().phi - compat.estimate(&d).unwrap().phi).abs()
@@ -158,7 +166,10 @@ fn convergence_table() {
     let cases = [
         ("monodisperse", SizeDistribution::monodisperse()),
         ("lognormal 0.5", SizeDistribution::lognormal(0.5).unwrap()),
-        ("lognormal 1.18", SizeDistribution::lognormal((4.0f64).ln().sqrt()).unwrap()),
+        (
+            "lognormal 1.18",
+            SizeDistribution::lognormal((4.0f64).ln().sqrt()).unwrap(),
+        ),
         ("lognormal 2.0", SizeDistribution::lognormal(2.0).unwrap()),
         (
             "tridisperse 2:3:4",
@@ -171,7 +182,11 @@ fn convergence_table() {
         ),
     ];
     for (name, d) in &cases {
-        let reference = RodPacking::default().rods(40_000_000).estimate(d).unwrap().phi;
+        let reference = RodPacking::default()
+            .rods(40_000_000)
+            .estimate(d)
+            .unwrap()
+            .phi;
         let mut line = format!("{name:18} N=4e7: {reference:.7}");
         for n in [16_000usize, 64_000, 256_000, 1_024_000, 4_096_000] {
             let phi = RodPacking::default().rods(n).estimate(d).unwrap().phi;

@@ -20,7 +20,10 @@ fn lognormal_d43_2_d32_half_prints_0_829998() {
 #[test]
 fn monodisperse_prints_0_643485() {
     let d = SizeDistribution::monodisperse();
-    assert_eq!(six(RodPacking::default().estimate(&d).unwrap().phi), "0.643485");
+    assert_eq!(
+        six(RodPacking::default().estimate(&d).unwrap().phi),
+        "0.643485"
+    );
     // and the analytic fit of Eq. 27 at σ = 0 gives the rounded value 0.6435
     assert_eq!(six(lognormal_fit(0.0, true)), "0.643500");
 }
@@ -34,7 +37,10 @@ fn help_examples_agree_with_reference_digits() {
         Population::monodisperse(4.0, 3.5),
     ])
     .unwrap();
-    assert_eq!(six(RodPacking::default().estimate(&tri).unwrap().phi), "0.670194");
+    assert_eq!(
+        six(RodPacking::default().estimate(&tri).unwrap().phi),
+        "0.670194"
+    );
     let two = SizeDistribution::new([
         Population::lognormal_d32(5.0, 4.0, 1.0).unwrap(),
         Population::lognormal_d32(3.0, 2.0, 1.0).unwrap(),
@@ -72,7 +78,12 @@ fn fast_algorithm_matches_baseline() {
             for (a, b) in fast_rods.iter().zip(&slow_rods) {
                 assert!((a - b).abs() <= tol * b, "{a} vs {b}");
             }
-            let fast = RodPacking::default().rods(n).erfc(flavour).estimate(d).unwrap().phi;
+            let fast = RodPacking::default()
+                .rods(n)
+                .erfc(flavour)
+                .estimate(d)
+                .unwrap()
+                .phi;
             let slow = baseline::pack_sorted_insertion(&slow_rods, 0.7654);
             assert!((fast - slow).abs() < 1e3 * tol, "{fast} vs {slow}");
         }
@@ -90,7 +101,11 @@ fn compat_reproduces_reference_for_wide_lognormals() {
         (3.0, "0.978153"),
     ] {
         let d = SizeDistribution::lognormal(sigma).unwrap();
-        assert_eq!(six(compat.estimate(&d).unwrap().phi), printed, "sigma {sigma}");
+        assert_eq!(
+            six(compat.estimate(&d).unwrap().phi),
+            printed,
+            "sigma {sigma}"
+        );
     }
 }
 
@@ -122,5 +137,25 @@ fn interpolated_rods_match_solved_rods() {
                 rods[i]
             );
         }
+    }
+}
+
+#[test]
+fn compat_rods_are_exactly_the_reference_bisection() {
+    // The replayed bisection of --compat must give bit-identical rods to 100 plain
+    // halvings per rod (spherepack1d's inverseF).
+    for d in [
+        SizeDistribution::lognormal(2.5).unwrap(),
+        SizeDistribution::new([
+            Population::lognormal(1.0, 0.3, 1.0),
+            Population::lognormal(40.0, 1.2, 2.0),
+            Population::monodisperse(3.0, 1.0),
+        ])
+        .unwrap(),
+    ] {
+        let n = 5000;
+        let fast = d.rod_lengths(n, ErfcFlavour::AbramowitzStegun).unwrap();
+        let slow = baseline::rod_lengths_bisection(&d, n, ErfcFlavour::AbramowitzStegun);
+        assert_eq!(fast, slow);
     }
 }

@@ -12,7 +12,10 @@ fn help_lists_the_examples() {
     let out = mote().args(["edmd", "--help"]).output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("example:NAME") && text.contains("maxwell2d"), "{text}");
+    assert!(
+        text.contains("example:NAME") && text.contains("maxwell2d"),
+        "{text}"
+    );
     let out = mote().args(["edmd", "--list"]).output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
@@ -27,7 +30,11 @@ fn cradle_passes_the_ball_through() {
         .args(["edmd", "example:cradle", "--no-output", "--time", "5"])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("final x-velocities: +0.000000000000 +0.000000000000 +0.000000000000 +0.000000000000 +1.000000000000"),
@@ -40,30 +47,51 @@ fn cradle_passes_the_ball_through() {
 fn maxwell2d_writes_trajectory_csv_and_histogram_with_the_seed() {
     let dir = tempfile::tempdir().unwrap();
     let out = mote()
-        .args(["edmd", "example:maxwell2d", "--seed", "99", "--time", "10", "--out-dir"])
+        .args([
+            "edmd",
+            "example:maxwell2d",
+            "--seed",
+            "99",
+            "--time",
+            "10",
+            "--out-dir",
+        ])
         .arg(dir.path())
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("seed 99"), "{text}");
     // the summary's KS p-value: Maxwell–Boltzmann is not rejected at 1 %
     let p: f64 = text
         .split("p = ")
         .nth(1)
-        .and_then(|s| s.trim_end_matches(|c: char| !c.is_ascii_digit()).split_whitespace().next())
+        .and_then(|s| {
+            s.trim_end_matches(|c: char| !c.is_ascii_digit())
+                .split_whitespace()
+                .next()
+        })
         .map(|s| s.trim_end_matches('.').parse().unwrap())
         .unwrap();
     assert!(p > 0.01, "{text}");
     let frames = mote_io::xyz::read_frames(&dir.path().join("maxwell2d.xyz")).unwrap();
     assert_eq!(frames.len(), 101);
     assert_eq!(frames[0].positions.len(), 250);
-    assert!(frames.iter().all(|f| f.positions.iter().all(|p| p[2] == 0.0)));
+    assert!(frames
+        .iter()
+        .all(|f| f.positions.iter().all(|p| p[2] == 0.0)));
     let xyz = std::fs::read_to_string(dir.path().join("maxwell2d.xyz")).unwrap();
     assert!(xyz.lines().nth(1).unwrap().contains("seed=99"));
     let table = mote_io::csv::read_table(&dir.path().join("maxwell2d.csv")).unwrap();
     let e = table.column("kinetic_energy").unwrap();
-    assert!(e.iter().all(|x| (x - 125.0).abs() < 1e-10), "energy 250·½·1² conserved");
+    assert!(
+        e.iter().all(|x| (x - 125.0).abs() < 1e-10),
+        "energy 250·½·1² conserved"
+    );
     let csv = std::fs::read_to_string(dir.path().join("maxwell2d.csv")).unwrap();
     assert!(csv.starts_with("# ") && csv.lines().next().unwrap().contains("seed=99"));
     let hist = mote_io::csv::read_table(&dir.path().join("maxwell2d-speeds.csv")).unwrap();
@@ -77,14 +105,21 @@ fn maxwell2d_writes_trajectory_csv_and_histogram_with_the_seed() {
 fn same_seed_same_result() {
     let run = || {
         let out = mote()
-            .args(["edmd", "example:cube", "--no-output", "--time", "0.2", "--seed", "5"])
+            .args([
+                "edmd",
+                "example:cube",
+                "--no-output",
+                "--time",
+                "0.2",
+                "--seed",
+                "5",
+            ])
             .output()
             .unwrap();
         assert!(out.status.success());
         let t = String::from_utf8_lossy(&out.stdout).to_string();
         // drop the timing part
-        t.split(" in ").next().unwrap().to_string()
-            + t.split("Wall pressure").nth(1).unwrap_or("")
+        t.split(" in ").next().unwrap().to_string() + t.split("Wall pressure").nth(1).unwrap_or("")
     };
     assert_eq!(run(), run());
 }
@@ -99,13 +134,21 @@ fn scene_file_runs_and_errors_name_file_and_line() {
     )
     .unwrap();
     let out = mote().arg("edmd").arg(&good).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Compressibility factor Z"), "{text}");
     assert!(dir.path().join("eos.csv").exists());
 
     let bad = dir.path().join("bad.toml");
-    std::fs::write(&bad, "dimension = 3\nn = 500\npacking_fraction = 0.2\ntime = \"long\"\n").unwrap();
+    std::fs::write(
+        &bad,
+        "dimension = 3\nn = 500\npacking_fraction = 0.2\ntime = \"long\"\n",
+    )
+    .unwrap();
     let out = mote().arg("edmd").arg(&bad).output().unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);

@@ -217,3 +217,60 @@ fn unstable_run_stops_naming_step_and_particle_and_keeps_files() {
     );
     assert!(table.rows.iter().all(|r| r.iter().all(|v| v.is_finite())));
 }
+
+/// ASE reads the trajectory back with the same positions, radii and time
+/// (skipped with a message when Python or ASE is missing).
+#[test]
+fn ase_reads_the_trajectory() {
+    let ok = Command::new("python3")
+        .args(["-c", "import ase"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !ok {
+        eprintln!("skipped: python3 with ASE is not available (pip install ase)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &[
+            "run",
+            "example:circumbinary",
+            "--steps",
+            "80",
+            "-q",
+            "-o",
+            "cb",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success());
+    let script = "import sys\nfrom ase.io import read\nfs = read(sys.argv[1], index=':')\nf = fs[-1]\nprint(len(fs), repr(float(f.info['Time'])), ' '.join(repr(float(x)) for x in f.get_positions().ravel()), ' '.join(repr(float(x)) for x in f.arrays['radius']))";
+    let path = dir.path().join("cb/trajectory.xyz");
+    let out = Command::new("python3")
+        .args(["-c", script, path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut words = text.split_whitespace();
+    let frames: usize = words.next().unwrap().parse().unwrap();
+    let time: f64 = words.next().unwrap().parse().unwrap();
+    let ours = mote_io::xyz::read_frames(&path).unwrap();
+    assert_eq!(frames, ours.len());
+    let last = ours.last().unwrap();
+    assert_eq!(time, last.time);
+    let ase_values: Vec<f64> = words.map(|w| w.parse().unwrap()).collect();
+    let mine: Vec<f64> = last
+        .positions
+        .iter()
+        .flatten()
+        .copied()
+        .chain(last.radii.iter().copied())
+        .collect();
+    assert_eq!(ase_values, mine);
+}

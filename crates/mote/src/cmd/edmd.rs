@@ -48,7 +48,9 @@ struct Args {
 }
 
 pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let args = match Args::try_parse_from(std::iter::once("mote edmd".to_string()).chain(args.iter().cloned())) {
+    let args = match Args::try_parse_from(
+        std::iter::once("mote edmd".to_string()).chain(args.iter().cloned()),
+    ) {
         Ok(a) => a,
         Err(e) => {
             let _ = e.print();
@@ -93,7 +95,10 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         (scene, scene_arg.to_string(), base)
     };
     if let Some(t) = args.time {
-        anyhow::ensure!(t >= 0.0 && t.is_finite(), "--time {t}: must be a non-negative number");
+        anyhow::ensure!(
+            t >= 0.0 && t.is_finite(),
+            "--time {t}: must be a non-negative number"
+        );
         scene.time = t;
     }
     if args.no_output {
@@ -103,22 +108,19 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
     }
     let out_base = match &args.out_dir {
         Some(d) => {
-            std::fs::create_dir_all(d).with_context(|| format!("{}: cannot create folder", d.display()))?;
+            std::fs::create_dir_all(d)
+                .with_context(|| format!("{}: cannot create folder", d.display()))?;
             d.clone()
         }
         None => base,
     };
-    let seed = args
-        .seed
-        .or(global.seed)
-        .or(scene.seed)
-        .unwrap_or_else(|| {
-            let t = std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map(|d| d.as_nanos() as u64)
-                .unwrap_or(0);
-            t ^ (std::process::id() as u64).rotate_left(32)
-        });
+    let seed = args.seed.or(global.seed).or(scene.seed).unwrap_or_else(|| {
+        let t = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64)
+            .unwrap_or(0);
+        t ^ (std::process::id() as u64).rotate_left(32)
+    });
     if !quiet {
         eprintln!("mote edmd: {label}, seed {seed}");
     }
@@ -135,15 +137,21 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
     } else {
         let b = indicatif::ProgressBar::new(1000);
         b.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} (eta {eta})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {percent:>3}% {elapsed_precise} (eta {eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         b
     };
     let cpu0 = cpu_seconds();
     let result = match scene.dimension {
-        2 => run_scene::<2>(&scene, seed, &out, |f| bar.set_position((f * 1000.0) as u64)),
-        _ => run_scene::<3>(&scene, seed, &out, |f| bar.set_position((f * 1000.0) as u64)),
+        2 => run_scene::<2>(&scene, seed, &out, |f| {
+            bar.set_position((f * 1000.0) as u64)
+        }),
+        _ => run_scene::<3>(&scene, seed, &out, |f| {
+            bar.set_position((f * 1000.0) as u64)
+        }),
     };
     bar.finish_and_clear();
     let r = result.with_context(|| format!("{label}: run stopped"))?;
@@ -174,7 +182,11 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
             s += &format!(
                 "Compressibility factor Z = {:.4} ({} {:.4}, {:+.2} %). ",
                 r.z,
-                if r.dimension == 2 { "Henderson" } else { "Carnahan-Starling" },
+                if r.dimension == 2 {
+                    "Henderson"
+                } else {
+                    "Carnahan-Starling"
+                },
                 r.z_reference,
                 100.0 * (r.z - r.z_reference) / r.z_reference
             );
@@ -188,7 +200,10 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
                 r.collision_rate, r.mean_free_time
             );
         }
-        s += &format!("kT = {:.6}; energy drift {:.1e}", r.temperature, r.energy_drift);
+        s += &format!(
+            "kT = {:.6}; energy drift {:.1e}",
+            r.temperature, r.energy_drift
+        );
         if r.momentum_drift.is_finite() {
             s += &format!(", momentum drift {:.1e}", r.momentum_drift);
         }
@@ -215,7 +230,11 @@ fn final_vx(r: &mote_edmd::Run) -> Option<String> {
     if r.final_velocities.is_empty() {
         return None;
     }
-    let v: Vec<String> = r.final_velocities.iter().map(|v| format!("{:+.12}", v[0])).collect();
+    let v: Vec<String> = r
+        .final_velocities
+        .iter()
+        .map(|v| format!("{:+.12}", v[0]))
+        .collect();
     Some(format!("final x-velocities: {}", v.join(" ")))
 }
 
@@ -229,7 +248,11 @@ fn cpu_seconds() -> f64 {
         return f64::NAN;
     };
     let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |k: usize| f.get(k).and_then(|x| x.parse::<f64>().ok()).unwrap_or(f64::NAN);
+    let ticks = |k: usize| {
+        f.get(k)
+            .and_then(|x| x.parse::<f64>().ok())
+            .unwrap_or(f64::NAN)
+    };
     // the kernel reports in USER_HZ, 100 on Linux
     (ticks(11) + ticks(12)) / 100.0
 }

@@ -683,16 +683,10 @@ fn search_from(vary: &[String], max_evals: usize) -> anyhow::Result<design::Sear
 }
 
 fn optimize(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let a = OptimizeArgs::try_parse_from(
-        std::iter::once("mote rcp optimize".to_string()).chain(args.iter().cloned()),
-    )
-    .map_err(|e| {
-        let _ = e.print();
-        e
-    });
-    let a = match a {
+    let argv = std::iter::once("mote rcp optimize".to_string()).chain(args.iter().cloned());
+    let a = match OptimizeArgs::try_parse_from(argv) {
         Ok(a) => a,
-        Err(e) => return Ok(ExitCode::from(if e.use_stderr() { 2 } else { 0 })),
+        Err(e) => return clap_exit(e),
     };
     let pops = a.input.populations()?;
     let est = a.input.estimator()?;
@@ -760,23 +754,18 @@ struct ScanArgs {
 }
 
 fn scan(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let a = ScanArgs::try_parse_from(
-        std::iter::once("mote rcp scan".to_string()).chain(args.iter().cloned()),
-    )
-    .map_err(|e| {
-        let _ = e.print();
-        e
-    });
-    let a = match a {
+    let argv = std::iter::once("mote rcp scan".to_string()).chain(args.iter().cloned());
+    let a = match ScanArgs::try_parse_from(argv) {
         Ok(a) => a,
-        Err(e) => return Ok(ExitCode::from(if e.use_stderr() { 2 } else { 0 })),
+        Err(e) => return clap_exit(e),
     };
+    global.init_threads()?;
     let x: Axis = a.x.parse().context("--x")?;
     let y: Axis = a.y.parse().context("--y")?;
     let pops = a.input.populations()?;
     let est = a.input.estimator()?;
     let search = design::Search::default();
-    let points = x.count * y.count;
+    let points = x.count.saturating_mul(y.count);
     let bar = if global.quiet {
         ProgressBar::hidden()
     } else {
@@ -839,4 +828,11 @@ fn scan(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode>
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Prints a clap message (help, version or usage error) and gives its exit status.
+fn clap_exit(e: clap::Error) -> anyhow::Result<ExitCode> {
+    let code = if e.use_stderr() { 2 } else { 0 };
+    e.print()?;
+    Ok(ExitCode::from(code))
 }

@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""Check that other programs read mote's trajectory files as mote means them.
+
+Usage: check_formats.py DIR
+
+DIR holds what crates/mote-io/tests/formats.rs writes: t.xyz (extended XYZ),
+t.dump (LAMMPS dump text), t.vtu (VTK XML) and expected.json (positions, cell
+vectors and origin of every frame). The extended XYZ is read with ASE, the dump
+with MDAnalysis and the VTU with meshio; positions and box must agree to 1e-6
+(relative). Exit status: 0 all agree, 1 a mismatch, 77 skipped (a package is
+missing: `pip install ase MDAnalysis meshio`).
+"""
+import json
+import os
+import sys
+import warnings
+
+
+def close(a, b, tol=1e-6):
+    a = [float(x) for x in a]
+    b = [float(x) for x in b]
+    return len(a) == len(b) and all(abs(x - y) <= tol * max(1.0, abs(y)) for x, y in zip(a, b))
+
+
+def flat(rows):
+    return [x for r in rows for x in r]
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__)
+        return 2
+    d = sys.argv[1]
+    try:
+        import numpy as np
+        import ase.io
+        import MDAnalysis
+        import meshio
+    except ImportError as e:
+        print(f"SKIP: {e.name} is not importable; run `pip install ase MDAnalysis meshio`")
+        return 77
+    warnings.filterwarnings("ignore")
+    with open(os.path.join(d, "expected.json")) as f:
+        want = json.load(f)
+    failures = []
+
+    def check(what, ok):
+        print(("ok   " if ok else "FAIL ") + what)
+        if not ok:
+            failures.append(what)
+
+    # Extended XYZ with ASE: positions, cell vectors (rows) per frame.
+    atoms = ase.io.read(os.path.join(d, "t.xyz"), index=":")
+    check(f"ASE reads {len(want)} frames of t.xyz", len(atoms) == len(want))
+    for k, (a, w) in enumerate(zip(atoms, want)):
+        check(f"ASE frame {k} positions", close(flat(a.get_positions()), flat(w["positions"])))
+        check(f"ASE frame {k} cell", close(flat(a.get_cell()[:]), flat(w["cell"])))
+
+    # LAMMPS dump with MDAnalysis: positions and box lengths (orthogonal box).
+    u = MDAnalysis.Universe(os.path.join(d, "t.dump"), format="LAMMPSDUMP")
+    check(f"MDAnalysis reads {len(want)} frames of t.dump", len(u.trajectory) == len(want))
+    for k, ts in enumerate(u.trajectory):
+        w = want[k]
+        pos = u.atoms.positions
+        # MDAnalysis keeps float32 positions; it may report them relative to the box origin.
+        exp = [[p[i] for i in range(3)] for p in w["positions"]]
+        shifted = [[p[i] - w["origin"][i] for i in range(3)] for p in w["positions"]]
+        ok = close(flat(pos), flat(exp), 1e-5) or close(flat(pos), flat(shifted), 1e-5)
+        check(f"MDAnalysis frame {k} positions", ok)
+        lengths = [w["cell"][0][0], w["cell"][1][1], w["cell"][2][2]]
+        check(f"MDAnalysis frame {k} box {list(ts.dimensions[:3])}", close(ts.dimensions[:3], lengths, 1e-5))
+
+    # VTU with meshio: points, and the cell stored as field data.
+    m = meshio.read(os.path.join(d, "t.vtu"))
+    w = want[-1]
+    check("meshio t.vtu points", close(flat(m.points), flat(w["positions"])))
+    check("meshio t.vtu radius array", "radius" in m.point_data and len(m.point_data["radius"]) == len(w["positions"]))
+    if "cell" in m.field_data:
+        check("meshio t.vtu cell (field data)", close(np.asarray(m.field_data["cell"]).ravel(), flat(w["cell"])))
+    else:
+        print("note: meshio does not expose the field data 'cell'; box not compared for VTU")
+    if failures:
+        print(f"{len(failures)} check(s) failed")
+        return 1
+    print("all formats agree")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,415 @@
+//! VTK XML unstructured grids (`.vtu`), one per frame, and the ParaView
+//! collection (`.pvd`) that lists them with their times.
+//!
+//! Particles are points with one `VTK_VERTEX` cell each, so that ParaView shows
+//! them directly (Point Gaussian or Glyph filters use the `radius` array). Point
+//! data: `radius`, `velocity` (3 components), `type` (species index from 0,
+//! names as NUL-terminated bytes in the field data `species`). Field data: `TIME`, `cell` (9 values,
+//! rows a, b, c), `origin`, `pbc`. Arrays are ASCII, so files are readable and
+//! [`read_vtu`] can read them back; meshio and VTK read them as well.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::xyz::Frame;
+use crate::{IoError, ParseError, Provenance};
+
+/// Writes one frame as a `.vtu` file.
+pub fn write_vtu(path: &Path, frame: &Frame, provenance: &Provenance) -> Result<(), IoError> {
+    let file = File::create(path).map_err(|e| IoError::os(path, e))?;
+    let mut out = BufWriter::new(file);
+    write_to(&mut out, frame, provenance)
+        .and_then(|_| out.flush())
+        .map_err(|e| IoError::os(path, e))
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+        .replace("--", "- -")
+}
+
+fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::Result<()> {
+    let n = frame.positions.len();
+    let mut names: Vec<&str> = Vec::new();
+    let types: Vec<usize> = frame
+        .species
+        .iter()
+        .map(|s| {
+            names.iter().position(|t| t == s).unwrap_or_else(|| {
+                names.push(s);
+                names.len() - 1
+            })
+        })
+        .collect();
+    writeln!(out, "<?xml version=\"1.0\"?>")?;
+    writeln!(out, "<!-- {} -->", xml_escape(&prov.line()))?;
+    writeln!(
+        out,
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
+    )?;
+    writeln!(out, "<UnstructuredGrid>")?;
+    writeln!(out, "<FieldData>")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"TIME\" NumberOfTuples=\"1\" format=\"ascii\">{:e}</DataArray>",
+        frame.time
+    )?;
+    let c = frame.cell;
+    write!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"cell\" NumberOfComponents=\"9\" NumberOfTuples=\"1\" format=\"ascii\">"
+    )?;
+    for row in c {
+        for v in row {
+            write!(out, "{v:e} ")?;
+        }
+    }
+    writeln!(out, "</DataArray>")?;
+    let o = frame.origin;
+    writeln!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"origin\" NumberOfComponents=\"3\" NumberOfTuples=\"1\" format=\"ascii\">{:e} {:e} {:e}</DataArray>",
+        o[0], o[1], o[2]
+    )?;
+    writeln!(
+        out,
+        "<DataArray type=\"Int32\" Name=\"pbc\" NumberOfComponents=\"3\" NumberOfTuples=\"1\" format=\"ascii\">{} {} {}</DataArray>",
+        frame.pbc[0] as i32, frame.pbc[1] as i32, frame.pbc[2] as i32
+    )?;
+    // Species names as NUL-terminated bytes (meshio reads no String arrays).
+    let mut bytes: Vec<u8> = Vec::new();
+    for s in &names {
+        bytes.extend(s.bytes());
+        bytes.push(0);
+    }
+    writeln!(
+        out,
+        "<DataArray type=\"UInt8\" Name=\"species\" NumberOfTuples=\"{}\" format=\"ascii\">",
+        bytes.len()
+    )?;
+    for b in bytes {
+        write!(out, "{b} ")?;
+    }
+    writeln!(out, "\n</DataArray>")?;
+    writeln!(out, "</FieldData>")?;
+    writeln!(out, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">")?;
+    writeln!(out, "<PointData Scalars=\"radius\" Vectors=\"velocity\">")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">"
+    )?;
+    for i in 0..n {
+        writeln!(out, "{:.10e}", frame.radii.get(i).copied().unwrap_or(0.0))?;
+    }
+    writeln!(out, "</DataArray>")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">"
+    )?;
+    for i in 0..n {
+        let v = frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
+        writeln!(out, "{:.10e} {:.10e} {:.10e}", v[0], v[1], v[2])?;
+    }
+    writeln!(out, "</DataArray>")?;
+    writeln!(out, "<DataArray type=\"Int32\" Name=\"type\" format=\"ascii\">")?;
+    for i in 0..n {
+        writeln!(out, "{}", types.get(i).copied().unwrap_or(0))?;
+    }
+    writeln!(out, "</DataArray>")?;
+    writeln!(out, "</PointData>")?;
+    writeln!(out, "<Points>")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">"
+    )?;
+    for p in &frame.positions {
+        writeln!(out, "{:.16e} {:.16e} {:.16e}", p[0], p[1], p[2])?;
+    }
+    writeln!(out, "</DataArray>")?;
+    writeln!(out, "</Points>")?;
+    writeln!(out, "<Cells>")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
+    )?;
+    for i in 0..n {
+        writeln!(out, "{i}")?;
+    }
+    writeln!(out, "</DataArray>")?;
+    writeln!(out, "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">")?;
+    for i in 0..n {
+        writeln!(out, "{}", i + 1)?;
+    }
+    writeln!(out, "</DataArray>")?;
+    writeln!(out, "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">")?;
+    for _ in 0..n {
+        writeln!(out, "1")?;
+    }
+    writeln!(out, "</DataArray>")?;
+    writeln!(out, "</Cells>")?;
+    writeln!(out, "</Piece>")?;
+    writeln!(out, "</UnstructuredGrid>")?;
+    writeln!(out, "</VTKFile>")?;
+    Ok(())
+}
+
+/// The numbers between `<DataArray ... Name="name" ...>` and `</DataArray>`, and
+/// the line where the array starts.
+fn array<'a>(text: &'a str, name: &str) -> Option<(usize, &'a str)> {
+    let key = format!("Name=\"{name}\"");
+    let at = text.find(&key)?;
+    let open = at + text[at..].find('>')? + 1;
+    let close = open + text[open..].find("</DataArray>")?;
+    let line = text[..at].matches('\n').count() + 1;
+    Some((line, &text[open..close]))
+}
+
+fn numbers(text: &str, fname: &str, name: &str) -> Result<Vec<f64>, ParseError> {
+    let (line, body) = array(text, name)
+        .ok_or_else(|| ParseError::new(fname, 0, format!("no DataArray named '{name}'")))?;
+    body.split_whitespace()
+        .map(|w| {
+            w.parse::<f64>().map_err(|_| {
+                ParseError::new(
+                    fname,
+                    line,
+                    format!("'{w}' in DataArray '{name}' is not a number (only ASCII arrays are read)"),
+                )
+            })
+        })
+        .collect()
+}
+
+/// Reads a `.vtu` written by [`write_vtu`] back into a frame.
+pub fn read_vtu(path: &Path) -> Result<Frame, IoError> {
+    let text = std::fs::read_to_string(path).map_err(|e| IoError::os(path, e))?;
+    let name = path.display().to_string();
+    parse_vtu(&text, &name).map_err(IoError::from)
+}
+
+/// Parses `.vtu` text; `name` is used in error messages.
+pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
+    if !text.contains("<VTKFile") || !text.contains("UnstructuredGrid") {
+        return Err(ParseError::new(name, 1, "not a VTK XML UnstructuredGrid file"));
+    }
+    let pts = numbers(text, name, "Points")?;
+    if pts.len() % 3 != 0 {
+        return Err(ParseError::new(name, 0, "Points: count not a multiple of 3"));
+    }
+    let n = pts.len() / 3;
+    let mut frame = Frame {
+        positions: pts.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        ..Frame::default()
+    };
+    let check = |v: &Vec<f64>, what: &str, k: usize| {
+        if v.len() == k {
+            Ok(())
+        } else {
+            Err(ParseError::new(
+                name,
+                0,
+                format!("{what} has {} values, expected {k}", v.len()),
+            ))
+        }
+    };
+    let r = numbers(text, name, "radius")?;
+    check(&r, "radius", n)?;
+    frame.radii = r;
+    let v = numbers(text, name, "velocity")?;
+    check(&v, "velocity", 3 * n)?;
+    frame.velocities = v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    if let Ok(t) = numbers(text, name, "TIME") {
+        frame.time = t.first().copied().unwrap_or(0.0);
+    }
+    if let Ok(c) = numbers(text, name, "cell") {
+        check(&c, "cell", 9)?;
+        frame.cell = [[c[0], c[1], c[2]], [c[3], c[4], c[5]], [c[6], c[7], c[8]]];
+    }
+    if let Ok(o) = numbers(text, name, "origin") {
+        check(&o, "origin", 3)?;
+        frame.origin = [o[0], o[1], o[2]];
+    }
+    if let Ok(p) = numbers(text, name, "pbc") {
+        check(&p, "pbc", 3)?;
+        frame.pbc = [p[0] != 0.0, p[1] != 0.0, p[2] != 0.0];
+    }
+    let species: Vec<String> = match numbers(text, name, "species") {
+        Ok(bytes) => bytes
+            .split(|b| *b == 0.0)
+            .filter(|s| !s.is_empty())
+            .map(|s| s.iter().map(|&b| b as u8 as char).collect())
+            .collect(),
+        Err(_) => Vec::new(),
+    };
+    let types = numbers(text, name, "type")?;
+    check(&types, "type", n)?;
+    frame.species = types
+        .iter()
+        .map(|&t| {
+            species
+                .get(t as usize)
+                .cloned()
+                .unwrap_or_else(|| format!("{t}"))
+        })
+        .collect();
+    Ok(frame)
+}
+
+/// Writes a series of frames as `DIR/STEM_00000.vtu`, ... plus `DIR/STEM.pvd`
+/// listing them with their times. The `.pvd` is rewritten (to a temporary file,
+/// then renamed) after every frame, so a run that stops early leaves a valid
+/// series of what it wrote.
+pub struct PvdWriter {
+    dir: PathBuf,
+    stem: String,
+    provenance: Provenance,
+    entries: Vec<(f64, String)>,
+}
+
+impl PvdWriter {
+    /// `pvd_path` is the collection file, e.g. `out/traj.pvd`; frames go beside it.
+    pub fn create(pvd_path: &Path, provenance: Provenance) -> Result<Self, IoError> {
+        let dir = pvd_path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_path_buf();
+        let stem = pvd_path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .ok_or_else(|| {
+                IoError::Parse(ParseError::new(
+                    pvd_path.display().to_string(),
+                    0,
+                    "a .pvd file name is needed",
+                ))
+            })?
+            .to_string();
+        let w = Self {
+            dir,
+            stem,
+            provenance,
+            entries: Vec::new(),
+        };
+        w.write_pvd()?;
+        Ok(w)
+    }
+
+    /// Writes the next frame and updates the collection; returns the frame's path.
+    pub fn write(&mut self, frame: &Frame) -> Result<PathBuf, IoError> {
+        let file = format!("{}_{:05}.vtu", self.stem, self.entries.len());
+        let path = self.dir.join(&file);
+        write_vtu(&path, frame, &self.provenance)?;
+        self.entries.push((frame.time, file));
+        self.write_pvd()?;
+        Ok(path)
+    }
+
+    /// The collection file's path.
+    pub fn pvd_path(&self) -> PathBuf {
+        self.dir.join(format!("{}.pvd", self.stem))
+    }
+
+    fn write_pvd(&self) -> Result<(), IoError> {
+        let path = self.pvd_path();
+        let tmp = self.dir.join(format!(".{}.pvd.tmp", self.stem));
+        let mut s = String::new();
+        s.push_str("<?xml version=\"1.0\"?>\n");
+        s.push_str(&format!("<!-- {} -->\n", xml_escape(&self.provenance.line())));
+        s.push_str("<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
+        for (t, f) in &self.entries {
+            s.push_str(&format!(
+                "<DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{}\"/>\n",
+                xml_escape(f)
+            ));
+        }
+        s.push_str("</Collection>\n</VTKFile>\n");
+        std::fs::write(&tmp, s).map_err(|e| IoError::os(&tmp, e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| IoError::os(&path, e))
+    }
+}
+
+/// Reads a `.pvd` collection: (time, path of the data set) in file order, paths
+/// relative to the collection's folder resolved.
+pub fn read_pvd(path: &Path) -> Result<Vec<(f64, PathBuf)>, IoError> {
+    let text = std::fs::read_to_string(path).map_err(|e| IoError::os(path, e))?;
+    let name = path.display().to_string();
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut out = Vec::new();
+    for (k, line) in text.lines().enumerate() {
+        let Some(at) = line.find("<DataSet") else {
+            continue;
+        };
+        let attr = |key: &str| -> Option<&str> {
+            let pat = format!("{key}=\"");
+            let s = at + line[at..].find(&pat)? + pat.len();
+            let e = s + line[s..].find('"')?;
+            Some(&line[s..e])
+        };
+        let t = attr("timestep")
+            .and_then(|t| t.parse::<f64>().ok())
+            .ok_or_else(|| ParseError::new(&name, k + 1, "DataSet without a numeric timestep"))?;
+        let f = attr("file")
+            .ok_or_else(|| ParseError::new(&name, k + 1, "DataSet without a file"))?;
+        out.push((t, dir.join(f)));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(t: f64) -> Frame {
+        Frame {
+            time: t,
+            cell: [[2.0, 0.0, 0.0], [0.5, 3.0, 0.0], [0.0, 0.0, 4.0]],
+            origin: [-1.0, 0.0, 0.5],
+            pbc: [true, false, true],
+            species: vec!["A".into(), "Bb".into(), "A".into()],
+            positions: vec![[0.1, 0.2, 0.3], [-1.25, 2.5, 1e-7], [1.0 / 3.0, 0.0, 0.0]],
+            velocities: vec![[1.0, 0.0, 0.0], [0.0, -2.0, 3.0], [0.0; 3]],
+            radii: vec![0.5, 0.25, 0.5],
+        }
+    }
+
+    #[test]
+    fn series_round_trips_through_pvd_and_vtu() {
+        let dir = tempfile::tempdir().unwrap();
+        let pvd = dir.path().join("traj.pvd");
+        let mut w = PvdWriter::create(&pvd, Provenance::default()).unwrap();
+        assert!(read_pvd(&pvd).unwrap().is_empty());
+        for k in 0..3 {
+            w.write(&frame(0.5 * k as f64)).unwrap();
+        }
+        let list = read_pvd(&pvd).unwrap();
+        assert_eq!(list.len(), 3);
+        assert_eq!(list[2].0, 1.0);
+        assert!(list[1].1.ends_with("traj_00001.vtu"));
+        let back = read_vtu(&list[2].1).unwrap();
+        let f = frame(1.0);
+        // Positions are written with 17 significant digits: exact round trip.
+        assert_eq!(back.positions, f.positions);
+        assert_eq!(back.velocities, f.velocities);
+        assert_eq!(back.radii, f.radii);
+        assert_eq!(back.cell, f.cell);
+        assert_eq!(back.origin, f.origin);
+        assert_eq!(back.pbc, f.pbc);
+        assert_eq!(back.species, f.species);
+        assert_eq!(back.time, 1.0);
+    }
+
+    #[test]
+    fn bad_vtu_is_named() {
+        let e = parse_vtu("<VTKFile type=\"UnstructuredGrid\">\n<DataArray Name=\"Points\">\n1 2 x\n</DataArray>", "p.vtu")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("p.vtu:2:") && e.contains("'x'"), "{e}");
+        let e = parse_vtu("hello", "h.vtu").unwrap_err().to_string();
+        assert_eq!(e, "h.vtu:1: not a VTK XML UnstructuredGrid file");
+    }
+}

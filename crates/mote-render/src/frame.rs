@@ -1,0 +1,138 @@
+//! A trajectory frame (`mote_io::xyz::Frame`) as a scene: one sphere per
+//! particle, coloured by species or by a per-particle quantity, with its box.
+
+use glam::Vec3;
+use mote_io::xyz::Frame;
+
+use crate::colormap::{category_color, finite_range, ColorMap};
+use crate::scene::{Cell, Scene};
+use crate::RenderError;
+
+/// What colours the particles.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ColorBy {
+    /// One colour per species name (categorical palette).
+    Species,
+    /// A per-particle quantity through a colour map: `speed`, `radius`, `vx`,
+    /// `vy`, `vz`, `x`, `y`, `z`.
+    Quantity(String),
+}
+
+/// The quantities [`ColorBy::Quantity`] knows.
+pub const QUANTITIES: &[&str] = &["speed", "radius", "vx", "vy", "vz", "x", "y", "z"];
+
+/// The values of a named per-particle quantity.
+pub fn quantity(frame: &Frame, name: &str) -> Result<Vec<f64>, RenderError> {
+    let n = frame.positions.len();
+    let vel = |i: usize| frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
+    let v: Vec<f64> = match name {
+        "speed" => (0..n)
+            .map(|i| {
+                let v = vel(i);
+                (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+            })
+            .collect(),
+        "radius" => (0..n)
+            .map(|i| frame.radii.get(i).copied().unwrap_or(f64::NAN))
+            .collect(),
+        "vx" | "vy" | "vz" => {
+            let d = (name.as_bytes()[1] - b'x') as usize;
+            (0..n).map(|i| vel(i)[d]).collect()
+        }
+        "x" | "y" | "z" => {
+            let d = (name.as_bytes()[0] - b'x') as usize;
+            frame.positions.iter().map(|p| p[d]).collect()
+        }
+        other => {
+            return Err(RenderError::Invalid(format!(
+                "unknown quantity '{other}' to colour by; known: species, {}",
+                QUANTITIES.join(", ")
+            )))
+        }
+    };
+    Ok(v)
+}
+
+/// What [`scene_from_frame`] made of the colours: the quantity's range for a colour bar.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coloring {
+    pub map: ColorMap,
+    pub range: Option<(f64, f64)>,
+}
+
+/// Builds the scene of a frame. Particles without a radius (0) are drawn with
+/// `default_radius`. The box is the frame's cell if it has a non-zero volume.
+pub fn scene_from_frame(
+    frame: &Frame,
+    color_by: &ColorBy,
+    map: ColorMap,
+    default_radius: f64,
+) -> Result<(Scene, Coloring), RenderError> {
+    let mut scene = Scene::new();
+    let n = frame.positions.len();
+    let mut range = None;
+    let colors: Vec<[f32; 3]> = match color_by {
+        ColorBy::Species => {
+            let mut names: Vec<&str> = Vec::new();
+            (0..n)
+                .map(|i| {
+                    let s = frame.species.get(i).map(String::as_str).unwrap_or("X");
+                    let k = names.iter().position(|&x| x == s).unwrap_or_else(|| {
+                        names.push(s);
+                        names.len() - 1
+                    });
+                    category_color(k)
+                })
+                .collect()
+        }
+        ColorBy::Quantity(name) => {
+            let q = quantity(frame, name)?;
+            let (lo, hi) = finite_range(&q);
+            range = Some((lo, hi));
+            q.iter()
+                .map(|&v| map.at(((v - lo) / (hi - lo)) as f32))
+                .collect()
+        }
+    };
+    for i in 0..n {
+        let p = frame.positions[i];
+        let r = frame
+            .radii
+            .get(i)
+            .copied()
+            .filter(|r| *r > 0.0)
+            .unwrap_or(default_radius);
+        scene.add_sphere(
+            Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
+            r as f32,
+            colors[i],
+        );
+    }
+    let c = frame.cell;
+    let edges = c.map(|e| Vec3::new(e[0] as f32, e[1] as f32, e[2] as f32));
+    if edges[0].cross(edges[1]).dot(edges[2]).abs() > 0.0 {
+        scene.cell = Some(Cell {
+            origin: Vec3::new(
+                frame.origin[0] as f32,
+                frame.origin[1] as f32,
+                frame.origin[2] as f32,
+            ),
+            edges,
+        });
+    }
+    Ok((scene, Coloring { map, range }))
+}
+
+/// A radius for point particles: a third of the mean spacing `(V/N)^(1/3)` of
+/// the frame's bounding box.
+pub fn default_radius(frame: &Frame) -> f64 {
+    let (cell, _) = Frame::bounding_cell(&frame.positions, &[], 0.0);
+    let v = cell[0][0] * cell[1][1] * cell[2][2];
+    let n = frame.positions.len().max(1) as f64;
+    let r = (v / n).cbrt() / 3.0;
+    if r.is_finite() && r > 0.0 {
+        r
+    } else {
+        0.5
+    }
+}
