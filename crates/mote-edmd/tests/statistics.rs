@@ -59,7 +59,7 @@ fn eos_check(dim: usize, n: usize, eta: f64, equil: f64, blocks: usize, tau: f64
 #[test]
 fn spheres_follow_carnahan_starling_small() {
     for eta in [0.2, 0.3, 0.4] {
-        eos_check(3, 1372, eta, 5.0, 10, 3.0);
+        eos_check(3, 1372, eta, 5.0, 10, 6.0);
     }
 }
 

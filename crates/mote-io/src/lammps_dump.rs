@@ -72,9 +72,11 @@ impl DumpWriter {
         write_frame(&mut self.out, timestep, frame, &types)
             .and_then(|_| self.out.flush())
             .map_err(|e| match e.kind() {
-                std::io::ErrorKind::InvalidInput => {
-                    IoError::Parse(ParseError::new(self.path.display().to_string(), 0, e.to_string()))
-                }
+                std::io::ErrorKind::InvalidInput => IoError::Parse(ParseError::new(
+                    self.path.display().to_string(),
+                    0,
+                    e.to_string(),
+                )),
                 _ => IoError::os(&self.path, e),
             })
     }
@@ -113,7 +115,10 @@ pub fn write_frame(
         pbc_flag(frame.pbc[1]),
         pbc_flag(frame.pbc[2])
     );
-    writeln!(out, "ITEM: TIMESTEP\n{timestep}\nITEM: NUMBER OF ATOMS\n{n}")?;
+    writeln!(
+        out,
+        "ITEM: TIMESTEP\n{timestep}\nITEM: NUMBER OF ATOMS\n{n}"
+    )?;
     let restricted = c[0][1] == 0.0 && c[0][2] == 0.0 && c[1][2] == 0.0;
     if !restricted {
         return Err(std::io::Error::new(
@@ -210,7 +215,10 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
             .map_err(|_| err(at, format!("'{v}' is not a time step (a whole number)")))?;
         let (at, l) = next(&mut k, "ITEM: NUMBER OF ATOMS")?;
         if l != "ITEM: NUMBER OF ATOMS" {
-            return Err(err(at, format!("expected 'ITEM: NUMBER OF ATOMS', found '{l}'")));
+            return Err(err(
+                at,
+                format!("expected 'ITEM: NUMBER OF ATOMS', found '{l}'"),
+            ));
         }
         let (at, v) = next(&mut k, "the number of atoms")?;
         let n: usize = v
@@ -218,7 +226,10 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
             .map_err(|_| err(at, format!("'{v}' is not a number of atoms")))?;
         let (at, l) = next(&mut k, "ITEM: BOX BOUNDS")?;
         let Some(rest) = l.strip_prefix("ITEM: BOX BOUNDS") else {
-            return Err(err(at, format!("expected 'ITEM: BOX BOUNDS ...', found '{l}'")));
+            return Err(err(
+                at,
+                format!("expected 'ITEM: BOX BOUNDS ...', found '{l}'"),
+            ));
         };
         let words: Vec<&str> = rest.split_whitespace().collect();
         let triclinic = words.len() >= 3 && words[..3] == ["xy", "xz", "yz"];
@@ -236,7 +247,10 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
             if v.len() != want {
                 return Err(err(
                     at,
-                    format!("expected {want} numbers (lo hi{})", if triclinic { " tilt" } else { "" }),
+                    format!(
+                        "expected {want} numbers (lo hi{})",
+                        if triclinic { " tilt" } else { "" }
+                    ),
                 ));
             }
             row[..want].copy_from_slice(&v);
@@ -270,7 +284,10 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
         } else if let (Some(x), Some(y), Some(z)) = (col("xs"), col("ys"), col("zs")) {
             ([x, y, z], true)
         } else {
-            return Err(err(at, "no position columns (x y z, xu yu zu or xs ys zs)".into()));
+            return Err(err(
+                at,
+                "no position columns (x y z, xu yu zu or xs ys zs)".into(),
+            ));
         };
         let vel = match (col("vx"), col("vy"), col("vz")) {
             (Some(a), Some(b), Some(c)) => Some([a, b, c]),
@@ -284,7 +301,11 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
             if f.len() < cols.len() {
                 return Err(err(
                     at,
-                    format!("{} values, but ITEM: ATOMS names {} columns", f.len(), cols.len()),
+                    format!(
+                        "{} values, but ITEM: ATOMS names {} columns",
+                        f.len(),
+                        cols.len()
+                    ),
                 ));
             }
             let num = |c: usize| {
@@ -371,11 +392,11 @@ mod tests {
             assert_eq!(back.len(), 2);
             assert_eq!(back[1].timestep, 100);
             let b = &back[0].frame;
-            for d in 0..3 {
-                for e in 0..3 {
-                    assert!((b.cell[d][e] - cell[d][e]).abs() < 1e-12, "{:?}", b.cell);
-                }
-                assert!((b.origin[d] - f.origin[d]).abs() < 1e-12);
+            for (got, want) in b.cell.iter().flatten().zip(cell.iter().flatten()) {
+                assert!((got - want).abs() < 1e-12, "{:?}", b.cell);
+            }
+            for (got, want) in b.origin.iter().zip(&f.origin) {
+                assert!((got - want).abs() < 1e-12);
             }
             assert_eq!(b.pbc, [true, true, false]);
             assert_eq!(b.species, ["1", "2", "1"]);
@@ -398,7 +419,10 @@ mod tests {
         let f = parse(text, "v.dump").unwrap();
         assert_eq!(f[0].timestep, 7);
         assert_eq!(f[0].frame.time, 0.5);
-        assert_eq!(f[0].frame.positions, vec![[1.0, 2.0, -2.0], [5.0, 5.0, 0.0]]);
+        assert_eq!(
+            f[0].frame.positions,
+            vec![[1.0, 2.0, -2.0], [5.0, 5.0, 0.0]]
+        );
         assert_eq!(f[0].frame.species, ["2", "1"]);
         let bad = "ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n\
                    0 1\n0 1\n0 1\nITEM: ATOMS id type x y z\n1 1 0 0 0\n2 1 0 zero 0\n";
@@ -411,7 +435,10 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let mut w = DumpWriter::create(&dir.path().join("x.dump")).unwrap();
         let e = w
-            .write(0, &frame([[1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+            .write(
+                0,
+                &frame([[1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+            )
             .unwrap_err()
             .to_string();
         assert!(e.contains("restricted triclinic"), "{e}");

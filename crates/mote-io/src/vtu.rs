@@ -115,7 +115,10 @@ fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::
         writeln!(out, "{:.10e} {:.10e} {:.10e}", v[0], v[1], v[2])?;
     }
     writeln!(out, "</DataArray>")?;
-    writeln!(out, "<DataArray type=\"Int32\" Name=\"type\" format=\"ascii\">")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Int32\" Name=\"type\" format=\"ascii\">"
+    )?;
     for i in 0..n {
         writeln!(out, "{}", types.get(i).copied().unwrap_or(0))?;
     }
@@ -140,12 +143,18 @@ fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::
         writeln!(out, "{i}")?;
     }
     writeln!(out, "</DataArray>")?;
-    writeln!(out, "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
+    )?;
     for i in 0..n {
         writeln!(out, "{}", i + 1)?;
     }
     writeln!(out, "</DataArray>")?;
-    writeln!(out, "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">")?;
+    writeln!(
+        out,
+        "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+    )?;
     for _ in 0..n {
         writeln!(out, "1")?;
     }
@@ -177,7 +186,9 @@ fn numbers(text: &str, fname: &str, name: &str) -> Result<Vec<f64>, ParseError> 
                 ParseError::new(
                     fname,
                     line,
-                    format!("'{w}' in DataArray '{name}' is not a number (only ASCII arrays are read)"),
+                    format!(
+                        "'{w}' in DataArray '{name}' is not a number (only ASCII arrays are read)"
+                    ),
                 )
             })
         })
@@ -194,11 +205,19 @@ pub fn read_vtu(path: &Path) -> Result<Frame, IoError> {
 /// Parses `.vtu` text; `name` is used in error messages.
 pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
     if !text.contains("<VTKFile") || !text.contains("UnstructuredGrid") {
-        return Err(ParseError::new(name, 1, "not a VTK XML UnstructuredGrid file"));
+        return Err(ParseError::new(
+            name,
+            1,
+            "not a VTK XML UnstructuredGrid file",
+        ));
     }
     let pts = numbers(text, name, "Points")?;
     if pts.len() % 3 != 0 {
-        return Err(ParseError::new(name, 0, "Points: count not a multiple of 3"));
+        return Err(ParseError::new(
+            name,
+            0,
+            "Points: count not a multiple of 3",
+        ));
     }
     let n = pts.len() / 3;
     let mut frame = Frame {
@@ -319,7 +338,10 @@ impl PvdWriter {
         let tmp = self.dir.join(format!(".{}.pvd.tmp", self.stem));
         let mut s = String::new();
         s.push_str("<?xml version=\"1.0\"?>\n");
-        s.push_str(&format!("<!-- {} -->\n", xml_escape(&self.provenance.line())));
+        s.push_str(&format!(
+            "<!-- {} -->\n",
+            xml_escape(&self.provenance.line())
+        ));
         s.push_str("<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
         for (t, f) in &self.entries {
             s.push_str(&format!(
@@ -353,8 +375,8 @@ pub fn read_pvd(path: &Path) -> Result<Vec<(f64, PathBuf)>, IoError> {
         let t = attr("timestep")
             .and_then(|t| t.parse::<f64>().ok())
             .ok_or_else(|| ParseError::new(&name, k + 1, "DataSet without a numeric timestep"))?;
-        let f = attr("file")
-            .ok_or_else(|| ParseError::new(&name, k + 1, "DataSet without a file"))?;
+        let f =
+            attr("file").ok_or_else(|| ParseError::new(&name, k + 1, "DataSet without a file"))?;
         out.push((t, dir.join(f)));
     }
     Ok(out)
@@ -405,9 +427,12 @@ mod tests {
 
     #[test]
     fn bad_vtu_is_named() {
-        let e = parse_vtu("<VTKFile type=\"UnstructuredGrid\">\n<DataArray Name=\"Points\">\n1 2 x\n</DataArray>", "p.vtu")
-            .unwrap_err()
-            .to_string();
+        let e = parse_vtu(
+            "<VTKFile type=\"UnstructuredGrid\">\n<DataArray Name=\"Points\">\n1 2 x\n</DataArray>",
+            "p.vtu",
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.starts_with("p.vtu:2:") && e.contains("'x'"), "{e}");
         let e = parse_vtu("hello", "h.vtu").unwrap_err().to_string();
         assert_eq!(e, "h.vtu:1: not a VTK XML UnstructuredGrid file");

@@ -42,7 +42,10 @@ fn the_three_trajectory_formats_agree() {
     let from_xyz = read_frames(&d.join("t.xyz")).unwrap().remove(0);
     let mut w = lammps_dump::DumpWriter::create(&d.join("t.dump")).unwrap();
     w.write(3, &from_xyz).unwrap();
-    let from_dump = lammps_dump::read_frames(&d.join("t.dump")).unwrap().remove(0).frame;
+    let from_dump = lammps_dump::read_frames(&d.join("t.dump"))
+        .unwrap()
+        .remove(0)
+        .frame;
     vtu::write_vtu(&d.join("t.vtu"), &from_dump, &Provenance::default()).unwrap();
     let from_vtu = vtu::read_vtu(&d.join("t.vtu")).unwrap();
     for g in [&from_xyz, &from_dump, &from_vtu] {
@@ -77,7 +80,10 @@ fn other_programs_read_the_same_positions_and_box() {
         w.write(k, &f).unwrap();
         vtu::write_vtu(&d.join("t.vtu"), &f, &Provenance::default()).unwrap();
         let rows = |v: &[[f64; 3]]| {
-            let r: Vec<String> = v.iter().map(|p| format!("[{:e},{:e},{:e}]", p[0], p[1], p[2])).collect();
+            let r: Vec<String> = v
+                .iter()
+                .map(|p| format!("[{:e},{:e},{:e}]", p[0], p[1], p[2]))
+                .collect();
             format!("[{}]", r.join(","))
         };
         if k > 0 {
@@ -95,14 +101,19 @@ fn other_programs_read_the_same_positions_and_box() {
     json.push(']');
     std::fs::write(d.join("expected.json"), json).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/check_formats.py");
-    let out = match std::process::Command::new("python3").arg(&script).arg(d).output() {
+    let out = match std::process::Command::new("python3")
+        .arg(&script)
+        .arg(d)
+        .output()
+    {
         Ok(o) => o,
         Err(e) => {
             eprintln!("SKIP: python3 not runnable ({e})");
             return;
         }
     };
-    let text = String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     match out.status.code() {
         Some(0) => assert!(text.contains("all formats agree"), "{text}"),
         Some(77) => eprintln!("{text}"),

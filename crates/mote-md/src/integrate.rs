@@ -119,7 +119,7 @@ impl Stepper {
     pub fn step(&mut self, sys: &mut System, ff: &mut ForceField, h: f64) {
         let t = sys.time;
         match self.scheme {
-            Integrator::Euler => {
+            Integrator::Euler | Integrator::SymplecticEuler => {
                 let mut acc = std::mem::take(&mut self.acc);
                 Self::eval(
                     ff,
@@ -129,28 +129,13 @@ impl Stepper {
                     t,
                     &mut acc,
                 );
+                let explicit = self.scheme == Integrator::Euler;
                 let p = &mut sys.particles;
                 for i in 0..p.len() {
-                    p.position[i] += p.velocity[i] * h;
+                    // Explicit: x moves with the old v; semi-implicit: with the new.
+                    let v_old = p.velocity[i];
                     p.velocity[i] += acc[i] * h;
-                }
-                self.acc = acc;
-                self.acc_valid = false;
-            }
-            Integrator::SymplecticEuler => {
-                let mut acc = std::mem::take(&mut self.acc);
-                Self::eval(
-                    ff,
-                    sys,
-                    &sys.particles.position,
-                    &sys.particles.velocity,
-                    t,
-                    &mut acc,
-                );
-                let p = &mut sys.particles;
-                for i in 0..p.len() {
-                    p.velocity[i] += acc[i] * h;
-                    p.position[i] += p.velocity[i] * h;
+                    p.position[i] += if explicit { v_old } else { p.velocity[i] } * h;
                 }
                 self.acc = acc;
                 self.acc_valid = false;

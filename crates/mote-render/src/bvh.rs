@@ -148,7 +148,10 @@ impl Bvh {
         let mut bounds = Aabb::empty();
         let mut cb = Aabb::empty();
         for (s, _) in prims.iter() {
-            bounds.grow(s.center - Vec3::splat(s.radius), s.center + Vec3::splat(s.radius));
+            bounds.grow(
+                s.center - Vec3::splat(s.radius),
+                s.center + Vec3::splat(s.radius),
+            );
             cb.grow(s.center, s.center);
         }
         let count = prims.len();
@@ -176,7 +179,10 @@ impl Bvh {
             for (s, _) in prims.iter() {
                 let b = (((s.center[axis] - cb.lo[axis]) * scale) as usize).min(BINS - 1);
                 bin_n[b] += 1;
-                bin_box[b].grow(s.center - Vec3::splat(s.radius), s.center + Vec3::splat(s.radius));
+                bin_box[b].grow(
+                    s.center - Vec3::splat(s.radius),
+                    s.center + Vec3::splat(s.radius),
+                );
             }
             let mut left_area = [0.0f32; BINS];
             let mut left_n = [0usize; BINS];
@@ -458,7 +464,12 @@ mod tests {
                 radius: 0.3,
             })
             .collect();
-        let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+        let pool = |n| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .unwrap()
+        };
         let a = pool(1).install(|| Bvh::build(&spheres));
         let b = pool(3).install(|| Bvh::build(&spheres));
         assert_eq!(a.index, b.index);

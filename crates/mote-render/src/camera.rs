@@ -123,7 +123,10 @@ mod tests {
         for (x, y) in [(0.5, 0.5), (160.0, 100.0), (319.5, 10.25)] {
             let ray = cam.ray(x, y);
             let (px, py, _) = cam.project(ray.at(7.0)).unwrap();
-            assert!((px - x).abs() < 1e-3 && (py - y).abs() < 1e-3, "{x},{y} -> {px},{py}");
+            assert!(
+                (px - x).abs() < 1e-3 && (py - y).abs() < 1e-3,
+                "{x},{y} -> {px},{py}"
+            );
         }
         // The centre of the picture looks at the target.
         let c = cam.ray(160.0, 100.0);

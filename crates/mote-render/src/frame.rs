@@ -94,8 +94,7 @@ pub fn scene_from_frame(
                 .collect()
         }
     };
-    for i in 0..n {
-        let p = frame.positions[i];
+    for (i, (p, color)) in frame.positions.iter().zip(&colors).enumerate() {
         let r = frame
             .radii
             .get(i)
@@ -105,7 +104,7 @@ pub fn scene_from_frame(
         scene.add_sphere(
             Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32),
             r as f32,
-            colors[i],
+            *color,
         );
     }
     let c = frame.cell;

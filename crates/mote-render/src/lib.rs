@@ -27,12 +27,12 @@ pub mod sdf;
 pub use bvh::{Bvh, Ray, Sphere};
 pub use camera::Camera;
 pub use colormap::ColorMap;
+/// The vector type of scenes and cameras (glam's, re-exported so users need not depend on glam).
+pub use glam::Vec3;
 pub use image::Image;
 pub use render::{render, RenderOptions, Renderer};
 pub use scene::{Cell, Rgb, Scene, SdfBody};
 pub use sdf::Sdf;
-/// The vector type of scenes and cameras (glam's, re-exported so users need not depend on glam).
-pub use glam::Vec3;
 
 use std::path::{Path, PathBuf};
 
@@ -70,10 +70,7 @@ pub(crate) const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 pub(crate) fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
-        let _ = plotters::style::register_font(
-            "sans-serif",
-            plotters::style::FontStyle::Normal,
-            FONT,
-        );
+        let _ =
+            plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT);
     });
 }

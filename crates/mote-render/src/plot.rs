@@ -70,7 +70,7 @@ impl Plot {
     }
 
     /// The ranges of the finite (and, on log axes, positive) points.
-    fn ranges(&self) -> Result<((f64, f64), (f64, f64)), RenderError> {
+    fn ranges(&self) -> Result<[(f64, f64); 2], RenderError> {
         let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
         let mut yr = (f64::INFINITY, f64::NEG_INFINITY);
         for s in &self.series {
@@ -86,7 +86,7 @@ impl Plot {
                 "no finite points to plot (on a log axis, values must be positive)".into(),
             ));
         }
-        Ok((pad(xr, self.log_x, 0.0), pad(yr, self.log_y, 0.05)))
+        Ok([pad(xr, self.log_x, 0.0), pad(yr, self.log_y, 0.05)])
     }
 
     fn usable(&self, x: f64, y: f64) -> bool {
@@ -100,7 +100,7 @@ impl Plot {
         crate::register_font();
         let err = |e: &dyn std::fmt::Display| RenderError::Plot(format!("plot: {e}"));
         root.fill(&WHITE).map_err(|e| err(&e))?;
-        let (xr, yr) = self.ranges()?;
+        let [xr, yr] = self.ranges()?;
         let scale = self.height as f64 / 600.0;
         let font = |px: f64| ("sans-serif", px * scale).into_font();
         let mut builder = ChartBuilder::on(root);
@@ -136,13 +136,12 @@ impl Plot {
                     } else {
                         color
                     };
-                    let pts: Vec<(f64, f64)> = s
-                        .x
-                        .iter()
-                        .zip(&s.y)
-                        .filter(|(&x, &y)| self.usable(x, y))
-                        .map(|(&x, &y)| (x, y))
-                        .collect();
+                    let pts: Vec<(f64, f64)> =
+                        s.x.iter()
+                            .zip(&s.y)
+                            .filter(|(&x, &y)| self.usable(x, y))
+                            .map(|(&x, &y)| (x, y))
+                            .collect();
                     chart
                         .draw_series(LineSeries::new(pts, color.stroke_width(2)))
                         .map_err(|e| err(&e))?

@@ -43,14 +43,22 @@ fn write_to(
     let (r, u, f) = cam.basis();
     let aspect = cam.width as f32 / cam.height as f32;
     let th = (cam.fov_deg.to_radians() * 0.5).tan();
-    writeln!(out, "// written by mote-render: {} spheres", scene.spheres.len())?;
+    writeln!(
+        out,
+        "// written by mote-render: {} spheres",
+        scene.spheres.len()
+    )?;
     writeln!(out, "#version 3.7;")?;
     writeln!(
         out,
         "global_settings {{ assumed_gamma 1.0 ambient_light rgb <1,1,1> }}"
     )?;
     let bg = opts.background;
-    writeln!(out, "background {{ color rgb <{}, {}, {}> }}", bg[0], bg[1], bg[2])?;
+    writeln!(
+        out,
+        "background {{ color rgb <{}, {}, {}> }}",
+        bg[0], bg[1], bg[2]
+    )?;
     // An explicit camera basis: direction f, right r·(2·aspect·th), up u·(2·th);
     // right-handed by passing the true right vector.
     writeln!(

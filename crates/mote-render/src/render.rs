@@ -166,7 +166,13 @@ impl<'a> Renderer<'a> {
         }
         let ndl = n.dot(light);
         let lit = if ndl > 0.0 && opts.shadows {
-            !self.occluded(&Ray { origin: p, dir: light }, f32::INFINITY)
+            !self.occluded(
+                &Ray {
+                    origin: p,
+                    dir: light,
+                },
+                f32::INFINITY,
+            )
         } else {
             ndl > 0.0
         };

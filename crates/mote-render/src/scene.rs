@@ -30,9 +30,8 @@ impl Cell {
     pub fn segments(&self) -> Vec<(Vec3, Vec3)> {
         let [a, b, c] = self.edges;
         let o = self.origin;
-        let corner = |i: u32| {
-            o + a * (i & 1) as f32 + b * ((i >> 1) & 1) as f32 + c * ((i >> 2) & 1) as f32
-        };
+        let corner =
+            |i: u32| o + a * (i & 1) as f32 + b * ((i >> 1) & 1) as f32 + c * ((i >> 2) & 1) as f32;
         let mut out = Vec::with_capacity(12);
         for i in 0..8u32 {
             for bit in [1u32, 2, 4] {
@@ -48,10 +47,7 @@ impl Cell {
     pub fn corners(&self) -> [Vec3; 8] {
         let [a, b, c] = self.edges;
         std::array::from_fn(|i| {
-            self.origin
-                + a * (i & 1) as f32
-                + b * ((i >> 1) & 1) as f32
-                + c * ((i >> 2) & 1) as f32
+            self.origin + a * (i & 1) as f32 + b * ((i >> 1) & 1) as f32 + c * ((i >> 2) & 1) as f32
         })
     }
 }

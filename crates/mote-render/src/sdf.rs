@@ -80,7 +80,11 @@ impl Sdf {
                 let s = pa.dot(axis);
                 let radial = pa - axis * s;
                 let rl = radial.length();
-                let rdir = if rl > 0.0 { radial / rl } else { axis.any_orthonormal_vector() };
+                let rdir = if rl > 0.0 {
+                    radial / rl
+                } else {
+                    axis.any_orthonormal_vector()
+                };
                 let dr = rl - radius; // distance outside the infinite cylinder
                 let (ds, sdir) = if s < h * 0.5 {
                     (-s, -axis)
@@ -97,14 +101,24 @@ impl Sdf {
                     (ds, sdir)
                 }
             }
-            Sdf::Union(parts) => parts
-                .iter()
-                .map(|s| s.eval_grad(p))
-                .fold((f32::INFINITY, Vec3::Z), |a, b| if b.0 < a.0 { b } else { a }),
-            Sdf::Intersection(parts) => parts
-                .iter()
-                .map(|s| s.eval_grad(p))
-                .fold((f32::NEG_INFINITY, Vec3::Z), |a, b| if b.0 > a.0 { b } else { a }),
+            Sdf::Union(parts) => {
+                parts
+                    .iter()
+                    .map(|s| s.eval_grad(p))
+                    .fold(
+                        (f32::INFINITY, Vec3::Z),
+                        |a, b| if b.0 < a.0 { b } else { a },
+                    )
+            }
+            Sdf::Intersection(parts) => {
+                parts
+                    .iter()
+                    .map(|s| s.eval_grad(p))
+                    .fold(
+                        (f32::NEG_INFINITY, Vec3::Z),
+                        |a, b| if b.0 > a.0 { b } else { a },
+                    )
+            }
             Sdf::Complement(inner) => {
                 let (f, g) = inner.eval_grad(p);
                 (-f, -g)
@@ -116,9 +130,10 @@ impl Sdf {
     /// a complement, or a union containing one).
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         match self {
-            Sdf::Sphere { center, radius } => {
-                Some((*center - Vec3::splat(*radius), *center + Vec3::splat(*radius)))
-            }
+            Sdf::Sphere { center, radius } => Some((
+                *center - Vec3::splat(*radius),
+                *center + Vec3::splat(*radius),
+            )),
             Sdf::Cuboid { center, half } => Some((*center - *half, *center + *half)),
             Sdf::Cylinder { a, b, radius } => {
                 let r = Vec3::splat(*radius);
@@ -164,7 +179,7 @@ impl Sdf {
             let b = (hi - ray.origin) * inv;
             let tn = a.min(b).max_element();
             let tf = a.max(b).min_element();
-            if !(tn <= tf) || tf < t_min || tn > t_max {
+            if tn.is_nan() || tf.is_nan() || tn > tf || tf < t_min || tn > t_max {
                 return None;
             }
             t0 = t0.max(tn - eps);

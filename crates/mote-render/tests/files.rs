@@ -38,7 +38,12 @@ fn plots_are_written_as_png_and_svg_with_labels() {
     let svg = dir.path().join("e.svg");
     energy_plot(false).write(&svg).unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
-    for label in ["time [s]", "energy [J]", "kinetic_energy", "potential_energy"] {
+    for label in [
+        "time [s]",
+        "energy [J]",
+        "kinetic_energy",
+        "potential_energy",
+    ] {
         assert!(text.contains(label), "svg lacks {label}");
     }
     let png = dir.path().join("e.png");

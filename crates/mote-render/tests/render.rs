@@ -241,7 +241,10 @@ fn golden_anaglyph() {
     assert_eq!(img.pixel(0, 0), [255, 255, 255]);
     let differing = img.rgb.chunks(3).filter(|p| p[0] != p[1]).count();
     assert!(differing > 200, "only {differing} pixels show parallax");
-    assert!(img.rgb.chunks(3).all(|p| p[1] == p[2]), "cyan = green + blue");
+    assert!(
+        img.rgb.chunks(3).all(|p| p[1] == p[2]),
+        "cyan = green + blue"
+    );
     golden("anaglyph", &img);
 }
 

@@ -107,7 +107,12 @@ fn render_reports_bad_input_without_panicking() {
         (vec!["--size", "12"], "WIDTHxHEIGHT"),
         (vec!["--view", "0,0,0"], "non-zero direction"),
     ] {
-        let mut a = vec!["render", good.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        let mut a = vec![
+            "render",
+            good.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
         a.extend(args);
         let o = mote(&a);
         assert!(!o.status.success(), "{a:?} should fail");

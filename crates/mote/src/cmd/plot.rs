@@ -85,7 +85,12 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         )
     })?;
     let ys: Vec<String> = if a.y.is_empty() {
-        table.columns.iter().filter(|c| **c != a.x).cloned().collect()
+        table
+            .columns
+            .iter()
+            .filter(|c| **c != a.x)
+            .cloned()
+            .collect()
     } else {
         a.y.clone()
     };
@@ -114,7 +119,9 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
     } else {
         let us: Vec<Option<String>> = ys.iter().map(|n| unit_of(n)).collect();
         match us.first().cloned().flatten() {
-            Some(u) if us.iter().all(|v| v.as_deref() == Some(u.as_str())) => format!("value [{u}]"),
+            Some(u) if us.iter().all(|v| v.as_deref() == Some(u.as_str())) => {
+                format!("value [{u}]")
+            }
             _ => "value".to_string(),
         }
     };
@@ -134,7 +141,12 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
     };
     plot.write(&a.output)?;
     if !global.quiet {
-        eprintln!("{} series, {} points -> {}", ys.len(), x.len(), a.output.display());
+        eprintln!(
+            "{} series, {} points -> {}",
+            ys.len(),
+            x.len(),
+            a.output.display()
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -130,7 +130,7 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
     if a.samples == 0 || a.samples > 8 {
         bail!("--samples must be 1 to 8, not {}", a.samples);
     }
-    if !(a.fov > 0.0 && a.fov < 179.0) {
+    if a.fov.is_nan() || a.fov <= 0.0 || a.fov >= 179.0 {
         bail!("--fov must be between 0 and 179 degrees, not {}", a.fov);
     }
     let frames = read_trajectory(&a.traj)?;
@@ -250,7 +250,10 @@ fn numbered(path: &Path, n: usize) -> PathBuf {
 fn parse_size(s: &str) -> anyhow::Result<(u32, u32)> {
     let bad = || anyhow::anyhow!("--size: '{s}' is not WIDTHxHEIGHT such as 1920x1080");
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?);
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    );
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         bail!("--size: {w}x{h} is outside 1x1 .. 16384x16384");
     }
@@ -273,7 +276,7 @@ fn parse_range(s: &str) -> anyhow::Result<(f64, f64)> {
     let (lo, hi) = s.split_once(',').ok_or_else(bad)?;
     let lo: f64 = lo.trim().parse().map_err(|_| bad())?;
     let hi: f64 = hi.trim().parse().map_err(|_| bad())?;
-    if !(lo < hi) {
+    if !lo.is_finite() || !hi.is_finite() || lo >= hi {
         return Err(bad());
     }
     Ok((lo, hi))

@@ -19,6 +19,40 @@ fn rsqrt(r2: __m512d) -> __m512d {
     _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(h, y), y, three_halves))
 }
 
+/// Separations d = r_j − r_i of the 8 particles from j, their masses, and
+/// r² = |d|² + ε².
+#[inline]
+#[target_feature(enable = "avx512f")]
+unsafe fn separations(
+    p: Soa,
+    j: usize,
+    ri: [__m512d; 3],
+    eps2: __m512d,
+) -> ([__m512d; 3], __m512d, __m512d) {
+    // SAFETY: the caller guarantees j + 8 ≤ the slices' length.
+    let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), ri[0]);
+    let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), ri[1]);
+    let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), ri[2]);
+    let m = _mm512_loadu_pd(p.m.as_ptr().add(j));
+    let r2 = _mm512_fmadd_pd(
+        dx,
+        dx,
+        _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, eps2)),
+    );
+    ([dx, dy, dz], m, r2)
+}
+
+/// r_i broadcast to all lanes.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn broadcast(p: Soa, i: usize) -> [__m512d; 3] {
+    [
+        _mm512_set1_pd(p.x[i]),
+        _mm512_set1_pd(p.y[i]),
+        _mm512_set1_pd(p.z[i]),
+    ]
+}
+
 /// See [`super::portable::pairs`].
 ///
 /// # Safety
@@ -40,11 +74,7 @@ pub(super) unsafe fn pairs(
 ) -> DVec3 {
     debug_assert!(j_end.is_multiple_of(8) && j_end <= p.x.len() && base <= j_start & !7);
     debug_assert!(rx.len() >= j_end - base && ry.len() >= j_end - base && rz.len() >= j_end - base);
-    let (xi, yi, zi) = (
-        _mm512_set1_pd(p.x[i]),
-        _mm512_set1_pd(p.y[i]),
-        _mm512_set1_pd(p.z[i]),
-    );
+    let ri = broadcast(p, i);
     let mi = _mm512_set1_pd(p.m[i]);
     let veps2 = _mm512_set1_pd(eps2);
     let zero = _mm512_setzero_pd();
@@ -55,15 +85,7 @@ pub(super) unsafe fn pairs(
     while j < j_end {
         // SAFETY: j + 8 ≤ j_end ≤ len for the particle arrays, and
         // j − base + 8 ≤ j_end − base ≤ len for the reaction arrays.
-        let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), xi);
-        let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), yi);
-        let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), zi);
-        let mj = _mm512_loadu_pd(p.m.as_ptr().add(j));
-        let r2 = _mm512_fmadd_pd(
-            dx,
-            dx,
-            _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, veps2)),
-        );
+        let ([dx, dy, dz], mj, r2) = separations(p, j, ri, veps2);
         let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero) & lanes;
         let y = rsqrt(r2);
         let s = _mm512_maskz_mul_pd(live, _mm512_mul_pd(y, y), y);
@@ -95,34 +117,19 @@ pub(super) unsafe fn pairs(
 /// The CPU must support AVX-512F; the slices of `p` have equal lengths, a multiple of 8.
 #[target_feature(enable = "avx512f")]
 pub(super) unsafe fn field_at(i: usize, p: Soa, eps2: f64) -> DVec3 {
-    let n = p.x.len();
-    let (xi, yi, zi) = (
-        _mm512_set1_pd(p.x[i]),
-        _mm512_set1_pd(p.y[i]),
-        _mm512_set1_pd(p.z[i]),
-    );
+    let ri = broadcast(p, i);
     let veps2 = _mm512_set1_pd(eps2);
     let zero = _mm512_setzero_pd();
     let (mut ax, mut ay, mut az) = (zero, zero, zero);
-    let mut j = 0;
-    while j < n {
-        // SAFETY: j + 8 ≤ n.
-        let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), xi);
-        let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), yi);
-        let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), zi);
-        let m = _mm512_loadu_pd(p.m.as_ptr().add(j));
-        let r2 = _mm512_fmadd_pd(
-            dx,
-            dx,
-            _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, veps2)),
-        );
+    for j in (0..p.x.len()).step_by(8) {
+        // SAFETY: j + 8 ≤ len.
+        let ([dx, dy, dz], m, r2) = separations(p, j, ri, veps2);
         let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero);
         let y = rsqrt(r2);
         let s = _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_mul_pd(y, y), y), m);
         ax = _mm512_fmadd_pd(s, dx, ax);
         ay = _mm512_fmadd_pd(s, dy, ay);
         az = _mm512_fmadd_pd(s, dz, az);
-        j += 8;
     }
     DVec3::new(
         _mm512_reduce_add_pd(ax),
@@ -137,34 +144,19 @@ pub(super) unsafe fn field_at(i: usize, p: Soa, eps2: f64) -> DVec3 {
 /// As for [`field_at`]; i < the slices' length.
 #[target_feature(enable = "avx512f")]
 pub(super) unsafe fn potential_at(i: usize, p: Soa, eps2: f64) -> f64 {
-    let n = p.x.len();
-    let (xi, yi, zi) = (
-        _mm512_set1_pd(p.x[i]),
-        _mm512_set1_pd(p.y[i]),
-        _mm512_set1_pd(p.z[i]),
-    );
+    let ri = broadcast(p, i);
     let veps2 = _mm512_set1_pd(eps2);
     let zero = _mm512_setzero_pd();
     let vi = _mm512_set1_epi64(i as i64);
     let mut lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
     let eight = _mm512_set1_epi64(8);
     let mut u = zero;
-    let mut j = 0;
-    while j < n {
-        // SAFETY: j + 8 ≤ n.
-        let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), xi);
-        let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), yi);
-        let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), zi);
-        let m = _mm512_loadu_pd(p.m.as_ptr().add(j));
-        let r2 = _mm512_fmadd_pd(
-            dx,
-            dx,
-            _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, veps2)),
-        );
+    for j in (0..p.x.len()).step_by(8) {
+        // SAFETY: j + 8 ≤ len.
+        let (_, m, r2) = separations(p, j, ri, veps2);
         let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero) & _mm512_cmpneq_epi64_mask(lane, vi);
         u = _mm512_mask3_fmadd_pd(m, rsqrt(r2), u, live);
         lane = _mm512_add_epi64(lane, eight);
-        j += 8;
     }
     _mm512_reduce_add_pd(u)
 }
