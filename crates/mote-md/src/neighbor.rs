@@ -1,9 +1,8 @@
 //! Neighbour search: cell lists feeding a Verlet list with a skin.
 //!
-//! The list holds, for every particle, all others within r_c + skin (a full
-//! list: each pair appears twice, so force loops run in parallel over
-//! particles without write conflicts and give the same bits for every thread
-//! count). It is rebuilt when any particle has moved more than half the skin
+//! The list holds, for every particle, the others within r_c + skin: all of
+//! them (a full list, each pair twice) or only those of higher index (a half
+//! list, each pair once, for loops that apply Newton's third law). It is rebuilt when any particle has moved more than half the skin
 //! since the last build (then no pair can have crossed r_c unseen), or after
 //! a fixed number of steps if one is set. Building bins the particles into
 //! cells of edge ≥ r_c + skin and scans the 27 surrounding cells, O(N).
@@ -22,6 +21,8 @@ pub struct VerletList {
     pub skin: f64,
     /// Rebuild at least every this many updates (0: only on displacement).
     pub every: u64,
+    /// Keep only neighbours j > i (each pair once).
+    pub half: bool,
     /// `neighbors[start[i]..start[i + 1]]` are the neighbours of i.
     pub start: Vec<u32>,
     pub neighbors: Vec<u32>,
@@ -37,6 +38,14 @@ impl VerletList {
             cutoff,
             skin,
             ..Self::default()
+        }
+    }
+
+    /// A half list: each pair once, j > i.
+    pub fn half(cutoff: f64, skin: f64) -> Self {
+        Self {
+            half: true,
+            ..Self::new(cutoff, skin)
         }
     }
 
@@ -75,7 +84,8 @@ impl VerletList {
             .map(|i| {
                 let mut near = Vec::new();
                 cells.for_each_candidate(pos[i], |j| {
-                    if j != i && image.apply(pos[j] - pos[i]).length_squared() < reach2 {
+                    let wanted = if self.half { j > i } else { j != i };
+                    if wanted && image.apply(pos[j] - pos[i]).length_squared() < reach2 {
                         near.push(j as u32);
                     }
                 });

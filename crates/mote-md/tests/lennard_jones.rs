@@ -39,6 +39,8 @@ fn verlet_list_never_misses_a_pair() {
                 .collect();
             let mut list = VerletList::new(1.1, 0.3);
             list.build(&pos, &b);
+            let mut half = VerletList::half(1.1, 0.3);
+            half.build(&pos, &b);
             let reach2 = 1.4f64 * 1.4;
             for i in 0..n {
                 let mut brute: Vec<u32> = (0..n)

@@ -24,6 +24,8 @@ pub struct LennardJones {
     pub boundary: Boundary,
     pub list: VerletList,
     virial: f64,
+    /// One force buffer per block of particles (see `add_forces`).
+    buffers: Vec<Vec<DVec3>>,
 }
 
 impl LennardJones {
@@ -41,8 +43,9 @@ impl LennardJones {
             cutoff,
             shifted,
             boundary,
-            list: VerletList::new(cutoff, skin),
+            list: VerletList::half(cutoff, skin),
             virial: 0.0,
+            buffers: Vec::new(),
         }
     }
 
@@ -97,37 +100,55 @@ impl Interaction for LennardJones {
         "lennard_jones"
     }
 
+    /// Each pair once (half list, Newton's third law). The particles are cut
+    /// into as many contiguous blocks as there are threads; each block adds
+    /// its pairs' forces into a buffer of its own, and the buffers are summed
+    /// in block order: the same bits for the same thread count.
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let pos = state.position;
+        let n = pos.len();
         self.list.update(pos, &self.boundary);
         let rc2 = self.cutoff * self.cutoff;
-        let this = &*self;
         let image = self.boundary.image();
-        let virials: Vec<f64> = force
-            .par_chunks_mut(512)
+        let blocks = rayon::current_num_threads().clamp(1, n.max(1));
+        let per_block = n.div_ceil(blocks);
+        self.buffers.resize_with(blocks, Vec::new);
+        let mut buffers = std::mem::take(&mut self.buffers);
+        let this = &*self;
+        let virials: Vec<f64> = buffers
+            .par_iter_mut()
             .enumerate()
-            .map(|(chunk, fs)| {
+            .map(|(b, buf)| {
+                buf.clear();
+                buf.resize(n, DVec3::ZERO);
                 let mut w = 0.0;
-                for (k, f) in fs.iter_mut().enumerate() {
-                    let i = chunk * 512 + k;
+                for i in b * per_block..((b + 1) * per_block).min(n) {
                     let ri = pos[i];
                     let mut fi = DVec3::ZERO;
                     for &j in this.list.of(i) {
-                        let d = image.apply(ri - pos[j as usize]);
+                        let j = j as usize;
+                        let d = image.apply(ri - pos[j]);
                         let r2 = d.length_squared();
                         if r2 < rc2 {
                             let (f_over_r, _) = this.pair(r2);
-                            fi += d * f_over_r;
+                            let f = d * f_over_r;
+                            fi += f;
+                            buf[j] -= f;
                             w += f_over_r * r2;
                         }
                     }
-                    *f += fi;
+                    buf[i] += fi;
                 }
                 w
             })
             .collect();
-        // Each pair was visited from both ends.
-        self.virial = 0.5 * virials.iter().sum::<f64>();
+        force.par_iter_mut().enumerate().with_min_len(1024).for_each(|(i, f)| {
+            for buf in &buffers {
+                *f += buf[i];
+            }
+        });
+        self.buffers = buffers;
+        self.virial = virials.iter().sum::<f64>();
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
@@ -151,7 +172,7 @@ impl Interaction for LennardJones {
                 u
             })
             .collect();
-        0.5 * per_i.iter().sum::<f64>()
+        per_i.iter().sum::<f64>()
     }
 
     fn virial(&self) -> f64 {
