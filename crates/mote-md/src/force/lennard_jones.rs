@@ -142,11 +142,15 @@ impl Interaction for LennardJones {
                 w
             })
             .collect();
-        force.par_iter_mut().enumerate().with_min_len(1024).for_each(|(i, f)| {
-            for buf in &buffers {
-                *f += buf[i];
-            }
-        });
+        force
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(i, f)| {
+                for buf in &buffers {
+                    *f += buf[i];
+                }
+            });
         self.buffers = buffers;
         self.virial = virials.iter().sum::<f64>();
     }
