@@ -39,19 +39,17 @@ impl fmt::Display for ParseError {
 pub enum IoError {
     #[error(transparent)]
     Parse(#[from] ParseError),
-    #[error("{path}: {source}")]
-    Os {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
+    /// The cause is part of the message (and not chained as a source, so
+    /// that `{:#}` does not print it twice).
+    #[error("{path}: {cause}")]
+    Os { path: PathBuf, cause: std::io::Error },
 }
 
 impl IoError {
     pub fn os(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         IoError::Os {
             path: path.into(),
-            source,
+            cause: source,
         }
     }
 }

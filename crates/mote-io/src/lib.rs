@@ -7,7 +7,9 @@
 pub mod csv;
 pub mod error;
 pub mod header;
+pub mod lammps_dump;
 pub mod plist;
+pub mod vtu;
 pub mod xyz;
 
 pub use error::{IoError, ParseError};

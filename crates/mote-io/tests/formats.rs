@@ -1,18 +1,8 @@
-//! LAMMPS dump and VTU/PVD: the modules' own round-trip tests, compiled here so
-//! they run before `pub mod lammps_dump; pub mod vtu;` are added to lib.rs.
-//! Once they are, replace the two `#[path]` modules below by
-//! `use mote_io::{lammps_dump, vtu};` (their unit tests then run in the library).
+//! LAMMPS dump and VTU/PVD round trips, and the check that ASE, MDAnalysis
+//! and meshio read mote's files (bench/check_formats.py).
 
-// The modules name `crate::xyz`, `crate::IoError`, ...: provide those here.
 #[allow(unused_imports)]
-use mote_io::{xyz, IoError, ParseError, Provenance};
-
-#[allow(dead_code)]
-#[path = "../src/lammps_dump.rs"]
-mod lammps_dump;
-#[allow(dead_code)]
-#[path = "../src/vtu.rs"]
-mod vtu;
+use mote_io::{lammps_dump, vtu, xyz, IoError, ParseError, Provenance};
 
 use std::path::Path;
 

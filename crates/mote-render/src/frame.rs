@@ -122,16 +122,49 @@ pub fn scene_from_frame(
     Ok((scene, Coloring { map, range }))
 }
 
-/// A radius for point particles: a third of the mean spacing `(V/N)^(1/3)` of
-/// the frame's bounding box.
+/// A radius for point particles: a third of the mean spacing `(V/N)^(1/d)` in the
+/// frame's bounding box, d the number of axes along which the particles spread.
 pub fn default_radius(frame: &Frame) -> f64 {
     let (cell, _) = Frame::bounding_cell(&frame.positions, &[], 0.0);
-    let v = cell[0][0] * cell[1][1] * cell[2][2];
+    let ext = [cell[0][0], cell[1][1], cell[2][2]];
     let n = frame.positions.len().max(1) as f64;
-    let r = (v / n).cbrt() / 3.0;
+    // Mean spacing in the dimensions the particles spread in (a flat or linear
+    // arrangement has zero extent along some axes).
+    let big = ext.iter().cloned().fold(0.0, f64::max);
+    let spread: Vec<f64> = ext.iter().cloned().filter(|e| *e > 1e-9 * big).collect();
+    let measure: f64 = spread.iter().product();
+    let r = (measure / n).powf(1.0 / spread.len().max(1) as f64) / 3.0;
     if r.is_finite() && r > 0.0 {
         r
     } else {
         0.5
     }
+}
+
+/// One call for "a picture at the end of a run" (`mote run --picture`,
+/// `mote pack --picture`): the frame coloured by species, auto-framed from the
+/// default direction, shadows on, box drawn, written as PNG of `width`×`height`.
+pub fn picture(
+    frame: &Frame,
+    path: &std::path::Path,
+    width: u32,
+    height: u32,
+) -> Result<(), RenderError> {
+    let (scene, _) = scene_from_frame(
+        frame,
+        &ColorBy::Species,
+        ColorMap::Viridis,
+        default_radius(frame),
+    )?;
+    let (lo, hi) = scene
+        .bounds()
+        .ok_or_else(|| RenderError::Invalid("the frame has nothing to draw".into()))?;
+    let cam = crate::Camera::frame(lo, hi, crate::camera::DEFAULT_VIEW, 30.0, width, height);
+    let opts = crate::RenderOptions {
+        shadows: true,
+        ..crate::RenderOptions::default()
+    };
+    crate::Renderer::new(&scene)
+        .render(&cam, &opts)
+        .write_png(path)
 }

@@ -81,9 +81,11 @@ struct SurfaceHit {
 impl<'a> Renderer<'a> {
     pub fn new(scene: &'a Scene) -> Self {
         let bvh = Bvh::build(&scene.spheres);
+        // Ray offsets must exceed the rounding of f32 coordinates, which grows
+        // with their magnitude as well as with the scene's size.
         let size = scene
             .bounds()
-            .map(|(lo, hi)| (hi - lo).length())
+            .map(|(lo, hi)| (hi - lo).length().max(lo.abs().max(hi.abs()).max_element()))
             .filter(|s| s.is_finite() && *s > 0.0)
             .unwrap_or(1.0);
         let mut radii: Vec<f32> = scene
@@ -101,7 +103,7 @@ impl<'a> Renderer<'a> {
         Self {
             scene,
             bvh,
-            eps: size * 2e-6,
+            eps: size * 4e-6,
             median_radius,
         }
     }

@@ -146,3 +146,37 @@ fn pov_ray_scene_has_every_sphere_camera_and_light() {
     assert!(text.contains("camera { perspective location"));
     assert!(text.contains("light_source") && !text.contains("shadowless"));
 }
+
+#[test]
+fn point_particles_get_a_radius_from_their_spacing() {
+    // 100 particles on a 10 × 10 square grid of spacing 1 in the plane z = 0:
+    // the spread is 9 × 9, the mean spacing 0.9, the radius a third of it.
+    let mut f = frame();
+    f.positions = (0..100)
+        .map(|k| [(k % 10) as f64, (k / 10) as f64, 0.0])
+        .collect();
+    let r = mote_render::frame::default_radius(&f);
+    assert!((r - 0.3).abs() < 1e-12, "{r}");
+}
+
+#[test]
+fn one_call_picture_of_a_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("end.png");
+    mote_render::frame::picture(&frame(), &path, 200, 150).unwrap();
+    let img = Image::read_png(&path).unwrap();
+    assert_eq!((img.width, img.height), (200, 150));
+    // Species A and B in their palette colours are both visible somewhere.
+    let lit = |c: [f32; 3]| {
+        img.rgb.chunks(3).any(|p| {
+            // Some shade of the colour: channels in the same proportion.
+            let s = p[0] as f32 + p[1] as f32 + p[2] as f32;
+            let t = (c[0] + c[1] + c[2]) * 255.0;
+            s > 30.0 && (0..3).all(|k| (p[k] as f32 / s - c[k] * 255.0 / t).abs() < 0.03)
+        })
+    };
+    assert!(lit(mote_render::colormap::category_color(0)));
+    assert!(lit(mote_render::colormap::category_color(1)));
+    let empty = Frame::default();
+    assert!(mote_render::frame::picture(&empty, &path, 10, 10).is_err());
+}

@@ -30,6 +30,18 @@ enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
+    /// Ray-traced pictures of a trajectory; see `mote render --help`.
+    #[command(disable_help_flag = true, disable_version_flag = true)]
+    Render {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Plot columns of an observables CSV; see `mote plot --help`.
+    #[command(disable_help_flag = true, disable_version_flag = true)]
+    Plot {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
     /// Event-driven hard spheres and disks; see `mote edmd --help`.
     #[command(disable_help_flag = true, disable_version_flag = true)]
     Edmd {
@@ -45,6 +57,8 @@ fn main() -> ExitCode {
         Command::Examples(args) => cmd::examples::run(&cli.global, args),
         Command::Rcp { args } => cmd::rcp::run(&cli.global, &args),
         Command::Edmd { args } => cmd::edmd::run(&cli.global, &args),
+        Command::Render { args } => cmd::render::run(&cli.global, &args),
+        Command::Plot { args } => cmd::plot::run(&cli.global, &args),
     };
     match result {
         Ok(code) => code,

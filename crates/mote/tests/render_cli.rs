@@ -36,7 +36,6 @@ fn png_size(path: &Path) -> (u32, u32) {
 }
 
 #[test]
-#[ignore = "enable once `mote render` is wired into main.rs"]
 fn render_writes_a_picture_of_the_asked_size() {
     let dir = tempfile::tempdir().unwrap();
     let xyz = dir.path().join("t.xyz");
@@ -59,7 +58,6 @@ fn render_writes_a_picture_of_the_asked_size() {
 }
 
 #[test]
-#[ignore = "enable once `mote render` is wired into main.rs"]
 fn render_all_numbers_frames_and_writes_pov() {
     let dir = tempfile::tempdir().unwrap();
     let xyz = dir.path().join("t.xyz");
@@ -88,7 +86,6 @@ fn render_all_numbers_frames_and_writes_pov() {
 }
 
 #[test]
-#[ignore = "enable once `mote render` is wired into main.rs"]
 fn render_reports_bad_input_without_panicking() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.xyz");
@@ -119,13 +116,21 @@ fn render_reports_bad_input_without_panicking() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(err.contains(msg), "{a:?}: {err}");
     }
+    let jpg = dir.path().join("x.jpg");
+    let o = mote(&[
+        "render",
+        good.to_str().unwrap(),
+        "-o",
+        jpg.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success() && !jpg.exists());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("ending in .png"));
     let o = mote(&["render", "--help"]);
     assert!(o.status.success());
     assert!(String::from_utf8_lossy(&o.stdout).contains("--anaglyph"));
 }
 
 #[test]
-#[ignore = "enable once `mote plot` is wired into main.rs"]
 fn plot_uses_units_from_the_header() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("e.csv");

@@ -2,7 +2,9 @@
 
 pub mod edmd;
 pub mod examples;
+pub mod plot;
 pub mod rcp;
+pub mod render;
 pub mod run;
 
 /// Options every subcommand understands.

@@ -127,11 +127,28 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         );
     };
     let range = a.range.as_deref().map(parse_range).transpose()?;
+    let is_png = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    };
+    if !is_png(&a.output) {
+        bail!(
+            "-o {}: pictures are written as PNG; give a name ending in .png",
+            a.output.display()
+        );
+    }
     if a.samples == 0 || a.samples > 8 {
         bail!("--samples must be 1 to 8, not {}", a.samples);
     }
     if a.fov.is_nan() || a.fov <= 0.0 || a.fov >= 179.0 {
         bail!("--fov must be between 0 and 179 degrees, not {}", a.fov);
+    }
+    for p in std::iter::once(&a.output).chain(a.pov.as_ref()) {
+        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+        }
     }
     let frames = read_trajectory(&a.traj)?;
     if frames.is_empty() {
@@ -160,6 +177,35 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         samples: a.samples,
         ..RenderOptions::default()
     };
+    // A movie keeps one camera and one colour range for all its frames: the
+    // union of the frames' bounds and of their quantity ranges.
+    let mut range = range;
+    let mut movie_bounds: Option<(Vec3, Vec3)> = None;
+    if chosen.len() > 1 {
+        let mut qlo = f64::INFINITY;
+        let mut qhi = f64::NEG_INFINITY;
+        for &k in &chosen {
+            let frame = &frames[k];
+            let radius = a.radius.unwrap_or_else(|| default_radius(frame));
+            let (mut scene, coloring) = scene_from_frame(frame, &color_by, map, radius)?;
+            if a.images {
+                scene.add_periodic_images(frame.pbc);
+            }
+            if let Some((lo, hi)) = scene.bounds() {
+                movie_bounds = Some(match movie_bounds {
+                    Some((l, h)) => (l.min(lo), h.max(hi)),
+                    None => (lo, hi),
+                });
+            }
+            if let Some((lo, hi)) = coloring.range {
+                qlo = qlo.min(lo);
+                qhi = qhi.max(hi);
+            }
+        }
+        if range.is_none() && qlo < qhi {
+            range = Some((qlo, qhi));
+        }
+    }
     for (n, &k) in chosen.iter().enumerate() {
         let frame = &frames[k];
         let out = if a.all {
@@ -179,7 +225,7 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         if a.images {
             scene.add_periodic_images(frame.pbc);
         }
-        let Some((lo, hi)) = scene.bounds() else {
+        let Some((lo, hi)) = movie_bounds.or_else(|| scene.bounds()) else {
             bail!("{}: frame {k} has nothing to draw", a.traj.display());
         };
         let view = opts_view.unwrap_or(mote_render::camera::DEFAULT_VIEW);
@@ -194,10 +240,12 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
             let (lo, hi) = range.or(coloring.range).unwrap_or((0.0, 1.0));
             mote_render::overlay::color_bar(&mut img, map, lo, hi, q)?;
         }
-        img.write_png(&out)?;
+        // (RenderError's text names the file and its cause already.)
+        img.write_png(&out).map_err(|e| anyhow::anyhow!("{e}"))?;
         if let Some(pov) = &a.pov {
             let pov = if a.all { numbered(pov, n) } else { pov.clone() };
-            mote_render::pov::write_pov(&pov, &scene, &cam, &opts)?;
+            mote_render::pov::write_pov(&pov, &scene, &cam, &opts)
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
         }
         if !global.quiet {
             eprintln!(
