@@ -13,11 +13,13 @@ use crate::particles::System;
 use crate::simulation::Observer;
 use crate::units::UnitSystem;
 
-/// observables.csv: time, energies, momentum, angular momentum, step, probes.
+/// observables.csv: time, energies, momentum, angular momentum, step, k_B T,
+/// the pressure (only for a box periodic on every axis), probes.
 pub struct ObservablesCsv {
     writer: CsvWriter,
     every: u64,
     probes: Vec<Probe>,
+    pressure: bool,
 }
 
 impl ObservablesCsv {
@@ -27,6 +29,7 @@ impl ObservablesCsv {
         units: UnitSystem,
         every: u64,
         probes: Vec<Probe>,
+        pressure: bool,
     ) -> Result<Self, MdError> {
         let [l, t, m, e] = units.labels();
         let p = format!("{m}*{l}/{t}");
@@ -47,6 +50,10 @@ impl ObservablesCsv {
             e.into(),
             format!("{e}/{l}^3"),
         ];
+        if !pressure {
+            columns.pop();
+            unit_row.pop();
+        }
         for probe in &probes {
             columns.push(probe.label());
             let label = probe.label();
@@ -61,6 +68,7 @@ impl ObservablesCsv {
             writer: CsvWriter::create(path, provenance, &columns, &unit_row)?,
             every,
             probes,
+            pressure,
         })
     }
 }
@@ -72,6 +80,9 @@ impl Observer for ObservablesCsv {
 
     fn observe(&mut self, sys: &System, obs: &Observables) -> Result<(), MdError> {
         let mut row: Vec<f64> = obs.values(sys.step).to_vec();
+        if !self.pressure {
+            row.pop();
+        }
         row.extend(self.probes.iter().map(|p| p.read(sys)));
         Ok(self.writer.row(&row)?)
     }
@@ -96,16 +107,26 @@ impl TrajectoryXyz {
     }
 }
 
-/// The system as a plain frame (open boundaries: the cell encloses the particles).
+/// The system as a plain frame: the cell is the simulation box when it is
+/// finite, else a box enclosing the particles.
 pub fn frame_of(sys: &System) -> Frame {
     let p = &sys.particles;
     let positions: Vec<[f64; 3]> = p.position.iter().map(|r| r.to_array()).collect();
-    let (cell, origin) = Frame::bounding_cell(&positions, &p.radius, 0.0);
+    let b = &sys.boundary;
+    let (cell, origin) = if b.volume().is_finite() {
+        let l = b.lengths();
+        (
+            [[l.x, 0.0, 0.0], [0.0, l.y, 0.0], [0.0, 0.0, l.z]],
+            b.lo.to_array(),
+        )
+    } else {
+        Frame::bounding_cell(&positions, &p.radius, 0.0)
+    };
     Frame {
         time: sys.time,
         cell,
         origin,
-        pbc: [false; 3],
+        pbc: b.periodic,
         species: vec!["X".to_string(); p.len()],
         positions,
         velocities: p.velocity.iter().map(|v| v.to_array()).collect(),

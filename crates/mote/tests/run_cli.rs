@@ -274,3 +274,29 @@ fn ase_reads_the_trajectory() {
         .collect();
     assert_eq!(ase_values, mine);
 }
+
+/// `--picture` ray-traces the final state into a 1920×1080 PNG.
+#[test]
+fn picture_of_the_final_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &[
+            "run",
+            "example:membrane",
+            "--steps",
+            "5",
+            "-q",
+            "-o",
+            "m",
+            "--picture",
+            "m.png",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(dir.path().join("m.png")).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let width = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
+    let height = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
+    assert_eq!((width, height), (1920, 1080));
+}

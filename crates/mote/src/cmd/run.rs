@@ -36,6 +36,9 @@ pub struct RunArgs {
     /// Folder for the output files (default: the scene's, or out/NAME).
     #[arg(long, short = 'o', value_name = "DIR")]
     pub output: Option<PathBuf>,
+    /// Ray-trace the final state into this PNG (1920×1080, shadows, box drawn).
+    #[arg(long, value_name = "FILE.png")]
+    pub picture: Option<PathBuf>,
 }
 
 /// The input text and the name it goes by in messages and headers.
@@ -148,6 +151,7 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             scene.units,
             out.observables_every,
             built.probes.clone(),
+            sim.system.boundary.periodic.iter().all(|p| *p),
         )?));
     }
     if out.trajectory_every > 0 {
@@ -194,8 +198,16 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
     bar.finish_and_clear();
     match result {
         Ok(report) => {
+            if let Some(png) = &args.picture {
+                let frame = mote_md::output::frame_of(&sim.system);
+                mote_render::frame::picture(&frame, png, 1920, 1080)
+                    .with_context(|| format!("cannot draw {}", png.display()))?;
+            }
             if !global.quiet {
                 summary(&report, &scene, &dir, steps);
+                if let Some(png) = &args.picture {
+                    println!("Picture of the final state: {}.", png.display());
+                }
             }
             Ok(ExitCode::SUCCESS)
         }
