@@ -1,4 +1,4 @@
-//! Timed runs for bench/results-edmd.md.
+//! Timed runs for BENCHMARKS.md.
 //!
 //! `cargo run --release -p mote-edmd --example edmd_bench -- eos D N ETA T [EQUIL] [SEED]`
 //!   monodisperse diameter 1, kT = 1, fcc/square start, periodic; prints
