@@ -111,6 +111,80 @@ pub(super) unsafe fn pairs(
     )
 }
 
+/// [`pairs`] for rows i and i + 1 over the same j range `j_start..j_end`
+/// (j_start a multiple of 8): both rows' pulls are returned and the
+/// reactions of row i, then of row i + 1, are subtracted per j block — the
+/// same operations in the same order as two calls of [`pairs`].
+///
+/// # Safety
+/// As for [`pairs`], with j_start a multiple of 8 and i + 1 < the slices' length.
+#[target_feature(enable = "avx512f")]
+#[allow(clippy::too_many_arguments)]
+pub(super) unsafe fn pairs2(
+    i: usize,
+    j_start: usize,
+    j_end: usize,
+    p: Soa,
+    eps2: f64,
+    base: usize,
+    rx: &mut [f64],
+    ry: &mut [f64],
+    rz: &mut [f64],
+) -> (DVec3, DVec3) {
+    debug_assert!(
+        j_start.is_multiple_of(8)
+            && j_end.is_multiple_of(8)
+            && j_end <= p.x.len()
+            && base <= j_start
+    );
+    let (r0, r1) = (broadcast(p, i), broadcast(p, i + 1));
+    let (m0, m1) = (_mm512_set1_pd(p.m[i]), _mm512_set1_pd(p.m[i + 1]));
+    let veps2 = _mm512_set1_pd(eps2);
+    let zero = _mm512_setzero_pd();
+    let mut a0 = [zero; 3];
+    let mut a1 = [zero; 3];
+    let mut j = j_start;
+    while j < j_end {
+        // SAFETY: j + 8 ≤ j_end ≤ len, and j − base + 8 ≤ the reaction slices' length.
+        let (d0, mj, r2_0) = separations(p, j, r0, veps2);
+        let (d1, _, r2_1) = separations(p, j, r1, veps2);
+        let y0 = rsqrt(r2_0);
+        let y1 = rsqrt(r2_1);
+        let s0 = _mm512_maskz_mul_pd(
+            _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2_0, zero),
+            _mm512_mul_pd(y0, y0),
+            y0,
+        );
+        let s1 = _mm512_maskz_mul_pd(
+            _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2_1, zero),
+            _mm512_mul_pd(y1, y1),
+            y1,
+        );
+        let (sj0, sj1) = (_mm512_mul_pd(s0, mj), _mm512_mul_pd(s1, mj));
+        let (si0, si1) = (_mm512_mul_pd(s0, m0), _mm512_mul_pd(s1, m1));
+        let k = j - base;
+        for (c, r) in [rx.as_mut_ptr(), ry.as_mut_ptr(), rz.as_mut_ptr()]
+            .into_iter()
+            .enumerate()
+        {
+            a0[c] = _mm512_fmadd_pd(sj0, d0[c], a0[c]);
+            a1[c] = _mm512_fmadd_pd(sj1, d1[c], a1[c]);
+            let pr = r.add(k);
+            let after0 = _mm512_fnmadd_pd(si0, d0[c], _mm512_loadu_pd(pr));
+            _mm512_storeu_pd(pr, _mm512_fnmadd_pd(si1, d1[c], after0));
+        }
+        j += 8;
+    }
+    let sum = |a: [__m512d; 3]| {
+        DVec3::new(
+            _mm512_reduce_add_pd(a[0]),
+            _mm512_reduce_add_pd(a[1]),
+            _mm512_reduce_add_pd(a[2]),
+        )
+    };
+    (sum(a0), sum(a1))
+}
+
 /// See [`super::portable::field_at`].
 ///
 /// # Safety
