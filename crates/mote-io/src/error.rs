@@ -42,7 +42,10 @@ pub enum IoError {
     /// The cause is part of the message (and not chained as a source, so
     /// that `{:#}` does not print it twice).
     #[error("{path}: {cause}")]
-    Os { path: PathBuf, cause: std::io::Error },
+    Os {
+        path: PathBuf,
+        cause: std::io::Error,
+    },
 }
 
 impl IoError {
