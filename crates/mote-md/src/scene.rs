@@ -874,7 +874,13 @@ pub enum PlistSystem {
 impl Scene {
     /// The scene twin of an MPPphys particle file: the same particles, forces
     /// and step, so both inputs run identical physics.
-    pub fn from_plist(pf: &ParticleFile, system: PlistSystem, solver: &str) -> Scene {
+    /// `file` names the particle file in errors.
+    pub fn from_plist(
+        pf: &ParticleFile,
+        system: PlistSystem,
+        solver: &str,
+        file: &str,
+    ) -> Result<Scene, ParseError> {
         let mut scene = Scene {
             title: "MPPphys particle file".into(),
             units: UnitSystem::Astro,
@@ -912,7 +918,13 @@ impl Scene {
                         .spring_types
                         .iter()
                         .find(|s| s.id == link.kind)
-                        .expect("spring types are checked by the reader");
+                        .ok_or_else(|| {
+                            ParseError::new(
+                                file,
+                                0,
+                                format!("spring type {} is not defined", link.kind),
+                            )
+                        })?;
                     scene.spring.push(Spanned::new(
                         0..0,
                         SpringSpec {
@@ -927,6 +939,6 @@ impl Scene {
         }
         scene.field = pf.gravity.map(|g| FieldSettings { g });
         scene.damping = pf.damping.map(|gamma| DampingSettings { gamma });
-        scene
+        Ok(scene)
     }
 }

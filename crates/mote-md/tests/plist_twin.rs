@@ -6,7 +6,7 @@ use mote_md::scene::{PlistSystem, Scene};
 
 fn run_plist(text: &str, system: PlistSystem, solver: &str, n: u64) -> Vec<mote_md::DVec3> {
     let pf = mote_io::plist::parse(text, "twin.plist").unwrap();
-    let scene = Scene::from_plist(&pf, system, solver);
+    let scene = Scene::from_plist(&pf, system, solver, "twin.plist").unwrap();
     let mut sim = scene.build("", "twin.plist", 1).unwrap().simulation;
     common::steps(&mut sim, n, |_| {});
     sim.system.particles.position

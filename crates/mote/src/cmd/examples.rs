@@ -34,5 +34,6 @@ pub fn run(global: &super::GlobalOpts, args: ExamplesArgs) -> anyhow::Result<Exi
         println!("{:width$}  {}", e.name, examples::title(&e.text));
     }
     println!("\nrun one with `mote run example:NAME`; copy them with `mote examples --write DIR`");
+    println!("event-driven hard-sphere examples: `mote edmd --list`");
     Ok(ExitCode::SUCCESS)
 }

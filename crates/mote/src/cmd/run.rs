@@ -99,7 +99,7 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         };
         let pf = mote_io::plist::parse(&input.text, &input.label)?;
         let solver = args.solver.clone().unwrap_or_else(|| "leapfrog".into());
-        Scene::from_plist(&pf, system, &solver)
+        Scene::from_plist(&pf, system, &solver, &input.label)?
     } else {
         let mut scene = Scene::parse(&input.text, &input.label)?;
         if let Some(s) = &args.solver {
