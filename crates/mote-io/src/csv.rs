@@ -42,6 +42,20 @@ impl CsvWriter {
         })
     }
 
+    /// Opens an existing table to append rows (a resumed run); the header is
+    /// already there.
+    pub fn append(path: &Path, columns: usize) -> Result<Self, IoError> {
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(|e| IoError::os(path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out: BufWriter::new(file),
+            columns,
+        })
+    }
+
     /// Appends one row (must have as many values as there are columns).
     pub fn row(&mut self, values: &[f64]) -> Result<(), IoError> {
         debug_assert_eq!(values.len(), self.columns);

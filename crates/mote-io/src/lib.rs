@@ -4,6 +4,7 @@
 //! numbers and strings. Every reader reports bad input as
 //! `file:line: what is wrong` ([`ParseError`]).
 
+pub mod checkpoint;
 pub mod csv;
 pub mod error;
 pub mod header;

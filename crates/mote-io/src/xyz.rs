@@ -78,6 +78,19 @@ impl XyzWriter {
         })
     }
 
+    /// Opens an existing trajectory to append frames (a resumed run).
+    pub fn append(path: &Path, provenance: Provenance) -> Result<Self, IoError> {
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(|e| IoError::os(path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out: BufWriter::new(file),
+            provenance,
+        })
+    }
+
     pub fn write(&mut self, frame: &Frame) -> Result<(), IoError> {
         write_frame(&mut self.out, frame, &self.provenance)
             .and_then(|_| self.out.flush())

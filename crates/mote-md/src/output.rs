@@ -30,6 +30,7 @@ impl ObservablesCsv {
         every: u64,
         probes: Vec<Probe>,
         pressure: bool,
+        append: bool,
     ) -> Result<Self, MdError> {
         let [l, t, m, e] = units.labels();
         let p = format!("{m}*{l}/{t}");
@@ -65,7 +66,11 @@ impl ObservablesCsv {
             unit_row.push(unit);
         }
         Ok(Self {
-            writer: CsvWriter::create(path, provenance, &columns, &unit_row)?,
+            writer: if append {
+                CsvWriter::append(path, columns.len())?
+            } else {
+                CsvWriter::create(path, provenance, &columns, &unit_row)?
+            },
             every,
             probes,
             pressure,
@@ -99,9 +104,18 @@ pub struct TrajectoryXyz {
 }
 
 impl TrajectoryXyz {
-    pub fn create(path: &Path, provenance: Provenance, every: u64) -> Result<Self, MdError> {
+    pub fn create(
+        path: &Path,
+        provenance: Provenance,
+        every: u64,
+        append: bool,
+    ) -> Result<Self, MdError> {
         Ok(Self {
-            writer: XyzWriter::create(path, provenance)?,
+            writer: if append {
+                XyzWriter::append(path, provenance)?
+            } else {
+                XyzWriter::create(path, provenance)?
+            },
             every,
         })
     }

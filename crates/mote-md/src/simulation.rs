@@ -39,7 +39,8 @@ impl RunLength {
 
 /// Something that samples the run on a schedule (writers, recorders).
 pub trait Observer {
-    /// Sample every this many steps (≥ 1); step 0 and the last step are always sampled.
+    /// Sample when the step number is a multiple of this (≥ 1); the first
+    /// and the last step of a run are always sampled.
     fn every(&self) -> u64;
     /// Samples the state; `obs` holds the whole-system observables of this instant.
     fn observe(&mut self, sys: &System, obs: &Observables) -> Result<(), MdError>;
@@ -70,8 +71,13 @@ pub struct Simulation {
     pub observers: Vec<Box<dyn Observer>>,
     /// Applied after every step (NVE when `None`).
     pub thermostat: Option<Thermostat>,
-    /// The run's random stream (thermostat noise), seeded from the run's seed.
-    pub rng: Xoshiro256PlusPlus,
+    /// The run's seed. Thermostat noise of step k comes from a generator
+    /// seeded by (seed, k) ([`Simulation::noise`]), so a run resumed from a
+    /// checkpoint draws exactly the numbers the uninterrupted run would.
+    pub seed: u64,
+    /// Hand the starting state to the observers (false when resuming: the
+    /// interrupted run already wrote it).
+    pub sample_at_start: bool,
 }
 
 impl Simulation {
@@ -91,16 +97,26 @@ impl Simulation {
         let e0 = initial.total_energy();
         let mut max_err: f64 = 0.0;
         let mut last = initial;
-        self.sample(0, steps, &initial)?;
+        if self.sample_at_start {
+            self.sample(true, &initial)?;
+        }
         for k in 1..=steps {
             self.stepper
                 .step(&mut self.system, &mut self.forces, self.dt);
+            if let Some(t) = self.thermostat {
+                let mut rng = self.noise(self.system.step);
+                t.apply(&mut self.system, self.dt, &mut rng);
+            }
             self.check_finite()?;
-            let due = k == steps
+            // Schedules count absolute steps, so a resumed run samples
+            // exactly where the uninterrupted one would.
+            let step = self.system.step;
+            let last_step = k == steps;
+            let due = last_step
                 || self
                     .observers
                     .iter()
-                    .any(|o| k.is_multiple_of(o.every().max(1)));
+                    .any(|o| step.is_multiple_of(o.every().max(1)));
             if due {
                 last = Observables::measure(&self.system, &mut self.forces);
                 let err = if e0 != 0.0 {
@@ -109,7 +125,7 @@ impl Simulation {
                     (last.total_energy() - e0).abs()
                 };
                 max_err = max_err.max(err);
-                self.sample(k, steps, &last)?;
+                self.sample(last_step, &last)?;
             }
             progress(&self.system);
         }
@@ -123,9 +139,20 @@ impl Simulation {
         })
     }
 
-    fn sample(&mut self, k: u64, steps: u64, obs: &Observables) -> Result<(), MdError> {
+    /// The random stream of step `step`: xoshiro256++ seeded (through
+    /// SplitMix64) from the run's seed and the step number.
+    pub fn noise(&self, step: u64) -> Xoshiro256PlusPlus {
+        use rand::SeedableRng;
+        Xoshiro256PlusPlus::seed_from_u64(
+            self.seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(17),
+        )
+    }
+
+    /// Hands the state to the observers due at this step (all of them when `always`).
+    fn sample(&mut self, always: bool, obs: &Observables) -> Result<(), MdError> {
+        let step = self.system.step;
         for o in &mut self.observers {
-            if k == 0 || k == steps || k.is_multiple_of(o.every().max(1)) {
+            if always || step.is_multiple_of(o.every().max(1)) {
                 o.observe(&self.system, obs)?;
             }
         }

@@ -41,7 +41,8 @@ tau = 0.1
         for _ in 0..steps {
             sim.stepper.step(&mut sim.system, &mut sim.forces, sim.dt);
             if let Some(t) = sim.thermostat {
-                t.apply(&mut sim.system, sim.dt, &mut sim.rng);
+                let mut noise = sim.noise(sim.system.step);
+                t.apply(&mut sim.system, sim.dt, &mut noise);
             }
         }
     };

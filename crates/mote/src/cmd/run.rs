@@ -7,17 +7,25 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::Provenance;
 use mote_md::output::{ObservablesCsv, TrajectoryXyz};
 use mote_md::scene::{PlistSystem, Scene};
-use mote_md::{MdError, RunLength, RunReport};
+use mote_md::{MdError, Observables, Observer, RunLength, RunReport, System};
 
 use crate::examples;
 
-#[derive(clap::Args, Debug)]
+#[derive(clap::Args, Debug, Clone)]
 pub struct RunArgs {
     /// Scene file (.toml), MPPphys particle file (.plist or any other name), or `example:NAME`.
-    pub input: String,
+    #[arg(required_unless_present = "resume")]
+    pub input: Option<String>,
+    /// Continue a run from its checkpoint, bit for bit as if it had not stopped.
+    #[arg(long, value_name = "CHECKPOINT", conflicts_with_all = ["input", "until", "steps", "dt", "solver", "output"])]
+    pub resume: Option<PathBuf>,
+    /// Write DIR/checkpoint.mote every N steps and at the end (atomically).
+    #[arg(long, value_name = "N")]
+    pub checkpoint_every: Option<u64>,
     /// Run until this simulated time (overrides the scene).
     #[arg(long, value_name = "T", conflicts_with = "steps")]
     pub until: Option<f64>,
@@ -88,9 +96,118 @@ fn fresh_seed() -> u64 {
     (t.as_nanos() as u64 ^ (std::process::id() as u64) << 32) % 1_000_000_007
 }
 
+/// Writes DIR/checkpoint.mote on its schedule: the run's input and options
+/// (`template`) with the current state.
+struct CheckpointWriter {
+    path: PathBuf,
+    every: u64,
+    template: Checkpoint,
+}
+
+impl Observer for CheckpointWriter {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, sys: &System, _obs: &Observables) -> Result<(), MdError> {
+        let p = &sys.particles;
+        let cp = Checkpoint {
+            time: sys.time,
+            step: sys.step,
+            positions: p.position.iter().map(|r| r.to_array()).collect(),
+            velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
+            ..self.template.clone()
+        };
+        Ok(checkpoint::write(&self.path, &cp)?)
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.path.display().to_string()]
+    }
+}
+
+fn hex(x: f64) -> String {
+    format!("{:016x}", x.to_bits())
+}
+
+fn unhex(s: &str) -> anyhow::Result<f64> {
+    Ok(f64::from_bits(
+        u64::from_str_radix(s, 16).context("a checkpoint option is not a hexadecimal f64")?,
+    ))
+}
+
+/// Drops what an interrupted run wrote after its last checkpoint (rows past
+/// `step`, frames past `time`), so the resumed run continues the files.
+fn trim_outputs(dir: &Path, step: u64, time: f64, provenance: &Provenance) -> anyhow::Result<()> {
+    let csv = dir.join("observables.csv");
+    if let Ok(text) = std::fs::read_to_string(&csv) {
+        let mut column = None;
+        let mut kept = String::new();
+        for line in text.lines() {
+            let keep = if line.starts_with('#') {
+                true
+            } else if let Some(k) = column {
+                line.split(',')
+                    .nth(k)
+                    .and_then(|v| v.trim().parse::<f64>().ok())
+                    .is_some_and(|s| s <= step as f64)
+            } else {
+                column = line.split(',').position(|c| c.trim() == "step");
+                true
+            };
+            if keep {
+                kept.push_str(line);
+                kept.push('\n');
+            }
+        }
+        std::fs::write(&csv, kept).with_context(|| format!("cannot rewrite {}", csv.display()))?;
+    }
+    let xyz = dir.join("trajectory.xyz");
+    if xyz.exists() {
+        let frames = mote_io::xyz::read_frames(&xyz)?;
+        let mut w = mote_io::xyz::XyzWriter::create(&xyz, provenance.clone())?;
+        for f in frames.iter().filter(|f| f.time <= time) {
+            w.write(f)?;
+        }
+    }
+    Ok(())
+}
+
+/// The input and the options of the run a checkpoint came from.
+fn restore(cp: &Checkpoint) -> anyhow::Result<(Input, RunArgs)> {
+    let get = |k: &str| cp.option(k).map(str::to_string);
+    let input = Input {
+        name: get("name").unwrap_or_else(|| "run".into()),
+        label: cp.input_label.clone(),
+        text: cp.input_text.clone(),
+        plist: get("plist").as_deref() == Some("true"),
+    };
+    let args = RunArgs {
+        input: None,
+        resume: None,
+        checkpoint_every: get("checkpoint-every").map(|v| v.parse()).transpose()?,
+        until: None,
+        steps: get("total-steps").map(|v| v.parse()).transpose()?,
+        dt: get("dt").map(|v| unhex(&v)).transpose()?,
+        system: get("system").unwrap_or_else(|| "nbody".into()),
+        solver: get("solver"),
+        output: get("output").map(PathBuf::from),
+        picture: None,
+    };
+    Ok((input, args))
+}
+
 pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode> {
     global.init_threads()?;
-    let input = read_input(&args.input)?;
+    let resumed = match &args.resume {
+        Some(path) => Some(checkpoint::read(path)?),
+        None => None,
+    };
+    let picture = args.picture.clone();
+    let (input, args) = match &resumed {
+        Some(cp) => restore(cp)?,
+        None => (read_input(args.input.as_deref().unwrap_or_default())?, args),
+    };
     let scene = if input.plist {
         let system = match args.system.as_str() {
             "nbody" => PlistSystem::Nbody,
@@ -117,7 +234,11 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             input.label
         );
     }
-    let seed_given = global.seed.or(scene.seed);
+    let seed_given = resumed
+        .as_ref()
+        .map(|cp| cp.seed)
+        .or(global.seed)
+        .or(scene.seed);
     let seed = seed_given.unwrap_or_else(fresh_seed);
     let mut built = scene.build(&input.text, &input.label, seed)?;
     let length = match (args.steps, args.until, built.length) {
@@ -137,11 +258,36 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
+    let total_steps = length.steps_from(built.simulation.system.time, built.simulation.dt);
+    let append = resumed.is_some();
+    if let Some(cp) = &resumed {
+        let sys = &mut built.simulation.system;
+        if cp.positions.len() != sys.particles.len() {
+            bail!(
+                "{}: the checkpoint has {} particles, its scene makes {}",
+                input.label,
+                cp.positions.len(),
+                sys.particles.len()
+            );
+        }
+        sys.time = cp.time;
+        sys.step = cp.step;
+        for (i, (r, v)) in cp.positions.iter().zip(&cp.velocities).enumerate() {
+            sys.particles.position[i] = mote_md::DVec3::from(*r);
+            sys.particles.velocity[i] = mote_md::DVec3::from(*v);
+        }
+        built.simulation.sample_at_start = false;
+    }
+    let length =
+        RunLength::Steps(total_steps - resumed.as_ref().map_or(0, |cp| cp.step.min(total_steps)));
     let provenance = Provenance {
         program: format!("mote {}", env!("CARGO_PKG_VERSION")),
         scene: input.label.clone(),
         seed,
     };
+    if let Some(cp) = &resumed {
+        trim_outputs(&dir, cp.step, cp.time, &provenance)?;
+    }
     let out = &scene.output;
     let sim = &mut built.simulation;
     if out.observables_every > 0 {
@@ -152,6 +298,7 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             out.observables_every,
             built.probes.clone(),
             sim.system.boundary.periodic.iter().all(|p| *p),
+            append,
         )?));
     }
     if out.trajectory_every > 0 {
@@ -159,7 +306,34 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             &dir.join("trajectory.xyz"),
             provenance.clone(),
             out.trajectory_every,
+            append,
         )?));
+    }
+    if let Some(every) = args.checkpoint_every {
+        let mut options = vec![
+            ("name".to_string(), input.name.clone()),
+            ("plist".to_string(), input.plist.to_string()),
+            ("system".to_string(), args.system.clone()),
+            ("total-steps".to_string(), total_steps.to_string()),
+            ("checkpoint-every".to_string(), every.to_string()),
+            ("dt".to_string(), hex(sim.dt)),
+            ("output".to_string(), dir.display().to_string()),
+        ];
+        if let Some(s) = &args.solver {
+            options.push(("solver".to_string(), s.clone()));
+        }
+        sim.observers.push(Box::new(CheckpointWriter {
+            path: dir.join("checkpoint.mote"),
+            every: every.max(1),
+            template: Checkpoint {
+                program: provenance.program.clone(),
+                seed,
+                options,
+                input_label: input.label.clone(),
+                input_text: input.text.clone(),
+                ..Checkpoint::default()
+            },
+        }));
     }
 
     let steps = length.steps_from(sim.system.time, sim.dt);
@@ -198,14 +372,14 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
     bar.finish_and_clear();
     match result {
         Ok(report) => {
-            if let Some(png) = &args.picture {
+            if let Some(png) = &picture {
                 let frame = mote_md::output::frame_of(&sim.system);
                 mote_render::frame::picture(&frame, png, 1920, 1080)
                     .with_context(|| format!("cannot draw {}", png.display()))?;
             }
             if !global.quiet {
                 summary(&report, &scene, &dir, steps);
-                if let Some(png) = &args.picture {
+                if let Some(png) = &picture {
                     println!("Picture of the final state: {}.", png.display());
                 }
             }

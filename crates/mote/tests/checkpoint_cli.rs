@@ -1,0 +1,140 @@
+//! Checkpoints: a run killed with SIGKILL and resumed from its last
+//! checkpoint ends in the same state, bit for bit, as an uninterrupted run
+//! (thermostat noise included).
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+const SCENE: &str = r#"
+title = "LJ liquid with a Bussi thermostat (checkpoint test)"
+units = "lj"
+seed = 3
+[run]
+integrator = "leapfrog"
+dt = 0.005
+steps = 3000
+[lennard_jones]
+cutoff = 2.5
+[[fcc]]
+cells = [4, 4, 4]
+density = 0.8
+kt = 1.5
+[thermostat]
+kind = "bussi"
+kt = 1.0
+tau = 0.2
+[output]
+observables_every = 100
+trajectory_every = 500
+"#;
+
+fn mote(args: &[&str], dir: &Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+fn state(path: &Path) -> (u64, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let cp = mote_io::checkpoint::read(path).unwrap();
+    (cp.step, cp.positions, cp.velocities)
+}
+
+#[test]
+fn killed_run_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("lj.toml"), SCENE).unwrap();
+    let o = mote(
+        &[
+            "run",
+            "lj.toml",
+            "--threads",
+            "1",
+            "-q",
+            "-o",
+            "whole",
+            "--checkpoint-every",
+            "200",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let whole = state(&dir.path().join("whole/checkpoint.mote"));
+    assert_eq!(whole.0, 3000);
+
+    // The same run, killed once a checkpoint past the start exists.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args([
+            "run",
+            "lj.toml",
+            "--threads",
+            "1",
+            "-q",
+            "-o",
+            "cut",
+            "--checkpoint-every",
+            "200",
+        ])
+        .current_dir(dir.path())
+        .spawn()
+        .unwrap();
+    let cp_path = dir.path().join("cut/checkpoint.mote");
+    let start = Instant::now();
+    loop {
+        if let Ok(cp) = mote_io::checkpoint::read(&cp_path) {
+            if cp.step >= 400 {
+                break;
+            }
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no checkpoint appeared"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    let at_kill = state(&cp_path).0;
+    assert!(
+        at_kill < 3000,
+        "the run finished before it could be killed (step {at_kill})"
+    );
+
+    let o = mote(
+        &[
+            "run",
+            "--resume",
+            "cut/checkpoint.mote",
+            "--threads",
+            "1",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let resumed = state(&cp_path);
+    assert_eq!(resumed.0, 3000);
+    let bits = |v: &Vec<[f64; 3]>| {
+        v.iter()
+            .flatten()
+            .map(|x| x.to_bits())
+            .collect::<Vec<u64>>()
+    };
+    assert_eq!(
+        bits(&resumed.1),
+        bits(&whole.1),
+        "positions differ (killed at step {at_kill})"
+    );
+    assert_eq!(bits(&resumed.2), bits(&whole.2), "velocities differ");
+    // The observables continue without a repeated or missing row.
+    let t = mote_io::csv::read_table(&dir.path().join("cut/observables.csv")).unwrap();
+    let steps = t.column("step").unwrap();
+    assert!(steps.windows(2).all(|w| w[1] > w[0]), "{steps:?}");
+    assert_eq!(*steps.last().unwrap(), 3000.0);
+    // The thermostat of the scene acted: the liquid started at kT = 1.5.
+    let kt = t.column("kT").unwrap();
+    let late: f64 = kt[kt.len() - 10..].iter().sum::<f64>() / 10.0;
+    assert!((late - 1.0).abs() < 0.1, "kT at the end {late}");
+}
