@@ -26,6 +26,9 @@ pub struct Checkpoint {
     pub step: u64,
     pub positions: Vec<[f64; 3]>,
     pub velocities: Vec<[f64; 3]>,
+    /// Integrator state carried from step to step (leap-frog's last
+    /// accelerations); empty when there is none.
+    pub accelerations: Vec<[f64; 3]>,
 }
 
 impl Checkpoint {
@@ -63,6 +66,12 @@ pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), IoError> {
     text.push_str(&format!("particles {}\n", cp.positions.len()));
     for (r, v) in cp.positions.iter().zip(&cp.velocities) {
         let w: Vec<String> = r.iter().chain(v.iter()).map(|x| hex(*x)).collect();
+        text.push_str(&w.join(" "));
+        text.push('\n');
+    }
+    text.push_str(&format!("accelerations {}\n", cp.accelerations.len()));
+    for a in &cp.accelerations {
+        let w: Vec<String> = a.iter().map(|x| hex(*x)).collect();
         text.push_str(&w.join(" "));
         text.push('\n');
     }
@@ -143,6 +152,24 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
                 }
                 k += n;
             }
+            "accelerations" => {
+                let n: usize = rest
+                    .parse()
+                    .map_err(|_| err(k, "accelerations needs a count"))?;
+                for j in 0..n {
+                    let ln = k + 1 + j;
+                    let w: Vec<&str> = lines
+                        .get(ln)
+                        .map(|l| l.split_whitespace().collect())
+                        .unwrap_or_default();
+                    if w.len() != 3 {
+                        return Err(err(ln, "expected three hexadecimal f64: ax ay az").into());
+                    }
+                    cp.accelerations
+                        .push([bits(w[0], ln)?, bits(w[1], ln)?, bits(w[2], ln)?]);
+                }
+                k += n;
+            }
             "" => {}
             other => return Err(err(k, &format!("unknown record '{other}'")).into()),
         }
@@ -172,6 +199,7 @@ mod tests {
             step: 3,
             positions: vec![[1.0 / 3.0, -0.0, 1e-300], [f64::MAX, 2.5, -7.25]],
             velocities: vec![[0.1, 0.2, 0.3], [std::f64::consts::PI, 0.0, -1.0]],
+            accelerations: vec![[1e-9, -2.0, 3.5], [0.0, 0.0, 1.0]],
         };
         write(&path, &cp).unwrap();
         let back = read(&path).unwrap();

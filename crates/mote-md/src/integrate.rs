@@ -67,8 +67,6 @@ impl Integrator {
 pub struct Stepper {
     pub scheme: Integrator,
     acc: Vec<DVec3>,
-    /// Leap-frog reuses a(x) of the previous step's end while this is true.
-    acc_valid: bool,
     x0: Vec<DVec3>,
     v0: Vec<DVec3>,
     xs: Vec<DVec3>,
@@ -82,7 +80,6 @@ impl Stepper {
         Self {
             scheme,
             acc: Vec::new(),
-            acc_valid: false,
             x0: Vec::new(),
             v0: Vec::new(),
             xs: Vec::new(),
@@ -90,11 +87,6 @@ impl Stepper {
             dx: Vec::new(),
             dv: Vec::new(),
         }
-    }
-
-    /// Forget cached forces (after the state or the force field was changed from outside).
-    pub fn invalidate(&mut self) {
-        self.acc_valid = false;
     }
 
     fn eval(
@@ -138,11 +130,13 @@ impl Stepper {
                     p.position[i] += if explicit { v_old } else { p.velocity[i] } * h;
                 }
                 self.acc = acc;
-                self.acc_valid = false;
+                sys.carried_acceleration.clear();
             }
             Integrator::LeapFrog => {
-                let mut acc = std::mem::take(&mut self.acc);
-                if !self.acc_valid || acc.len() != sys.particles.len() {
+                // a(x) of the previous step's end is carried in the system
+                // (and in checkpoints), so it is evaluated once per step.
+                let mut acc = std::mem::take(&mut sys.carried_acceleration);
+                if acc.len() != sys.particles.len() {
                     Self::eval(
                         ff,
                         sys,
@@ -172,8 +166,7 @@ impl Stepper {
                 for i in 0..p.len() {
                     p.velocity[i] += acc[i] * half;
                 }
-                self.acc = acc;
-                self.acc_valid = true;
+                sys.carried_acceleration = acc;
             }
             Integrator::Rk4 => self.rk4(sys, ff, h),
         }
@@ -220,6 +213,6 @@ impl Stepper {
             p.velocity[i] = self.v0[i] + self.dv[i] * (h / 6.0);
         }
         self.acc = acc;
-        self.acc_valid = false;
+        sys.carried_acceleration.clear();
     }
 }

@@ -77,6 +77,10 @@ pub struct System {
     pub boundary: Boundary,
     pub time: f64,
     pub step: u64,
+    /// Accelerations leap-frog evaluated at the end of the last step and
+    /// uses to start the next (empty when none are carried). Part of the
+    /// state so that checkpoints resume bit for bit.
+    pub carried_acceleration: Vec<DVec3>,
 }
 
 impl System {
@@ -86,6 +90,7 @@ impl System {
             boundary: Boundary::open(),
             time: 0.0,
             step: 0,
+            carried_acceleration: Vec::new(),
         }
     }
 

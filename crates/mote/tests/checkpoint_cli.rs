@@ -1,6 +1,7 @@
 //! Checkpoints: a run killed with SIGKILL and resumed from its last
 //! checkpoint ends in the same state, bit for bit, as an uninterrupted run
-//! (thermostat noise included).
+//! (thermostat noise and leap-frog's carried accelerations of a
+//! velocity-dependent force included).
 
 use std::path::Path;
 use std::process::Command;
@@ -24,6 +25,8 @@ kt = 1.5
 kind = "bussi"
 kt = 1.0
 tau = 0.2
+[damping]
+gamma = 0.01
 [output]
 observables_every = 100
 trajectory_every = 500

@@ -116,6 +116,11 @@ impl Observer for CheckpointWriter {
             step: sys.step,
             positions: p.position.iter().map(|r| r.to_array()).collect(),
             velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
+            accelerations: sys
+                .carried_acceleration
+                .iter()
+                .map(|a| a.to_array())
+                .collect(),
             ..self.template.clone()
         };
         Ok(checkpoint::write(&self.path, &cp)?)
@@ -276,6 +281,11 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             sys.particles.position[i] = mote_md::DVec3::from(*r);
             sys.particles.velocity[i] = mote_md::DVec3::from(*v);
         }
+        sys.carried_acceleration = cp
+            .accelerations
+            .iter()
+            .map(|a| mote_md::DVec3::from(*a))
+            .collect();
         built.simulation.sample_at_start = false;
     }
     let length =
