@@ -133,42 +133,18 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
                 k += n;
             }
             "particles" => {
-                let n: usize = rest
-                    .parse()
-                    .map_err(|_| err(k, "particles needs a count"))?;
-                for j in 0..n {
-                    let ln = k + 1 + j;
-                    let w: Vec<&str> = lines
-                        .get(ln)
-                        .map(|l| l.split_whitespace().collect())
-                        .unwrap_or_default();
-                    if w.len() != 6 {
-                        return Err(err(ln, "expected six hexadecimal f64: x y z vx vy vz").into());
-                    }
-                    let v: Result<Vec<f64>, _> = w.iter().map(|s| bits(s, ln)).collect();
-                    let v = v?;
+                let rows = table(&lines, k, rest, 6, "x y z vx vy vz", &bits, &err)?;
+                for v in &rows {
                     cp.positions.push([v[0], v[1], v[2]]);
                     cp.velocities.push([v[3], v[4], v[5]]);
                 }
-                k += n;
+                k += rows.len();
             }
             "accelerations" => {
-                let n: usize = rest
-                    .parse()
-                    .map_err(|_| err(k, "accelerations needs a count"))?;
-                for j in 0..n {
-                    let ln = k + 1 + j;
-                    let w: Vec<&str> = lines
-                        .get(ln)
-                        .map(|l| l.split_whitespace().collect())
-                        .unwrap_or_default();
-                    if w.len() != 3 {
-                        return Err(err(ln, "expected three hexadecimal f64: ax ay az").into());
-                    }
-                    cp.accelerations
-                        .push([bits(w[0], ln)?, bits(w[1], ln)?, bits(w[2], ln)?]);
-                }
-                k += n;
+                let rows = table(&lines, k, rest, 3, "ax ay az", &bits, &err)?;
+                cp.accelerations
+                    .extend(rows.iter().map(|v| [v[0], v[1], v[2]]));
+                k += rows.len();
             }
             "" => {}
             other => return Err(err(k, &format!("unknown record '{other}'")).into()),
@@ -176,6 +152,36 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
         k += 1;
     }
     Ok(cp)
+}
+
+/// The `count` rows of `width` hexadecimal f64 after the record at line k.
+fn table(
+    lines: &[&str],
+    k: usize,
+    count: &str,
+    width: usize,
+    names: &str,
+    bits: &dyn Fn(&str, usize) -> Result<f64, ParseError>,
+    err: &dyn Fn(usize, &str) -> ParseError,
+) -> Result<Vec<Vec<f64>>, ParseError> {
+    let n: usize = count
+        .parse()
+        .map_err(|_| err(k, "the record needs a row count"))?;
+    (k + 1..k + 1 + n)
+        .map(|ln| {
+            let w: Vec<&str> = lines
+                .get(ln)
+                .map(|l| l.split_whitespace().collect())
+                .unwrap_or_default();
+            if w.len() != width {
+                return Err(err(
+                    ln,
+                    &format!("expected {width} hexadecimal f64: {names}"),
+                ));
+            }
+            w.iter().map(|s| bits(s, ln)).collect()
+        })
+        .collect()
 }
 
 #[cfg(test)]
