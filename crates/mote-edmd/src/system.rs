@@ -470,6 +470,25 @@ impl<const D: usize> System<D> {
         c
     }
 
+    /// The cell at `offset` from cell `ci`, wrapped on periodic axes; `None`
+    /// past a wall.
+    #[inline]
+    fn neighbour_cell(&self, ci: &[u32; D], offset: &[i32; D]) -> Option<[u32; D]> {
+        let mut cc = [0u32; D];
+        for d in 0..D {
+            let k = ci[d] as i64 + offset[d] as i64;
+            let m = self.ncell[d] as i64;
+            cc[d] = if (0..m).contains(&k) {
+                k as u32
+            } else if self.simbox.boundary[d] == Boundary::Periodic {
+                k.rem_euclid(m) as u32
+            } else {
+                return None;
+            };
+        }
+        Some(cc)
+    }
+
     #[inline]
     fn flat(&self, c: &[u32; D]) -> usize {
         let mut f = 0;
@@ -727,22 +746,9 @@ impl<const D: usize> System<D> {
         for i in 0..n {
             let ci = self.cidx[i];
             for off in &self.offsets {
-                let mut cc = [0u32; D];
-                let mut skip = false;
-                for d in 0..D {
-                    let k = ci[d] as i64 + off[d] as i64;
-                    let m = self.ncell[d] as i64;
-                    if (0..m).contains(&k) {
-                        cc[d] = k as u32;
-                    } else if self.simbox.boundary[d] == Boundary::Periodic {
-                        cc[d] = k.rem_euclid(m) as u32;
-                    } else {
-                        skip = true;
-                    }
-                }
-                if skip {
+                let Some(cc) = self.neighbour_cell(&ci, off) else {
                     continue;
-                }
+                };
                 let mut j = self.head[self.flat(&cc)];
                 while j != NONE {
                     let ju = j as usize;
@@ -915,22 +921,9 @@ impl<const D: usize> System<D> {
         let ri = self.p[i].r;
         for o in 0..self.offsets.len() {
             let off = self.offsets[o];
-            let mut cc = [0u32; D];
-            let mut skip = false;
-            for d in 0..D {
-                let k = ci[d] as i64 + off[d] as i64;
-                let m = self.ncell[d] as i64;
-                if (0..m).contains(&k) {
-                    cc[d] = k as u32;
-                } else if self.simbox.boundary[d] == Boundary::Periodic {
-                    cc[d] = k.rem_euclid(m) as u32;
-                } else {
-                    skip = true;
-                }
-            }
-            if skip {
+            let Some(cc) = self.neighbour_cell(&ci, &off) else {
                 continue;
-            }
+            };
             let mut j = self.head[self.flat(&cc)];
             while j != NONE {
                 let ju = j as usize;

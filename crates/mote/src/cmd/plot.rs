@@ -17,15 +17,8 @@ use mote_render::plot::{axis_label, Plot, Series};
     after_help = "Examples:\n  mote plot energy.csv --x time --y total_energy -o energy.png\n  mote plot energy.csv --x time --y kinetic_energy --y potential_energy --logy -o e.svg"
 )]
 struct PlotArgs {
-    /// Print nothing but errors.
-    #[arg(short = 'q', long)]
-    quiet: bool,
-    /// Number of worker threads (default: all cores; pictures are the same for any number).
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
-    /// Accepted for symmetry with other subcommands (pictures use no random numbers).
-    #[arg(long, value_name = "N", hide = true)]
-    seed: Option<u64>,
+    #[command(flatten)]
+    global: super::GlobalOpts,
     /// The CSV file (lines starting with # are comments; `# units: u1,u2,...` gives units).
     file: PathBuf,
     /// Column for the horizontal axis.
@@ -62,11 +55,7 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         }
     };
     // Global options may also come after the subcommand.
-    let global = &super::GlobalOpts {
-        quiet: global.quiet || a.quiet,
-        threads: a.threads.or(global.threads),
-        seed: a.seed.or(global.seed),
-    };
+    let global = &global.merged(&a.global);
     let (width, height) = parse_size(&a.size)?;
     // (The error's own text already names the file; no second copy of its cause.)
     let table = mote_io::csv::read_table(&a.file).map_err(|e| anyhow::anyhow!("{e}"))?;

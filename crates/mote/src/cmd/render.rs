@@ -20,15 +20,8 @@ use mote_render::{Camera, ColorMap, RenderOptions, Renderer};
     after_help = "Examples:\n  mote render traj.xyz -o last.png\n  mote render traj.xyz --all -o movie/frame.png --color-by speed --shadows\n  mote render traj.xyz --frame 0 -o first.png --anaglyph --lattice 0.2\n  mote render traj.xyz -o scene.png --pov scene.pov   (POV-Ray twin of the picture)"
 )]
 struct RenderArgs {
-    /// Print nothing but errors.
-    #[arg(short = 'q', long)]
-    quiet: bool,
-    /// Number of worker threads (default: all cores; pictures are the same for any number).
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
-    /// Accepted for symmetry with other subcommands (pictures use no random numbers).
-    #[arg(long, value_name = "N", hide = true)]
-    seed: Option<u64>,
+    #[command(flatten)]
+    global: super::GlobalOpts,
     /// Trajectory: .xyz (extended XYZ), .dump/.lammpstrj (LAMMPS), .vtu or .pvd.
     traj: PathBuf,
     /// Output picture (.png). With --all, frames become NAME_00000.png, NAME_00001.png, ...
@@ -101,11 +94,7 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         }
     };
     // Global options may also come after the subcommand.
-    let global = &super::GlobalOpts {
-        quiet: global.quiet || a.quiet,
-        threads: a.threads.or(global.threads),
-        seed: a.seed.or(global.seed),
-    };
+    let global = &global.merged(&a.global);
     global.init_threads()?;
     let opts_view = parse_vec3(a.view.as_deref(), "--view")?;
     let (w, h) = parse_size(&a.size)?;
