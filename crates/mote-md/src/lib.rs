@@ -18,9 +18,11 @@ pub mod neighbor;
 pub mod observe;
 pub mod output;
 pub mod particles;
+pub mod rigid;
 pub mod scene;
 pub mod simulation;
 pub mod thermostat;
+pub mod tree;
 pub mod units;
 
 pub use boundary::Boundary;

@@ -42,6 +42,12 @@ enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
+    /// Random close packings by growing spheres (Lubachevsky–Stillinger); see `mote pack --help`.
+    #[command(disable_help_flag = true, disable_version_flag = true)]
+    Pack {
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
     /// Event-driven hard spheres and disks; see `mote edmd --help`.
     #[command(disable_help_flag = true, disable_version_flag = true)]
     Edmd {
@@ -57,6 +63,7 @@ fn main() -> ExitCode {
         Command::Examples(args) => cmd::examples::run(&cli.global, args),
         Command::Rcp { args } => cmd::rcp::run(&cli.global, &args),
         Command::Edmd { args } => cmd::edmd::run(&cli.global, &args),
+        Command::Pack { args } => cmd::pack::run(&cli.global, &args),
         Command::Render { args } => cmd::render::run(&cli.global, &args),
         Command::Plot { args } => cmd::plot::run(&cli.global, &args),
     };

@@ -3,6 +3,7 @@
 //! interaction per evaluation, never per pair: each interaction's pair loop
 //! is a plain generic loop over `#[inline]` kernels.
 
+pub mod ewald;
 mod damping;
 mod gravity;
 mod lennard_jones;

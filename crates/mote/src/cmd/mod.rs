@@ -2,6 +2,7 @@
 
 pub mod edmd;
 pub mod examples;
+pub mod pack;
 pub mod plot;
 pub mod rcp;
 pub mod render;

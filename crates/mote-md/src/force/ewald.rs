@@ -1,0 +1,1 @@
+//! Ewald summation for charges and point dipoles in cubic periodic boxes.

@@ -1,0 +1,1 @@
+//! The octree shared by range queries and Barnes–Hut multipole sums.
