@@ -9,13 +9,15 @@ use crate::particles::System;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Observables {
     pub time: f64,
-    /// K = Σ ½ m v².
+    /// K = Σ ½ m v² + Σ ½ I ω² (translation and rotation).
     pub kinetic: f64,
+    /// The rotational part Σ ½ I ω².
+    pub rotational: f64,
     /// U from every interaction with a potential.
     pub potential: f64,
     /// Total linear momentum P = Σ m v.
     pub momentum: DVec3,
-    /// Total angular momentum about the origin L = Σ m r × v.
+    /// Total angular momentum about the origin L = Σ (m r × v + I ω).
     pub angular_momentum: DVec3,
     /// k_B T = 2K / N_f in energy units (N_f: free translational degrees of freedom).
     pub kt: f64,
@@ -40,6 +42,14 @@ impl Observables {
             momentum += mv;
             angular_momentum += p.position[i].cross(mv);
         }
+        let mut rotational = 0.0;
+        for i in 0..p.len() {
+            let iw = p.angular_velocity[i] * p.inertia[i];
+            rotational += 0.5 * iw.dot(p.angular_velocity[i]);
+            angular_momentum += iw;
+        }
+        let translational = kinetic;
+        kinetic += rotational;
         let state = State {
             position: &p.position,
             velocity: &p.velocity,
@@ -50,17 +60,22 @@ impl Observables {
         let nf = sys.degrees_of_freedom();
         let volume = sys.boundary.volume();
         let pressure = if sys.boundary.periodic.iter().all(|p| *p) && volume.is_finite() {
-            (2.0 * kinetic + ff.virial()) / (3.0 * volume)
+            (2.0 * translational + ff.virial()) / (3.0 * volume)
         } else {
             f64::NAN
         };
         Self {
             time: sys.time,
             kinetic,
+            rotational,
             potential,
             momentum,
             angular_momentum,
-            kt: if nf > 0.0 { 2.0 * kinetic / nf } else { 0.0 },
+            kt: if nf > 0.0 {
+                2.0 * translational / nf
+            } else {
+                0.0
+            },
             pressure,
         }
     }

@@ -16,6 +16,14 @@ pub struct Particles {
     /// Per axis 1.0 where the particle may move, 0.0 where it is fixed
     /// (MPPphys `vfix`); multiplies accelerations and velocities.
     pub mobility: Vec<DVec3>,
+    /// Angular velocity ω of spheres that rotate (zero for point masses).
+    pub angular_velocity: Vec<DVec3>,
+    /// Moment of inertia I about the centre (2/5 m r² for a solid sphere);
+    /// torques turn into angular accelerations τ/I where I > 0.
+    pub inertia: Vec<f64>,
+    /// Magnetic dipole moment m (a vector: magnitude and orientation; zero
+    /// for non-magnetic particles). It turns with the particle's ω.
+    pub dipole: Vec<DVec3>,
 }
 
 /// Everything needed to add one particle.
@@ -28,6 +36,10 @@ pub struct ParticleInit {
     pub radius: f64,
     pub color: [f64; 3],
     pub free: [bool; 3],
+    pub angular_velocity: DVec3,
+    /// Moment of inertia; `None` takes the solid sphere's 2/5 m r².
+    pub inertia: Option<f64>,
+    pub dipole: DVec3,
 }
 
 impl Default for ParticleInit {
@@ -40,6 +52,9 @@ impl Default for ParticleInit {
             radius: 0.0,
             color: [1.0, 1.0, 1.0],
             free: [true; 3],
+            angular_velocity: DVec3::ZERO,
+            inertia: None,
+            dipole: DVec3::ZERO,
         }
     }
 }
@@ -67,6 +82,17 @@ impl Particles {
         self.radius.push(p.radius);
         self.color.push(p.color);
         self.mobility.push(mobility);
+        self.angular_velocity.push(p.angular_velocity);
+        self.inertia
+            .push(p.inertia.unwrap_or(0.4 * p.mass * p.radius * p.radius));
+        self.dipole.push(p.dipole);
+    }
+
+    /// Whether particle i may rotate: it has a moment of inertia and is not
+    /// fixed on every axis.
+    #[inline]
+    pub fn rotates(&self, i: usize) -> bool {
+        self.inertia[i] > 0.0 && self.mobility[i] != DVec3::ZERO
     }
 }
 
@@ -81,6 +107,9 @@ pub struct System {
     /// uses to start the next (empty when none are carried). Part of the
     /// state so that checkpoints resume bit for bit.
     pub carried_acceleration: Vec<DVec3>,
+    /// The angular accelerations τ/I carried the same way (empty when no
+    /// interaction exerts torques).
+    pub carried_angular_acceleration: Vec<DVec3>,
 }
 
 impl System {
@@ -91,6 +120,7 @@ impl System {
             time: 0.0,
             step: 0,
             carried_acceleration: Vec::new(),
+            carried_angular_acceleration: Vec::new(),
         }
     }
 

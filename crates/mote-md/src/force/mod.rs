@@ -3,8 +3,8 @@
 //! interaction per evaluation, never per pair: each interaction's pair loop
 //! is a plain generic loop over `#[inline]` kernels.
 
-pub mod ewald;
 mod damping;
+pub mod ewald;
 mod gravity;
 mod lennard_jones;
 mod springs;
@@ -28,12 +28,39 @@ pub struct State<'a> {
     pub time: f64,
 }
 
+/// The rotational state at which torques are evaluated, beside [`State`].
+#[derive(Clone, Copy)]
+pub struct Spin<'a> {
+    /// Angular velocity ω of each particle.
+    pub angular_velocity: &'a [DVec3],
+    /// Magnetic dipole moment m of each particle (zero if none).
+    pub dipole: &'a [DVec3],
+}
+
 /// Something that exerts forces.
 pub trait Interaction: Send {
     /// A short name for reports (`gravity`, `springs`, ...).
     fn name(&self) -> &'static str;
     /// Adds this interaction's force on each particle to `force`.
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]);
+    /// Whether this interaction exerts torques (frictional contacts,
+    /// dipoles); then the integrator rotates the particles and calls
+    /// [`Interaction::add_forces_and_torques`].
+    fn exerts_torques(&self) -> bool {
+        false
+    }
+    /// Adds forces and torques about each particle's centre. Interactions
+    /// without torques keep the default, which adds the forces only.
+    fn add_forces_and_torques(
+        &mut self,
+        state: &State,
+        spin: &Spin,
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+    ) {
+        let _ = (spin, torque);
+        self.add_forces(state, force);
+    }
     /// The potential energy of the interaction; 0 for dissipative forces.
     fn potential_energy(&mut self, state: &State) -> f64;
     /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation, for
@@ -48,6 +75,7 @@ pub trait Interaction: Send {
 pub struct ForceField {
     pub interactions: Vec<Box<dyn Interaction>>,
     force: Vec<DVec3>,
+    torque: Vec<DVec3>,
 }
 
 impl ForceField {
@@ -78,6 +106,41 @@ impl ForceField {
         }
         for i in 0..n {
             acc[i] = self.force[i] / state.mass[i] * mobility[i];
+        }
+    }
+
+    /// Whether any interaction exerts torques.
+    pub fn exerts_torques(&self) -> bool {
+        self.interactions.iter().any(|i| i.exerts_torques())
+    }
+
+    /// Accelerations a_i = F_i / m_i and angular accelerations α_i = τ_i / I_i
+    /// (zero for particles that do not rotate, see [`Particles::rotates`]).
+    ///
+    /// [`Particles::rotates`]: crate::Particles::rotates
+    pub fn accelerations_and_angular(
+        &mut self,
+        state: &State,
+        spin: &Spin,
+        particles: &crate::Particles,
+        acc: &mut [DVec3],
+        alpha: &mut [DVec3],
+    ) {
+        let n = state.position.len();
+        self.force.clear();
+        self.force.resize(n, DVec3::ZERO);
+        self.torque.clear();
+        self.torque.resize(n, DVec3::ZERO);
+        for interaction in &mut self.interactions {
+            interaction.add_forces_and_torques(state, spin, &mut self.force, &mut self.torque);
+        }
+        for i in 0..n {
+            acc[i] = self.force[i] / state.mass[i] * particles.mobility[i];
+            alpha[i] = if particles.rotates(i) {
+                self.torque[i] / particles.inertia[i]
+            } else {
+                DVec3::ZERO
+            };
         }
     }
 
