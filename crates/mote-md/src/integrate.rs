@@ -13,7 +13,8 @@
 //! When an interaction exerts torques (frictional contacts), leap-frog kicks
 //! the angular velocities with α = τ/I alongside the velocities:
 //! ω½ = ω + h/2 α, ω' = ω½ + h/2 α' (spheres: isotropic inertia, so ω is
-//! constant in free flight and no orientation is needed). The other schemes
+//! constant in free flight, and a dipole moment m turns by the rotation
+//! vector ω½ h in the drift). The other schemes
 //! ignore torques; scenes with rotation require leap-frog.
 
 use glam::DVec3;
@@ -67,6 +68,20 @@ impl Integrator {
             Integrator::Rk4 => 4,
         }
     }
+}
+
+/// Rotates vector m by the rotation vector θ (angle |θ|, axis θ/|θ|),
+/// Rodrigues' formula m' = m cos θ + (k × m) sin θ + k (k·m)(1 − cos θ):
+/// exact, so |m| is kept to round-off.
+#[inline]
+pub fn rotate(m: DVec3, theta: DVec3) -> DVec3 {
+    let angle = theta.length();
+    if angle == 0.0 {
+        return m;
+    }
+    let k = theta / angle;
+    let (sin, cos) = angle.sin_cos();
+    m * cos + k.cross(m) * sin + k * (k.dot(m) * (1.0 - cos))
 }
 
 /// An integrator with its scratch space (the state itself lives in [`System`]).
@@ -154,6 +169,9 @@ impl Stepper {
                 p.velocity[i] += acc[i] * half;
                 p.position[i] += p.velocity[i] * h;
                 p.angular_velocity[i] += alpha[i] * half;
+                if p.dipole[i] != DVec3::ZERO {
+                    p.dipole[i] = rotate(p.dipole[i], p.angular_velocity[i] * h);
+                }
             }
         }
         Self::eval_rotating(ff, sys, t + h, &mut acc, &mut alpha);
