@@ -4,7 +4,9 @@
 //! is a plain generic loop over `#[inline]` kernels.
 
 mod damping;
+pub mod dipolar;
 pub mod ewald;
+pub mod granular;
 mod gravity;
 mod lennard_jones;
 mod springs;
@@ -63,6 +65,12 @@ pub trait Interaction: Send {
     }
     /// The potential energy of the interaction; 0 for dissipative forces.
     fn potential_energy(&mut self, state: &State) -> f64;
+    /// The force the particles exert on each wall of this interaction
+    /// (name, force) at the last evaluation; empty for interactions without
+    /// walls.
+    fn wall_forces(&self) -> Vec<(String, DVec3)> {
+        Vec::new()
+    }
     /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation, for
     /// the pressure P V = N k T + W/3 of periodic systems (0 if not tracked).
     fn virial(&self) -> f64 {

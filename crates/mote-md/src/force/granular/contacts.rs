@@ -1,0 +1,297 @@
+//! Contacts between spheres, through a half Verlet list whose every entry
+//! carries the history of that pair's contact.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::law::{ContactLaw, History};
+use crate::boundary::Boundary;
+use crate::force::{Interaction, Spin, State};
+use crate::neighbor::VerletList;
+
+/// Hertz–Mindlin contacts between all spheres (see [`super::law`]).
+///
+/// The history (tangential and rolling elongations) sits beside the
+/// neighbour list, one entry per listed pair, so the force loop reads it
+/// without a search; when the list is rebuilt the entries of pairs that are
+/// still listed are carried over (both lists are sorted by partner, so this
+/// is a merge). A pair leaves the list only when it is farther apart than
+/// the skin, long after its contact has ended.
+#[derive(Debug, Clone)]
+pub struct GranularContacts {
+    pub law: ContactLaw,
+    pub boundary: Boundary,
+    pub list: VerletList,
+    radius: Vec<f64>,
+    history: Vec<History>,
+    history_start: Vec<u32>,
+    history_partner: Vec<u32>,
+    last_time: Option<f64>,
+    /// One (force, torque) buffer per extra block of particles.
+    buffers: Vec<(Vec<DVec3>, Vec<DVec3>)>,
+    contacts: usize,
+    virial: f64,
+}
+
+impl GranularContacts {
+    /// Contacts among spheres of the given radii; `skin` is the Verlet skin.
+    pub fn new(law: ContactLaw, radius: &[f64], skin: f64, boundary: Boundary) -> Self {
+        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+        Self {
+            law,
+            boundary,
+            list: VerletList::half(2.0 * r_max, skin),
+            radius: radius.to_vec(),
+            history: Vec::new(),
+            history_start: vec![0],
+            history_partner: Vec::new(),
+            last_time: None,
+            buffers: Vec::new(),
+            contacts: 0,
+            virial: 0.0,
+        }
+    }
+
+    /// Number of touching pairs at the last force evaluation.
+    pub fn contacts(&self) -> usize {
+        self.contacts
+    }
+
+    /// The contact history of pair (i, j), if they are listed.
+    pub fn history(&self, i: usize, j: usize) -> Option<History> {
+        let (i, j) = if i < j { (i, j) } else { (j, i) };
+        let range = self.history_start.get(i)?.to_owned() as usize
+            ..self.history_start.get(i + 1)?.to_owned() as usize;
+        let k = self.history_partner[range.clone()]
+            .binary_search(&(j as u32))
+            .ok()?;
+        Some(self.history[range.start + k])
+    }
+
+    /// Carries the history over to a freshly built list.
+    fn carry_history(&mut self) {
+        let n = self.list.start.len().saturating_sub(1);
+        let mut history = vec![History::default(); self.list.neighbors.len()];
+        let old_n = self.history_start.len().saturating_sub(1);
+        for i in 0..n.min(old_n) {
+            let old = self.history_start[i] as usize..self.history_start[i + 1] as usize;
+            let new = self.list.start[i] as usize..self.list.start[i + 1] as usize;
+            let (mut a, mut b) = (old.start, new.start);
+            while a < old.end && b < new.end {
+                let (pa, pb) = (self.history_partner[a], self.list.neighbors[b]);
+                match pa.cmp(&pb) {
+                    std::cmp::Ordering::Less => a += 1,
+                    std::cmp::Ordering::Greater => b += 1,
+                    std::cmp::Ordering::Equal => {
+                        history[b] = self.history[a];
+                        a += 1;
+                        b += 1;
+                    }
+                }
+            }
+        }
+        self.history = history;
+        self.history_start.clone_from(&self.list.start);
+        self.history_partner.clone_from(&self.list.neighbors);
+    }
+
+    fn evaluate(
+        &mut self,
+        state: &State,
+        omega: &[DVec3],
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+    ) {
+        let pos = state.position;
+        let n = pos.len();
+        if self.list.update(pos, &self.boundary) || self.history.len() != self.list.neighbors.len()
+        {
+            self.carry_history();
+        }
+        let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
+        self.last_time = Some(state.time);
+
+        let blocks = rayon::current_num_threads().clamp(1, n.max(1));
+        let per_block = n.div_ceil(blocks.max(1)).max(1);
+        self.buffers
+            .resize_with(blocks.saturating_sub(1), Default::default);
+        let mut buffers = std::mem::take(&mut self.buffers);
+        let mut history = std::mem::take(&mut self.history);
+
+        // Split the history into the slices owned by each block of i.
+        let mut history_blocks: Vec<&mut [History]> = Vec::with_capacity(blocks);
+        {
+            let mut rest: &mut [History] = &mut history;
+            let mut taken = 0usize;
+            for b in 0..blocks {
+                let end_i = ((b + 1) * per_block).min(n);
+                let end = self.list.start[end_i] as usize;
+                let (head, tail) = rest.split_at_mut(end - taken);
+                history_blocks.push(head);
+                rest = tail;
+                taken = end;
+            }
+        }
+        let mut targets: Vec<(&mut [DVec3], &mut [DVec3])> = Vec::with_capacity(blocks);
+        targets.push((&mut *force, &mut *torque));
+        for (f, t) in buffers.iter_mut() {
+            f.clear();
+            f.resize(n, DVec3::ZERO);
+            t.clear();
+            t.resize(n, DVec3::ZERO);
+            targets.push((f.as_mut_slice(), t.as_mut_slice()));
+        }
+
+        let this = &*self;
+        let results: Vec<(usize, f64)> = targets
+            .into_par_iter()
+            .zip(history_blocks)
+            .enumerate()
+            .map(|(b, ((f, t), hist))| {
+                let first = (b * per_block).min(n);
+                let last = ((b + 1) * per_block).min(n);
+                this.block(state, omega, first..last, dt, f, t, hist)
+            })
+            .collect();
+
+        if !buffers.is_empty() {
+            force
+                .par_iter_mut()
+                .zip(torque.par_iter_mut())
+                .enumerate()
+                .with_min_len(1024)
+                .for_each(|(i, (f, t))| {
+                    for (bf, bt) in &buffers {
+                        *f += bf[i];
+                        *t += bt[i];
+                    }
+                });
+        }
+        self.history = history;
+        self.buffers = buffers;
+        self.contacts = results.iter().map(|r| r.0).sum();
+        self.virial = results.iter().map(|r| r.1).sum();
+    }
+
+    /// The pairs of particles `range` (and their partners j > i), adding
+    /// forces and torques into `f`, `t`; returns (contacts, virial).
+    #[allow(clippy::too_many_arguments)]
+    fn block(
+        &self,
+        state: &State,
+        omega: &[DVec3],
+        range: std::ops::Range<usize>,
+        dt: f64,
+        f: &mut [DVec3],
+        t: &mut [DVec3],
+        hist: &mut [History],
+    ) -> (usize, f64) {
+        let pos = state.position;
+        let vel = state.velocity;
+        let mass = state.mass;
+        let image = self.boundary.image();
+        let offset = self.list.start[range.start] as usize;
+        let mut contacts = 0usize;
+        let mut virial = 0.0;
+        for i in range {
+            let (ri, vi, wi, radi, mi) = (pos[i], vel[i], omega[i], self.radius[i], mass[i]);
+            let (mut fi, mut ti) = (DVec3::ZERO, DVec3::ZERO);
+            let lo = self.list.start[i] as usize;
+            for (k, &j) in self.list.of(i).iter().enumerate() {
+                let j = j as usize;
+                let h = &mut hist[lo + k - offset];
+                let d = image.apply(ri - pos[j]);
+                let reach = radi + self.radius[j];
+                let r2 = d.length_squared();
+                if r2 >= reach * reach {
+                    *h = History::default();
+                    continue;
+                }
+                let r = r2.sqrt();
+                let nrm = d / r;
+                let delta = reach - r;
+                let (arm_i, arm_j) = (radi - 0.5 * delta, self.radius[j] - 0.5 * delta);
+                let wj = omega[j];
+                let v_rel = vi - vel[j] - (wi * arm_i + wj * arm_j).cross(nrm);
+                let r_eff = radi * self.radius[j] / reach;
+                let m_eff = mi * mass[j] / (mi + mass[j]);
+                let c = self.law.force(
+                    delta,
+                    nrm,
+                    v_rel,
+                    wi - wj,
+                    arm_i,
+                    arm_j,
+                    r_eff,
+                    m_eff,
+                    dt,
+                    h,
+                );
+                fi += c.force;
+                f[j] -= c.force;
+                ti += c.torque_i;
+                t[j] += c.torque_j;
+                contacts += 1;
+                virial += d.dot(c.force);
+            }
+            f[i] += fi;
+            t[i] += ti;
+        }
+        (contacts, virial)
+    }
+}
+
+impl Interaction for GranularContacts {
+    fn name(&self) -> &'static str {
+        "granular"
+    }
+
+    fn exerts_torques(&self) -> bool {
+        true
+    }
+
+    /// Without rotation the spheres are taken as not spinning.
+    fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
+        let omega = vec![DVec3::ZERO; force.len()];
+        let mut torque = vec![DVec3::ZERO; force.len()];
+        self.evaluate(state, &omega, force, &mut torque);
+    }
+
+    fn add_forces_and_torques(
+        &mut self,
+        state: &State,
+        spin: &Spin,
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+    ) {
+        self.evaluate(state, spin.angular_velocity, force, torque);
+    }
+
+    /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}.
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        let pos = state.position;
+        self.list.update(pos, &self.boundary);
+        if self.history.len() != self.list.neighbors.len() {
+            self.carry_history();
+        }
+        let image = self.boundary.image();
+        let mut u = 0.0;
+        for i in 0..pos.len() {
+            for &j in self.list.of(i) {
+                let j = j as usize;
+                let reach = self.radius[i] + self.radius[j];
+                let r = image.apply(pos[i] - pos[j]).length();
+                if r < reach {
+                    let delta = reach - r;
+                    let r_eff = self.radius[i] * self.radius[j] / reach;
+                    u += 8.0 / 15.0 * self.law.e_star * r_eff.sqrt() * delta.powf(2.5);
+                }
+            }
+        }
+        u
+    }
+
+    fn virial(&self) -> f64 {
+        self.virial
+    }
+}

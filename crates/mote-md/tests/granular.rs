@@ -1,0 +1,380 @@
+//! Granular contacts checked against analytic results: restitution of a
+//! head-on Hertz impact, the sliding oblique impact, rolling resistance,
+//! the weight of a settled bed on its walls, conservation of momentum, and
+//! neighbour lists against brute force.
+
+use mote_md::force::granular::{
+    ContactLaw, Damping, GranularContacts, GranularWalls, Material, Wall,
+};
+use mote_md::force::{ForceField, UniformField};
+use mote_md::neighbor::VerletList;
+use mote_md::particles::ParticleInit;
+use mote_md::{Boundary, DVec3, Integrator, Observables, Particles, Stepper, System};
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+const RHO: f64 = 2500.0;
+
+fn sphere(position: DVec3, velocity: DVec3, radius: f64) -> ParticleInit {
+    ParticleInit {
+        position,
+        velocity,
+        mass: RHO * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3),
+        radius,
+        ..Default::default()
+    }
+}
+
+fn glass() -> Material {
+    Material {
+        young: 1e7,
+        poisson: 0.3,
+    }
+}
+
+/// Runs until `done` or `max_steps`.
+fn run(
+    sys: &mut System,
+    ff: &mut ForceField,
+    dt: f64,
+    max_steps: usize,
+    mut done: impl FnMut(&System) -> bool,
+) {
+    let mut stepper = Stepper::new(Integrator::LeapFrog);
+    for _ in 0..max_steps {
+        stepper.step(sys, ff, dt);
+        if done(sys) {
+            return;
+        }
+    }
+    panic!("did not finish in {max_steps} steps");
+}
+
+/// Hertz contact time t_c ≈ 2.87 (m*²/(R* E*² v))^{1/5}.
+fn contact_time(m_eff: f64, r_eff: f64, e_star: f64, v: f64) -> f64 {
+    2.87 * (m_eff * m_eff / (r_eff * e_star * e_star * v)).powf(0.2)
+}
+
+/// Leap-frog evaluates the damping at the half-step velocity, an O(dt)
+/// error in e; 1000 steps per contact keep it below 0.3 % at e = 0.1.
+const STEPS_PER_CONTACT: f64 = 1000.0;
+
+#[test]
+fn head_on_impact_gives_back_the_restitution() {
+    let r = 1e-3;
+    let v = 0.5;
+    for limit_damping in [false, true] {
+        for e in [0.1, 0.3, 0.5, 0.7, 0.9] {
+            let law = ContactLaw::new(glass(), glass(), e, 0.5, Damping::Exact, limit_damping);
+            let mut p = Particles::default();
+            p.push(sphere(
+                DVec3::new(-1.01 * r, 0.0, 0.0),
+                DVec3::new(v, 0.0, 0.0),
+                r,
+            ));
+            p.push(sphere(
+                DVec3::new(1.01 * r, 0.0, 0.0),
+                DVec3::new(-v, 0.0, 0.0),
+                r,
+            ));
+            let m = p.mass[0];
+            let tc = contact_time(m / 2.0, r / 2.0, law.e_star, 2.0 * v);
+            let mut ff = ForceField::new().with(GranularContacts::new(
+                law,
+                &p.radius,
+                0.2 * r,
+                Boundary::open(),
+            ));
+            let mut sys = System::new(p);
+            let dt = tc / STEPS_PER_CONTACT;
+            run(&mut sys, &mut ff, dt, 100_000, |s| {
+                let gap = s.particles.position[1].x - s.particles.position[0].x;
+                gap > 2.02 * r
+            });
+            let u = sys.particles.velocity[1].x - sys.particles.velocity[0].x;
+            let measured = u / (2.0 * v);
+            assert!(
+                (measured - e).abs() < 0.01 * e,
+                "e {e} (limit_damping {limit_damping}): measured {measured}"
+            );
+        }
+    }
+}
+
+#[test]
+fn sliding_oblique_impact_matches_the_rigid_body_result() {
+    // Sliding throughout the impact when v_t > (7/2) μ (1 + e) v_n: the
+    // tangential impulse is μ times the normal one, m(1 + e) v_n, so
+    // v_t' = v_t − μ(1 + e)v_n and R ω' = (5/2) μ (1 + e) v_n.
+    let r = 1e-3;
+    let (vn, vt, mu, e) = (0.5, 2.0, 0.3, 0.5);
+    // A stiff material keeps the overlap, and so the change of lever arm
+    // R − δ/2 the torque acts through, below 0.3 %.
+    let stiff = Material {
+        young: 1e9,
+        poisson: 0.3,
+    };
+    let law = ContactLaw::new(stiff, stiff, e, mu, Damping::Exact, true);
+    let mut p = Particles::default();
+    p.push(sphere(
+        DVec3::new(0.0, 0.0, 1.01 * r),
+        DVec3::new(vt, 0.0, -vn),
+        r,
+    ));
+    let m = p.mass[0];
+    let walls = GranularWalls::new(
+        law,
+        vec![Wall::plane("floor", DVec3::ZERO, DVec3::Z)],
+        &p.radius,
+    );
+    let mut ff = ForceField::new().with(walls);
+    let mut sys = System::new(p);
+    let dt = contact_time(m, r, law.e_star, vn) / 400.0;
+    run(&mut sys, &mut ff, dt, 100_000, |s| {
+        s.particles.position[0].z > 1.02 * r
+    });
+    let v = sys.particles.velocity[0];
+    let w = sys.particles.angular_velocity[0];
+    let expect_vt = vt - mu * (1.0 + e) * vn;
+    let expect_spin = 2.5 * mu * (1.0 + e) * vn / r;
+    assert!(
+        (v.z / vn - e).abs() < 0.01 * e,
+        "normal restitution {}",
+        v.z / vn
+    );
+    assert!(
+        (v.x - expect_vt).abs() < 0.01 * expect_vt,
+        "v_t' {} expected {expect_vt}",
+        v.x
+    );
+    // Rolling in +x on a floor below spins about +y.
+    assert!(
+        (w.y - expect_spin).abs() < 0.01 * expect_spin,
+        "ω' {} expected {expect_spin}",
+        w.y
+    );
+    // Tangential restitution of the contact point, −(v_t' − Rω')/v_t.
+    let et = (v.x - r * w.y) / vt;
+    let expect_et = 1.0 - 3.5 * mu * (1.0 + e) * vn / vt;
+    assert!(
+        (et - expect_et).abs() < 0.01,
+        "e_t {et} expected {expect_et}"
+    );
+}
+
+#[test]
+fn rolling_resistance_decelerates_at_five_sevenths_mu_r_g() {
+    let r: f64 = 5e-3;
+    let g = 9.81;
+    let mu_r = 0.05;
+    let mut law = ContactLaw::new(glass(), glass(), 0.5, 0.5, Damping::Exact, false);
+    law.rolling_friction = mu_r;
+    let mut p = Particles::default();
+    let m = RHO * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+    // Start at the static overlap δ₀ = (m g / ((4/3) E* √R))^{2/3}.
+    let delta0 = (m * g / (4.0 / 3.0 * law.e_star * r.sqrt())).powf(2.0 / 3.0);
+    let v0 = 0.2;
+    let mut s = sphere(
+        DVec3::new(0.0, 0.0, r - delta0),
+        DVec3::new(v0, 0.0, 0.0),
+        r,
+    );
+    s.angular_velocity = DVec3::new(0.0, v0 / r, 0.0);
+    p.push(s);
+    let walls = GranularWalls::new(
+        law,
+        vec![Wall::plane("floor", DVec3::ZERO, DVec3::Z)],
+        &p.radius,
+    );
+    let mut ff = ForceField::new().with(walls).with(UniformField {
+        g: DVec3::new(0.0, 0.0, -g),
+    });
+    let mut sys = System::new(p);
+    let dt = 1e-5;
+    let mut stepper = Stepper::new(Integrator::LeapFrog);
+    // Let the rolling spring load up, then fit v(t) over 0.1 s.
+    for _ in 0..5_000 {
+        stepper.step(&mut sys, &mut ff, dt);
+    }
+    let (t1, v1) = (sys.time, sys.particles.velocity[0].x);
+    for _ in 0..10_000 {
+        stepper.step(&mut sys, &mut ff, dt);
+    }
+    let (t2, v2) = (sys.time, sys.particles.velocity[0].x);
+    let decel = -(v2 - v1) / (t2 - t1);
+    let expect = 5.0 / 7.0 * mu_r * g;
+    assert!(
+        (decel - expect).abs() < 0.02 * expect,
+        "deceleration {decel} expected {expect}"
+    );
+}
+
+/// A few hundred spheres dropped into a box settle; the walls then carry
+/// their weight.
+#[test]
+fn settled_bed_weighs_on_its_walls() {
+    let r = 2e-3;
+    let (lx, ly, lz) = (0.03, 0.03, 0.06);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+    let mut p = Particles::default();
+    // A loose simple-cubic stack with jitter, so nothing overlaps at the start.
+    let a = 2.4 * r;
+    let mut z = r * 1.2;
+    while z < lz - r && p.len() < 400 {
+        let mut y = r * 1.2;
+        while y < ly - r {
+            let mut x = r * 1.2;
+            while x < lx - r {
+                let jitter = DVec3::new(rng.gen(), rng.gen(), 0.0) * 0.1 * r;
+                p.push(sphere(DVec3::new(x, y, z) + jitter, DVec3::ZERO, r));
+                x += a;
+            }
+            y += a;
+        }
+        z += a;
+    }
+    let n = p.len();
+    let m = p.mass[0];
+    let g = 9.81;
+    let mat = Material {
+        young: 1e6,
+        poisson: 0.3,
+    };
+    let law = ContactLaw::new(mat, mat, 0.3, 0.5, Damping::Exact, false);
+    let walls = GranularWalls::new(
+        law,
+        Wall::closed_box("box", DVec3::ZERO, DVec3::new(lx, ly, lz)),
+        &p.radius,
+    );
+    let contacts = GranularContacts::new(law, &p.radius, 0.2 * r, Boundary::open());
+    let mut ff = ForceField::new()
+        .with(contacts)
+        .with(walls)
+        .with(UniformField {
+            g: DVec3::new(0.0, 0.0, -g),
+        });
+    let mut sys = System::new(p);
+    let dt = 5e-5;
+    let mut stepper = Stepper::new(Integrator::LeapFrog);
+    for _ in 0..12_000 {
+        stepper.step(&mut sys, &mut ff, dt);
+    }
+    // Average the vertical wall force over a further window.
+    let mut fz = 0.0;
+    let window = 2_000;
+    for _ in 0..window {
+        stepper.step(&mut sys, &mut ff, dt);
+        fz += ff_wall_force_z(&ff);
+    }
+    fz /= window as f64;
+    let weight = n as f64 * m * g;
+    let obs = Observables::measure(&sys, &mut ff);
+    assert!(
+        obs.kinetic < 1e-6 * weight * lz,
+        "bed not at rest: K = {}",
+        obs.kinetic
+    );
+    assert!(
+        ((fz - weight) / weight).abs() < 1e-3,
+        "walls carry {fz} N, weight {weight} N ({n} spheres)"
+    );
+}
+
+fn ff_wall_force_z(ff: &ForceField) -> f64 {
+    ff.interactions
+        .iter()
+        .flat_map(|i| i.wall_forces())
+        .map(|(_, f)| -f.z)
+        .sum::<f64>()
+}
+
+#[test]
+fn colliding_cloud_conserves_momentum_and_angular_momentum() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+    let mut p = Particles::default();
+    for _ in 0..200 {
+        let r = 1e-3 * (0.7 + 0.6 * rng.gen::<f64>());
+        let x = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * 0.03;
+        let v = DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.5;
+        let mut s = sphere(x, v, r);
+        s.angular_velocity = (DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.5) * 100.0;
+        p.push(s);
+    }
+    let law = ContactLaw::new(glass(), glass(), 0.5, 0.4, Damping::Exact, false);
+    let mut ff = ForceField::new().with(GranularContacts::new(
+        law,
+        &p.radius,
+        2e-4,
+        Boundary::open(),
+    ));
+    let mut sys = System::new(p);
+    let before = Observables::measure(&sys, &mut ff);
+    let mut stepper = Stepper::new(Integrator::LeapFrog);
+    for _ in 0..3000 {
+        stepper.step(&mut sys, &mut ff, 2e-6);
+    }
+    let after = Observables::measure(&sys, &mut ff);
+    let p_scale = sys
+        .particles
+        .velocity
+        .iter()
+        .zip(&sys.particles.mass)
+        .map(|(v, m)| v.length() * m)
+        .sum::<f64>();
+    assert!((after.momentum - before.momentum).length() < 1e-13 * p_scale);
+    let l_scale = p_scale * 0.03;
+    assert!(
+        (after.angular_momentum - before.angular_momentum).length() < 1e-12 * l_scale,
+        "ΔL = {}",
+        (after.angular_momentum - before.angular_momentum).length() / l_scale
+    );
+    assert!(
+        after.total_energy() < before.total_energy(),
+        "collisions must dissipate"
+    );
+}
+
+/// Every touching pair is in the list, for polydisperse spheres in periodic
+/// and open boxes, while the particles move and the list is rebuilt.
+#[test]
+fn neighbour_list_never_misses_a_contact() {
+    for periodic in [true, false] {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        let l = 1.0;
+        let n = 600;
+        let radius: Vec<f64> = (0..n).map(|_| 0.01 + 0.04 * rng.gen::<f64>()).collect();
+        let mut pos: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()) * l)
+            .collect();
+        let boundary = if periodic {
+            Boundary::periodic(DVec3::ZERO, DVec3::splat(l))
+        } else {
+            Boundary::open()
+        };
+        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+        let skin = 0.02;
+        let mut list = VerletList::half(2.0 * r_max, skin);
+        for step in 0..50 {
+            list.update(&pos, &boundary);
+            let image = boundary.image();
+            for i in 0..n {
+                for j in i + 1..n {
+                    let d = image.apply(pos[i] - pos[j]).length();
+                    if d < radius[i] + radius[j] {
+                        assert!(
+                            list.of(i).contains(&(j as u32)),
+                            "step {step}: pair ({i}, {j}) missing (periodic {periodic})"
+                        );
+                    }
+                }
+            }
+            for r in pos.iter_mut() {
+                *r += (DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.5) * 0.006;
+                if periodic {
+                    *r = boundary.wrap(*r);
+                }
+            }
+        }
+        assert!(list.builds > 1, "the list must have been rebuilt");
+    }
+}
