@@ -1,0 +1,1 @@
+//! Dipolar interactions (in progress).
