@@ -8,6 +8,7 @@ pub mod checkpoint;
 pub mod csv;
 pub mod error;
 pub mod header;
+pub mod lammps_data;
 pub mod lammps_dump;
 pub mod plist;
 pub mod vtu;

@@ -325,3 +325,66 @@ mod tests {
         assert!(lat.springs.iter().all(|s| s.rest_length > 0.99));
     }
 }
+
+/// A cloud of non-overlapping spheres in the box [min, max] by random
+/// sequential addition (as Yade's `makeCloud`): radii uniform in
+/// r (1 ± spread), each sphere tried at up to `attempts` random places and
+/// kept where it overlaps nothing. Returns fewer than `n` spheres if the box
+/// is too full; the caller reports that.
+pub fn cloud(
+    n: usize,
+    min: DVec3,
+    max: DVec3,
+    radius: f64,
+    spread: f64,
+    template: &ParticleInit,
+    rng: &mut impl Rng,
+) -> Vec<ParticleInit> {
+    let r_max = radius * (1.0 + spread);
+    let edge = 2.0 * r_max;
+    let span = (max - min).max(DVec3::splat(edge));
+    let dims = [0, 1, 2].map(|k| ((span[k] / edge).floor() as usize).max(1));
+    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); dims[0] * dims[1] * dims[2]];
+    let cell_of = |x: DVec3| -> [usize; 3] {
+        [0, 1, 2].map(|k| (((x[k] - min[k]) / span[k] * dims[k] as f64) as usize).min(dims[k] - 1))
+    };
+    let mut placed: Vec<ParticleInit> = Vec::with_capacity(n);
+    const ATTEMPTS: usize = 1000;
+    for _ in 0..n {
+        let r = radius * (1.0 + spread * (2.0 * rng.gen::<f64>() - 1.0));
+        let lo = min + DVec3::splat(r);
+        let hi = max - DVec3::splat(r);
+        if (0..3).any(|k| hi[k] < lo[k]) {
+            break;
+        }
+        let mut found = None;
+        'attempt: for _ in 0..ATTEMPTS {
+            let x = lo + (hi - lo) * DVec3::new(rng.gen(), rng.gen(), rng.gen());
+            let c = cell_of(x);
+            for cz in c[2].saturating_sub(1)..=(c[2] + 1).min(dims[2] - 1) {
+                for cy in c[1].saturating_sub(1)..=(c[1] + 1).min(dims[1] - 1) {
+                    for cx in c[0].saturating_sub(1)..=(c[0] + 1).min(dims[0] - 1) {
+                        for &j in &cells[cx + dims[0] * (cy + dims[1] * cz)] {
+                            let q = &placed[j];
+                            let reach = r + q.radius;
+                            if (q.position - x).length_squared() < reach * reach {
+                                continue 'attempt;
+                            }
+                        }
+                    }
+                }
+            }
+            found = Some(x);
+            break;
+        }
+        let Some(x) = found else { break };
+        let c = cell_of(x);
+        cells[c[0] + dims[0] * (c[1] + dims[1] * c[2])].push(placed.len());
+        placed.push(ParticleInit {
+            position: x,
+            radius: r,
+            ..template.clone()
+        });
+    }
+    placed
+}

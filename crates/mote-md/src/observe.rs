@@ -6,7 +6,7 @@ use crate::force::{ForceField, State};
 use crate::particles::System;
 
 /// Whole-system observables at one instant.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Observables {
     pub time: f64,
     /// K = Σ ½ m v² + Σ ½ I ω² (translation and rotation).
@@ -23,6 +23,9 @@ pub struct Observables {
     pub kt: f64,
     /// P = (2K + W)/(3V) from the virial W of the last force evaluation; NaN without a periodic box.
     pub pressure: f64,
+    /// The force the particles exert on each wall (name, force), from the
+    /// last force evaluation.
+    pub wall_forces: Vec<(String, DVec3)>,
 }
 
 impl Observables {
@@ -71,6 +74,11 @@ impl Observables {
             potential,
             momentum,
             angular_momentum,
+            wall_forces: ff
+                .interactions
+                .iter()
+                .flat_map(|i| i.wall_forces())
+                .collect(),
             kt: if nf > 0.0 {
                 2.0 * translational / nf
             } else {

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use glam::DVec3;
 use mote_io::csv::CsvWriter;
 use mote_io::xyz::{Frame, XyzWriter};
 use mote_io::Provenance;
@@ -14,12 +15,14 @@ use crate::simulation::Observer;
 use crate::units::UnitSystem;
 
 /// observables.csv: time, energies, momentum, angular momentum, step, k_B T,
-/// the pressure (only for a box periodic on every axis), probes.
+/// the pressure (only for a box periodic on every axis), probes, the force
+/// on each wall.
 pub struct ObservablesCsv {
     writer: CsvWriter,
     every: u64,
     probes: Vec<Probe>,
     pressure: bool,
+    walls: usize,
 }
 
 impl ObservablesCsv {
@@ -30,6 +33,7 @@ impl ObservablesCsv {
         every: u64,
         probes: Vec<Probe>,
         pressure: bool,
+        walls: &[String],
         append: bool,
     ) -> Result<Self, MdError> {
         let [l, t, m, e] = units.labels();
@@ -65,6 +69,13 @@ impl ObservablesCsv {
             };
             unit_row.push(unit);
         }
+        // The force on each wall, F = −Σ (contact forces on the particles).
+        for wall in walls {
+            for axis in ["x", "y", "z"] {
+                columns.push(format!("F_{wall}_{axis}"));
+                unit_row.push(format!("{m}*{l}/{t}^2"));
+            }
+        }
         Ok(Self {
             writer: if append {
                 CsvWriter::append(path, columns.len())?
@@ -74,6 +85,7 @@ impl ObservablesCsv {
             every,
             probes,
             pressure,
+            walls: walls.len(),
         })
     }
 }
@@ -89,6 +101,10 @@ impl Observer for ObservablesCsv {
             row.pop();
         }
         row.extend(self.probes.iter().map(|p| p.read(sys)));
+        for k in 0..self.walls {
+            let f = obs.wall_forces.get(k).map_or(DVec3::NAN, |w| w.1);
+            row.extend([f.x, f.y, f.z]);
+        }
         Ok(self.writer.row(&row)?)
     }
 

@@ -2,7 +2,8 @@
 //!
 //! Every key is documented in docs/scene-format.md. Particles are numbered in
 //! this order: `[[particle]]` tables, then `[[lattice]]`, `[[ring]]`,
-//! `[[annulus]]`, `[[random_box]]` and `[[fcc]]` generators, each in file order.
+//! `[[annulus]]`, `[[random_box]]`, `[[fcc]]` and `[[cloud]]` generators,
+//! then `[[lammps_data]]` files, each in file order.
 
 use glam::DVec3;
 use rand::SeedableRng;
@@ -13,6 +14,9 @@ use toml::Spanned;
 use mote_io::plist::ParticleFile;
 use mote_io::ParseError;
 
+use crate::force::granular::{
+    ContactLaw, Damping, GranularContacts, GranularWalls, Material, Wall,
+};
 use crate::force::{
     DirectGravity, ForceField, GlobalDamping, LennardJones, Spring, SpringNetwork, UniformField,
 };
@@ -43,6 +47,9 @@ pub struct Scene {
     pub damping: Option<DampingSettings>,
     pub lennard_jones: Option<Spanned<LennardJonesSettings>>,
     pub thermostat: Option<Spanned<ThermostatSettings>>,
+    pub granular: Option<Spanned<GranularSettings>>,
+    #[serde(default)]
+    pub wall: Vec<Spanned<WallSpec>>,
     #[serde(rename = "box")]
     pub bounds: Option<Spanned<BoxSettings>>,
     #[serde(default)]
@@ -58,9 +65,99 @@ pub struct Scene {
     #[serde(default)]
     pub fcc: Vec<Spanned<FccSpec>>,
     #[serde(default)]
+    pub cloud: Vec<Spanned<CloudSpec>>,
+    #[serde(default)]
+    pub lammps_data: Vec<Spanned<DataSpec>>,
+    #[serde(default)]
     pub spring: Vec<Spanned<SpringSpec>>,
     #[serde(default)]
     pub output: OutputSettings,
+}
+
+/// `[granular]`: Hertz–Mindlin contacts between all particles of radius > 0
+/// (see `force::granular::law`), and the material of the `[[wall]]`s.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GranularSettings {
+    /// Young's modulus E of the particles.
+    pub young: f64,
+    /// Poisson's ratio ν.
+    pub poisson: f64,
+    /// Coefficient of restitution e of a head-on impact.
+    pub restitution: f64,
+    /// Sliding friction coefficient μ.
+    pub friction: f64,
+    /// Rolling friction coefficient μ_r (default 0).
+    #[serde(default)]
+    pub rolling_friction: f64,
+    /// Work of adhesion w (DMT pull 2πwR*; default 0).
+    #[serde(default)]
+    pub adhesion: f64,
+    /// `exact` (α solved so that e is met, default) or `tsuji` (LAMMPS'
+    /// polynomial fit, for comparisons).
+    #[serde(default = "exact")]
+    pub damping: String,
+    /// Never let the normal force pull (LAMMPS `limit_damping`).
+    #[serde(default)]
+    pub limit_damping: bool,
+    /// Verlet-list skin (default a quarter of the smallest diameter).
+    pub skin: Option<f64>,
+    /// Walls' Young's modulus and Poisson's ratio (default: the particles').
+    pub wall_young: Option<f64>,
+    pub wall_poisson: Option<f64>,
+    /// Friction with the walls (default: `friction`).
+    pub wall_friction: Option<f64>,
+}
+
+fn exact() -> String {
+    "exact".into()
+}
+
+/// `[[wall]]`: a wall for granular contacts. `kind = "plane"` (point,
+/// normal towards the particles), `"box"` (lo, hi: six inward planes) or
+/// `"cylinder"` (point, axis, radius: the particles are inside).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSpec {
+    pub kind: String,
+    /// Name in observables.csv (default wall0, wall1, ...).
+    pub name: Option<String>,
+    pub point: Option<[f64; 3]>,
+    pub normal: Option<[f64; 3]>,
+    pub lo: Option<[f64; 3]>,
+    pub hi: Option<[f64; 3]>,
+    pub axis: Option<[f64; 3]>,
+    pub radius: Option<f64>,
+    /// The wall translates at this velocity.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Angular speed about the cylinder's axis or the plane's normal (rad/s).
+    #[serde(default)]
+    pub angular_speed: f64,
+}
+
+/// `[[cloud]]`: n non-overlapping spheres placed at random in [min, max]
+/// (random sequential addition), radii uniform in radius·(1 ± spread).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudSpec {
+    pub n: usize,
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    #[serde(default)]
+    pub spread: f64,
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[lammps_data]]`: spheres from a LAMMPS data file (`atom_style sphere`:
+/// id type diameter density x y z), path relative to the scene file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DataSpec {
+    pub file: String,
+    #[serde(default = "white")]
+    pub color: [f64; 3],
 }
 
 /// `[run]`: integrator, time step and length.
@@ -206,6 +303,8 @@ pub struct Properties {
     pub charge: f64,
     #[serde(default)]
     pub radius: f64,
+    /// Mass density ρ: when given, the mass is ρ (4/3)π r³ (solid spheres).
+    pub density: Option<f64>,
     #[serde(default = "white")]
     pub color: [f64; 3],
     /// Per axis: may the particle move? (MPPphys `vfix` 1 1 1 = all free.)
@@ -219,6 +318,7 @@ impl Default for Properties {
             mass: 1.0,
             charge: 0.0,
             radius: 0.0,
+            density: None,
             color: white(),
             free: all_free(),
         }
@@ -228,7 +328,9 @@ impl Default for Properties {
 impl Properties {
     fn template(&self) -> ParticleInit {
         ParticleInit {
-            mass: self.mass,
+            mass: self
+                .density
+                .map_or(self.mass, |rho| sphere_mass(rho, self.radius)),
             charge: self.charge,
             radius: self.radius,
             color: self.color,
@@ -236,6 +338,11 @@ impl Properties {
             ..ParticleInit::default()
         }
     }
+}
+
+/// The mass ρ (4/3)π r³ of a solid sphere.
+fn sphere_mass(density: f64, radius: f64) -> f64 {
+    density * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3)
 }
 
 /// `[[particle]]`: one particle.
@@ -451,22 +558,31 @@ impl Scene {
         let mut displacements: Vec<DVec3> = Vec::new();
         let mut springs: Vec<Spring> = Vec::new();
 
-        let check_props =
-            |p: &Properties, span: std::ops::Range<usize>| -> Result<(), ParseError> {
-                if !p.mass.is_finite() || p.mass <= 0.0 {
+        let check_props = |p: &Properties,
+                           span: std::ops::Range<usize>|
+         -> Result<(), ParseError> {
+            if !p.mass.is_finite() || p.mass <= 0.0 {
+                return Err(err(
+                    span,
+                    format!("mass must be positive, found {}", p.mass),
+                ));
+            }
+            if let Some(rho) = p.density {
+                if !rho.is_finite() || rho <= 0.0 || p.radius <= 0.0 {
                     return Err(err(
                         span,
-                        format!("mass must be positive, found {}", p.mass),
+                        format!("density must be positive and needs a radius, found density {rho}"),
                     ));
                 }
-                if p.radius < 0.0 {
-                    return Err(err(
-                        span,
-                        format!("radius must not be negative, found {}", p.radius),
-                    ));
-                }
-                Ok(())
-            };
+            }
+            if p.radius < 0.0 {
+                return Err(err(
+                    span,
+                    format!("radius must not be negative, found {}", p.radius),
+                ));
+            }
+            Ok(())
+        };
 
         for spec in &self.particle {
             let s = spec.get_ref();
@@ -651,6 +767,69 @@ impl Scene {
                 displacements.push(DVec3::ZERO);
             }
         }
+        for spec in &self.cloud {
+            let s = spec.get_ref();
+            check_props(&s.props, spec.span())?;
+            if s.props.radius <= 0.0 || !(0.0..1.0).contains(&s.spread) {
+                return Err(err(
+                    spec.span(),
+                    "a cloud needs radius > 0 and 0 ≤ spread < 1".into(),
+                ));
+            }
+            let made = init::cloud(
+                s.n,
+                DVec3::from(s.min),
+                DVec3::from(s.max),
+                s.props.radius,
+                s.spread,
+                &s.props.template(),
+                &mut rng,
+            );
+            if made.len() < s.n {
+                return Err(err(
+                    spec.span(),
+                    format!(
+                        "only {} of {} spheres fit in the cloud's box without overlap: enlarge it or lower n",
+                        made.len(),
+                        s.n
+                    ),
+                ));
+            }
+            for mut p in made {
+                if let Some(rho) = s.props.density {
+                    p.mass = sphere_mass(rho, p.radius);
+                }
+                inits.push(p);
+                displacements.push(DVec3::ZERO);
+            }
+        }
+        for spec in &self.lammps_data {
+            let s = spec.get_ref();
+            let path = std::path::Path::new(file)
+                .parent()
+                .unwrap_or(std::path::Path::new("."))
+                .join(&s.file);
+            let data = mote_io::lammps_data::read(&path).map_err(|e| {
+                if e.line == 0 && e.message.starts_with("cannot read") {
+                    err(spec.span(), format!("{}: {}", path.display(), e.message))
+                } else {
+                    e
+                }
+            })?;
+            for a in &data.atoms {
+                let radius = 0.5 * a.diameter;
+                inits.push(ParticleInit {
+                    position: DVec3::from(a.position),
+                    velocity: DVec3::from(a.velocity),
+                    angular_velocity: DVec3::from(a.angular_velocity),
+                    mass: sphere_mass(a.density, radius),
+                    radius,
+                    color: s.color,
+                    ..ParticleInit::default()
+                });
+                displacements.push(DVec3::ZERO);
+            }
+        }
         let n = inits.len();
         if n == 0 {
             return Err(ParseError::new(file, 0, "the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]])"));
@@ -759,6 +938,87 @@ impl Scene {
             pair.list.every = v.rebuild_every;
             forces.push(pair);
         }
+        if let Some(g) = &self.granular {
+            let v = g.get_ref();
+            let radius: Vec<f64> = particles.radius.clone();
+            let bad = |msg: &str| Err(err(g.span(), msg.to_string()));
+            if !(v.young > 0.0) || !(-1.0 < v.poisson && v.poisson < 0.5) {
+                return bad("[granular] needs young > 0 and −1 < poisson < 0.5");
+            }
+            if !(v.restitution > 0.0 && v.restitution <= 1.0) {
+                return bad("[granular] restitution must be in (0, 1]");
+            }
+            if v.friction < 0.0 || v.rolling_friction < 0.0 || v.adhesion < 0.0 {
+                return bad(
+                    "[granular] friction, rolling_friction and adhesion must not be negative",
+                );
+            }
+            if radius.iter().any(|r| *r <= 0.0) {
+                return bad("[granular] needs every particle to have a radius > 0");
+            }
+            if Integrator::from_name(self.run.integrator.get_ref()) != Some(Integrator::LeapFrog) {
+                return Err(err(
+                    self.run.integrator.span(),
+                    "[granular] contacts turn the spheres: use integrator = \"leapfrog\"".into(),
+                ));
+            }
+            let damping = match v.damping.as_str() {
+                "exact" => Damping::Exact,
+                "tsuji" => Damping::TsujiFit,
+                other => {
+                    return Err(err(
+                        g.span(),
+                        format!("unknown damping '{other}': expected exact or tsuji"),
+                    ))
+                }
+            };
+            let particle = Material {
+                young: v.young,
+                poisson: v.poisson,
+            };
+            let mut law = ContactLaw::new(
+                particle,
+                particle,
+                v.restitution,
+                v.friction,
+                damping,
+                v.limit_damping,
+            );
+            law.rolling_friction = v.rolling_friction;
+            law.adhesion = v.adhesion;
+            let d_min = radius.iter().cloned().fold(f64::INFINITY, f64::min) * 2.0;
+            let skin = v.skin.unwrap_or(0.25 * d_min);
+            if !(skin > 0.0) {
+                return bad("[granular] skin must be positive");
+            }
+            forces.push(GranularContacts::new(law, &radius, skin, boundary));
+            if !self.wall.is_empty() {
+                let wall_material = Material {
+                    young: v.wall_young.unwrap_or(v.young),
+                    poisson: v.wall_poisson.unwrap_or(v.poisson),
+                };
+                let mut wall_law = ContactLaw::new(
+                    particle,
+                    wall_material,
+                    v.restitution,
+                    v.wall_friction.unwrap_or(v.friction),
+                    damping,
+                    v.limit_damping,
+                );
+                wall_law.rolling_friction = v.rolling_friction;
+                wall_law.adhesion = v.adhesion;
+                let mut walls = Vec::new();
+                for (k, w) in self.wall.iter().enumerate() {
+                    walls.extend(wall_of(w.get_ref(), k).map_err(|m| err(w.span(), m))?);
+                }
+                forces.push(GranularWalls::new(wall_law, walls, &radius));
+            }
+        } else if let Some(w) = self.wall.first() {
+            return Err(err(
+                w.span(),
+                "[[wall]] needs a [granular] section for its contact law".into(),
+            ));
+        }
         let thermostat = match &self.thermostat {
             None => None,
             Some(t) => {
@@ -863,6 +1123,49 @@ impl Scene {
     }
 }
 
+/// The walls a `[[wall]]` table makes (a box makes six).
+fn wall_of(w: &WallSpec, index: usize) -> Result<Vec<Wall>, String> {
+    let name = w.name.clone().unwrap_or_else(|| format!("wall{index}"));
+    let need = |v: Option<[f64; 3]>, key: &str| -> Result<DVec3, String> {
+        v.map(DVec3::from)
+            .ok_or_else(|| format!("a {} wall needs `{key}`", w.kind))
+    };
+    let mut walls = match w.kind.as_str() {
+        "plane" => {
+            let normal = need(w.normal, "normal")?;
+            if normal.length() == 0.0 {
+                return Err("the plane's normal must not be zero".into());
+            }
+            vec![Wall::plane(&name, need(w.point, "point")?, normal)]
+        }
+        "box" => {
+            let (lo, hi) = (need(w.lo, "lo")?, need(w.hi, "hi")?);
+            if (0..3).any(|k| hi[k] <= lo[k]) {
+                return Err("a box wall needs lo < hi on every axis".into());
+            }
+            Wall::closed_box(&name, lo, hi)
+        }
+        "cylinder" => {
+            let axis = need(w.axis, "axis")?;
+            let radius = w.radius.ok_or("a cylinder wall needs `radius`")?;
+            if axis.length() == 0.0 || !(radius > 0.0) {
+                return Err("a cylinder needs a non-zero axis and radius > 0".into());
+            }
+            vec![Wall::cylinder(&name, need(w.point, "point")?, axis, radius)]
+        }
+        other => {
+            return Err(format!(
+                "unknown wall kind '{other}': expected plane, box or cylinder"
+            ))
+        }
+    };
+    for wall in &mut walls {
+        wall.velocity = DVec3::from(w.velocity);
+        wall.angular_speed = w.angular_speed;
+    }
+    Ok(walls)
+}
+
 /// Which MPPphys model a particle file is run with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PlistSystem {
@@ -900,6 +1203,7 @@ impl Scene {
                         mass: p.mass,
                         charge: p.charge,
                         radius: p.radius,
+                        density: None,
                         color: p.color,
                         free: p.free,
                     },

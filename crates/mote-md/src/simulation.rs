@@ -96,7 +96,7 @@ impl Simulation {
         let initial = Observables::measure(&self.system, &mut self.forces);
         let e0 = initial.total_energy();
         let mut max_err: f64 = 0.0;
-        let mut last = initial;
+        let mut last = initial.clone();
         if self.sample_at_start {
             self.sample(true, &initial)?;
         }

@@ -308,6 +308,12 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             out.observables_every,
             built.probes.clone(),
             sim.system.boundary.periodic.iter().all(|p| *p),
+            &sim.forces
+                .interactions
+                .iter()
+                .flat_map(|i| i.wall_forces())
+                .map(|w| w.0)
+                .collect::<Vec<_>>(),
             append,
         )?));
     }

@@ -204,7 +204,9 @@ impl GranularContacts {
                 let reach = radi + self.radius[j];
                 let r2 = d.length_squared();
                 if r2 >= reach * reach {
-                    *h = History::default();
+                    if *h != History::default() {
+                        *h = History::default();
+                    }
                     continue;
                 }
                 let r = r2.sqrt();

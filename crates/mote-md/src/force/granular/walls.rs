@@ -77,35 +77,41 @@ impl Wall {
         }
     }
 
-    /// For a sphere at x: (gap along the normal from the wall surface to the
-    /// centre, unit normal into the particle side, the wall surface's
-    /// velocity at the contact point), at time t.
-    #[inline]
-    fn probe(&self, x: DVec3, t: f64) -> (f64, DVec3, DVec3) {
-        let shift = self.velocity * t;
+    /// For a sphere at x at time t: the gap along the normal from the wall
+    /// surface to the centre, and the unit normal into the particle side.
+    #[inline(always)]
+    fn gap(&self, x: DVec3, t: f64) -> (f64, DVec3) {
         match self.shape {
             WallShape::Plane { point, normal } => {
-                let p = point + shift;
-                let gap = (x - p).dot(normal);
-                let contact = x - normal * gap;
-                let v = self.velocity + (normal * self.angular_speed).cross(contact - p);
-                (gap, normal, v)
+                ((x - point - self.velocity * t).dot(normal), normal)
             }
             WallShape::Cylinder {
                 point,
                 axis,
                 radius,
             } => {
-                let p = point + shift;
-                let rel = x - p;
+                let rel = x - point - self.velocity * t;
                 let radial = rel - axis * rel.dot(axis);
                 let rho = radial.length();
                 let outward = if rho > 0.0 { radial / rho } else { DVec3::X };
-                let contact = p + axis * rel.dot(axis) + outward * radius;
-                let v = self.velocity + (axis * self.angular_speed).cross(contact - p);
-                (radius - rho, -outward, v)
+                (radius - rho, -outward)
             }
         }
+    }
+
+    /// The velocity of the wall's surface at the contact point
+    /// x − gap·n of a sphere at x.
+    #[inline]
+    fn surface_velocity(&self, x: DVec3, gap: f64, n: DVec3, t: f64) -> DVec3 {
+        if self.angular_speed == 0.0 {
+            return self.velocity;
+        }
+        let (point, axis) = match self.shape {
+            WallShape::Plane { point, normal } => (point, normal),
+            WallShape::Cylinder { point, axis, .. } => (point, axis),
+        };
+        let contact = x - n * gap;
+        self.velocity + (axis * self.angular_speed).cross(contact - point - self.velocity * t)
     }
 }
 
@@ -115,8 +121,10 @@ pub struct GranularWalls {
     pub law: ContactLaw,
     pub walls: Vec<Wall>,
     radius: Vec<f64>,
-    /// history[w][i]: the contact of particle i with wall w.
-    history: Vec<Vec<History>>,
+    /// history[i · walls + w]: the contact of particle i with wall w.
+    history: Vec<History>,
+    /// Whether particle i touched wall w at the last evaluation (same layout).
+    touching: Vec<bool>,
     /// The force the particles exert on each wall at the last evaluation.
     wall_force: Vec<DVec3>,
     last_time: Option<f64>,
@@ -127,7 +135,8 @@ impl GranularWalls {
         let n = radius.len();
         Self {
             law,
-            history: vec![vec![History::default(); n]; walls.len()],
+            history: vec![History::default(); n * walls.len()],
+            touching: vec![false; n * walls.len()],
             wall_force: vec![DVec3::ZERO; walls.len()],
             walls,
             radius: radius.to_vec(),
@@ -135,6 +144,9 @@ impl GranularWalls {
         }
     }
 
+    /// One pass over the particles, each tested against every wall; chunks
+    /// of particles run in parallel and their wall forces are summed in
+    /// chunk order (the same bits for every thread count).
     fn evaluate(
         &mut self,
         state: &State,
@@ -142,37 +154,69 @@ impl GranularWalls {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
+        const CHUNK: usize = 1024;
         let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
         self.last_time = Some(state.time);
         let t = state.time;
         let law = self.law;
+        let walls = &self.walls;
+        let n_walls = walls.len();
+        if n_walls == 0 {
+            return;
+        }
         let radius = &self.radius;
-        for (w, wall) in self.walls.iter().enumerate() {
-            let hist = &mut self.history[w];
-            let f_wall: DVec3 = force
-                .par_iter_mut()
-                .zip(torque.par_iter_mut())
-                .zip(hist.par_iter_mut())
-                .enumerate()
-                .with_min_len(1024)
-                .map(|(i, ((f, tq), h))| {
+        let sums: Vec<Vec<DVec3>> = force
+            .par_chunks_mut(CHUNK)
+            .zip(torque.par_chunks_mut(CHUNK))
+            .zip(self.history.par_chunks_mut(CHUNK * n_walls))
+            .zip(self.touching.par_chunks_mut(CHUNK * n_walls))
+            .enumerate()
+            .map(|(c, (((f, tq), hist), touching))| {
+                let mut sum = vec![DVec3::ZERO; n_walls];
+                for k in 0..f.len() {
+                    let i = c * CHUNK + k;
                     let x = state.position[i];
                     let r = radius[i];
-                    let (gap, n, v_wall) = wall.probe(x, t);
-                    if gap >= r || gap <= -r {
-                        *h = History::default();
-                        return DVec3::ZERO;
+                    for (w, wall) in walls.iter().enumerate() {
+                        let slot = k * n_walls + w;
+                        let (gap, n) = wall.gap(x, t);
+                        if gap >= r || gap <= -r {
+                            if touching[slot] {
+                                touching[slot] = false;
+                                hist[slot] = History::default();
+                            }
+                            continue;
+                        }
+                        touching[slot] = true;
+                        let v_wall = wall.surface_velocity(x, gap, n, t);
+                        let delta = r - gap;
+                        let arm = r - 0.5 * delta;
+                        let v_rel = state.velocity[i] - v_wall - (omega[i] * arm).cross(n);
+                        let cf = law.force(
+                            delta,
+                            n,
+                            v_rel,
+                            omega[i],
+                            arm,
+                            0.0,
+                            r,
+                            state.mass[i],
+                            dt,
+                            &mut hist[slot],
+                        );
+                        f[k] += cf.force;
+                        tq[k] += cf.torque_i;
+                        sum[w] -= cf.force;
                     }
-                    let delta = r - gap;
-                    let arm = r - 0.5 * delta;
-                    let v_rel = state.velocity[i] - v_wall - (omega[i] * arm).cross(n);
-                    let c = law.force(delta, n, v_rel, omega[i], arm, 0.0, r, state.mass[i], dt, h);
-                    *f += c.force;
-                    *tq += c.torque_i;
-                    -c.force
-                })
-                .reduce(|| DVec3::ZERO, |a, b| a + b);
-            self.wall_force[w] = f_wall;
+                }
+                sum
+            })
+            .collect();
+        self.wall_force.iter_mut().for_each(|f| *f = DVec3::ZERO);
+        for sum in sums {
+            for (total, s) in self.wall_force.iter_mut().zip(sum) {
+                *total += s;
+            }
         }
     }
 }
@@ -218,7 +262,7 @@ impl Interaction for GranularWalls {
         for wall in &self.walls {
             for (i, &x) in state.position.iter().enumerate() {
                 let r = self.radius[i];
-                let (gap, _, _) = wall.probe(x, state.time);
+                let (gap, _) = wall.gap(x, state.time);
                 if gap < r && gap > -r {
                     u += 8.0 / 15.0 * self.law.e_star * r.sqrt() * (r - gap).powf(2.5);
                 }
