@@ -378,3 +378,34 @@ fn neighbour_list_never_misses_a_contact() {
         assert!(list.builds > 1, "the list must have been rebuilt");
     }
 }
+
+#[test]
+fn granular_scene_errors_name_their_line() {
+    use mote_md::scene::Scene;
+    let base = "[run]\ndt = 1e-5\nsteps = 1\n[[particle]]\nposition = [0.0, 0.0, 0.01]\nradius = 0.001\ndensity = 2500.0\n";
+    let cases = [
+        ("[[wall]]\nkind = \"plane\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n", 8, "needs a [granular]"),
+        ("[granular]\nyoung = 1e6\npoisson = 0.3\nrestitution = 0.5\nfriction = 0.5\n[[wall]]\nkind = \"cone\"\n", 13, "unknown wall kind"),
+        ("[granular]\nyoung = 1e6\npoisson = 0.7\nrestitution = 0.5\nfriction = 0.5\n", 8, "poisson"),
+        ("[granular]\nyoung = 1e6\npoisson = 0.3\nrestitution = 0.5\nfriction = 0.5\ndamping = \"magic\"\n", 8, "unknown damping"),
+    ];
+    for (extra, line, words) in cases {
+        let text = format!("{base}{extra}");
+        let scene = Scene::parse(&text, "s.toml").unwrap();
+        let e = match scene.build(&text, "s.toml", 1) {
+            Err(e) => e,
+            Ok(_) => panic!("{extra} must be rejected"),
+        };
+        assert_eq!(e.line, line, "{e}");
+        assert!(e.message.contains(words), "{e}");
+    }
+    // A good scene builds, with rotation-aware contacts and a wall.
+    let good = format!("{base}[granular]\nyoung = 1e6\npoisson = 0.3\nrestitution = 0.5\nfriction = 0.5\n[[wall]]\nkind = \"box\"\nlo = [-0.1, -0.1, 0.0]\nhi = [0.1, 0.1, 0.1]\n");
+    let built = Scene::parse(&good, "s.toml")
+        .unwrap()
+        .build(&good, "s.toml", 1)
+        .unwrap();
+    assert!(built.simulation.forces.exerts_torques());
+    let m = built.simulation.system.particles.mass[0];
+    assert!((m - 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * 1e-9).abs() < 1e-15);
+}

@@ -8,7 +8,7 @@ pub struct Example {
 
 const CHOREOGRAPHY: &str = include_str!("../../../examples/choreography.toml");
 
-const SCENES: [(&str, &str); 6] = [
+const SCENES: [(&str, &str); 9] = [
     (
         "sun-earth",
         include_str!("../../../examples/sun-earth.toml"),
@@ -29,6 +29,15 @@ const SCENES: [(&str, &str); 6] = [
     (
         "cantilever",
         include_str!("../../../examples/cantilever.toml"),
+    ),
+    ("settling", include_str!("../../../examples/settling.toml")),
+    (
+        "column-collapse",
+        include_str!("../../../examples/column-collapse.toml"),
+    ),
+    (
+        "rotating-drum",
+        include_str!("../../../examples/rotating-drum.toml"),
     ),
 ];
 

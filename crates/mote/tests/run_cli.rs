@@ -79,6 +79,9 @@ fn examples_are_listed_and_written_and_each_one_runs() {
         "double-pendulum",
         "membrane",
         "cantilever",
+        "settling",
+        "column-collapse",
+        "rotating-drum",
     ] {
         assert!(list.contains(name), "{name} missing from {list}");
     }

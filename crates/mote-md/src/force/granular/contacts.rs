@@ -24,6 +24,9 @@ pub struct GranularContacts {
     pub list: VerletList,
     radius: Vec<f64>,
     history: Vec<History>,
+    /// Whether each listed pair touched at the last evaluation; only those
+    /// entries' histories are read or cleared.
+    touching: Vec<bool>,
     history_start: Vec<u32>,
     history_partner: Vec<u32>,
     last_time: Option<f64>,
@@ -43,6 +46,7 @@ impl GranularContacts {
             list: VerletList::half(2.0 * r_max, skin),
             radius: radius.to_vec(),
             history: Vec::new(),
+            touching: Vec::new(),
             history_start: vec![0],
             history_partner: Vec::new(),
             last_time: None,
@@ -72,6 +76,7 @@ impl GranularContacts {
     fn carry_history(&mut self) {
         let n = self.list.start.len().saturating_sub(1);
         let mut history = vec![History::default(); self.list.neighbors.len()];
+        let mut touching = vec![false; self.list.neighbors.len()];
         let old_n = self.history_start.len().saturating_sub(1);
         for i in 0..n.min(old_n) {
             let old = self.history_start[i] as usize..self.history_start[i + 1] as usize;
@@ -84,6 +89,7 @@ impl GranularContacts {
                     std::cmp::Ordering::Greater => b += 1,
                     std::cmp::Ordering::Equal => {
                         history[b] = self.history[a];
+                        touching[b] = self.touching[a];
                         a += 1;
                         b += 1;
                     }
@@ -91,6 +97,7 @@ impl GranularContacts {
             }
         }
         self.history = history;
+        self.touching = touching;
         self.history_start.clone_from(&self.list.start);
         self.history_partner.clone_from(&self.list.neighbors);
     }
@@ -117,18 +124,22 @@ impl GranularContacts {
             .resize_with(blocks.saturating_sub(1), Default::default);
         let mut buffers = std::mem::take(&mut self.buffers);
         let mut history = std::mem::take(&mut self.history);
+        let mut touching = std::mem::take(&mut self.touching);
 
         // Split the history into the slices owned by each block of i.
-        let mut history_blocks: Vec<&mut [History]> = Vec::with_capacity(blocks);
+        let mut history_blocks: Vec<(&mut [History], &mut [bool])> = Vec::with_capacity(blocks);
         {
             let mut rest: &mut [History] = &mut history;
+            let mut rest_touch: &mut [bool] = &mut touching;
             let mut taken = 0usize;
             for b in 0..blocks {
                 let end_i = ((b + 1) * per_block).min(n);
                 let end = self.list.start[end_i] as usize;
                 let (head, tail) = rest.split_at_mut(end - taken);
-                history_blocks.push(head);
+                let (head_touch, tail_touch) = rest_touch.split_at_mut(end - taken);
+                history_blocks.push((head, head_touch));
                 rest = tail;
+                rest_touch = tail_touch;
                 taken = end;
             }
         }
@@ -147,10 +158,10 @@ impl GranularContacts {
             .into_par_iter()
             .zip(history_blocks)
             .enumerate()
-            .map(|(b, ((f, t), hist))| {
+            .map(|(b, ((f, t), (hist, touch)))| {
                 let first = (b * per_block).min(n);
                 let last = ((b + 1) * per_block).min(n);
-                this.block(state, omega, first..last, dt, f, t, hist)
+                this.block(state, omega, first..last, dt, f, t, hist, touch)
             })
             .collect();
 
@@ -168,6 +179,7 @@ impl GranularContacts {
                 });
         }
         self.history = history;
+        self.touching = touching;
         self.buffers = buffers;
         self.contacts = results.iter().map(|r| r.0).sum();
         self.virial = results.iter().map(|r| r.1).sum();
@@ -185,6 +197,7 @@ impl GranularContacts {
         f: &mut [DVec3],
         t: &mut [DVec3],
         hist: &mut [History],
+        touch: &mut [bool],
     ) -> (usize, f64) {
         let pos = state.position;
         let vel = state.velocity;
@@ -199,16 +212,19 @@ impl GranularContacts {
             let lo = self.list.start[i] as usize;
             for (k, &j) in self.list.of(i).iter().enumerate() {
                 let j = j as usize;
-                let h = &mut hist[lo + k - offset];
+                let slot = lo + k - offset;
                 let d = image.apply(ri - pos[j]);
                 let reach = radi + self.radius[j];
                 let r2 = d.length_squared();
                 if r2 >= reach * reach {
-                    if *h != History::default() {
-                        *h = History::default();
+                    if touch[slot] {
+                        touch[slot] = false;
+                        hist[slot] = History::default();
                     }
                     continue;
                 }
+                touch[slot] = true;
+                let h = &mut hist[slot];
                 let r = r2.sqrt();
                 let nrm = d / r;
                 let delta = reach - r;

@@ -165,6 +165,17 @@ impl GranularWalls {
             return;
         }
         let radius = &self.radius;
+        // Planes as (n, c) with gap = x·n − c at this time.
+        let planes: Vec<Option<(DVec3, f64)>> = walls
+            .iter()
+            .map(|w| match w.shape {
+                WallShape::Plane { point, normal } => {
+                    Some((normal, (point + w.velocity * t).dot(normal)))
+                }
+                WallShape::Cylinder { .. } => None,
+            })
+            .collect();
+        let planes = &planes;
         let sums: Vec<Vec<DVec3>> = force
             .par_chunks_mut(CHUNK)
             .zip(torque.par_chunks_mut(CHUNK))
@@ -179,7 +190,10 @@ impl GranularWalls {
                     let r = radius[i];
                     for (w, wall) in walls.iter().enumerate() {
                         let slot = k * n_walls + w;
-                        let (gap, n) = wall.gap(x, t);
+                        let (gap, n) = match planes[w] {
+                            Some((normal, offset)) => (x.dot(normal) - offset, normal),
+                            None => wall.gap(x, t),
+                        };
                         if gap >= r || gap <= -r {
                             if touching[slot] {
                                 touching[slot] = false;
