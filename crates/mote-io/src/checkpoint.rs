@@ -29,6 +29,12 @@ pub struct Checkpoint {
     /// Integrator state carried from step to step (leap-frog's last
     /// accelerations); empty when there is none.
     pub accelerations: Vec<[f64; 3]>,
+    /// Angular velocities and carried angular accelerations (ω, α) of
+    /// rotating particles; empty when nothing rotates.
+    pub angular: Vec<[f64; 6]>,
+    /// What each interaction carries from step to step (contact
+    /// histories), by the interaction's index; empty lists are omitted.
+    pub carried: Vec<(usize, Vec<f64>)>,
 }
 
 impl Checkpoint {
@@ -74,6 +80,21 @@ pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), IoError> {
         let w: Vec<String> = a.iter().map(|x| hex(*x)).collect();
         text.push_str(&w.join(" "));
         text.push('\n');
+    }
+    text.push_str(&format!("angular {}\n", cp.angular.len()));
+    for a in &cp.angular {
+        let w: Vec<String> = a.iter().map(|x| hex(*x)).collect();
+        text.push_str(&w.join(" "));
+        text.push('\n');
+    }
+    for (index, values) in &cp.carried {
+        let lines = values.len().div_ceil(8);
+        text.push_str(&format!("carried {index} {} {lines}\n", values.len()));
+        for chunk in values.chunks(8) {
+            let w: Vec<String> = chunk.iter().map(|x| hex(*x)).collect();
+            text.push_str(&w.join(" "));
+            text.push('\n');
+        }
     }
     let tmp = path.with_extension("tmp");
     let write = || -> std::io::Result<()> {
@@ -146,6 +167,50 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
                     .extend(rows.iter().map(|v| [v[0], v[1], v[2]]));
                 k += rows.len();
             }
+            "angular" => {
+                let rows = table(
+                    &lines,
+                    k,
+                    rest,
+                    6,
+                    "wx wy wz alpha_x alpha_y alpha_z",
+                    &bits,
+                    &err,
+                )?;
+                cp.angular
+                    .extend(rows.iter().map(|v| [v[0], v[1], v[2], v[3], v[4], v[5]]));
+                k += rows.len();
+            }
+            "carried" => {
+                let w: Vec<usize> = rest
+                    .split_whitespace()
+                    .map(|x| {
+                        x.parse()
+                            .map_err(|_| err(k, "carried needs: index count lines"))
+                    })
+                    .collect::<Result<_, _>>()?;
+                let [index, count, nlines] = w[..] else {
+                    return Err(err(k, "carried needs: index count lines").into());
+                };
+                let mut values = Vec::with_capacity(count);
+                for ln in k + 1..=k + nlines {
+                    let line = lines
+                        .get(ln)
+                        .ok_or_else(|| err(ln, "the carried state ends early"))?;
+                    for x in line.split_whitespace() {
+                        values.push(bits(x, ln)?);
+                    }
+                }
+                if values.len() != count {
+                    return Err(err(
+                        k,
+                        &format!("carried announces {count} numbers, found {}", values.len()),
+                    )
+                    .into());
+                }
+                cp.carried.push((index, values));
+                k += nlines;
+            }
             "" => {}
             other => return Err(err(k, &format!("unknown record '{other}'")).into()),
         }
@@ -206,6 +271,11 @@ mod tests {
             positions: vec![[1.0 / 3.0, -0.0, 1e-300], [f64::MAX, 2.5, -7.25]],
             velocities: vec![[0.1, 0.2, 0.3], [std::f64::consts::PI, 0.0, -1.0]],
             accelerations: vec![[1e-9, -2.0, 3.5], [0.0, 0.0, 1.0]],
+            angular: vec![[1.0, 2.0, 3.0, 4.0, 5.0, f64::MIN_POSITIVE]; 2],
+            carried: vec![
+                (0, (0..11).map(|k| k as f64 / 7.0).collect()),
+                (2, vec![-0.0, f64::INFINITY]),
+            ],
         };
         write(&path, &cp).unwrap();
         let back = read(&path).unwrap();

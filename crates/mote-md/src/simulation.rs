@@ -48,6 +48,12 @@ pub trait Observer {
     fn files(&self) -> Vec<String> {
         Vec::new()
     }
+    /// Called just before [`Observer::observe`] with the force field, for
+    /// observers that record what interactions carry from step to step
+    /// (checkpoints of contact histories).
+    fn observe_forces(&mut self, forces: &ForceField) {
+        let _ = forces;
+    }
 }
 
 /// What a run did.
@@ -153,6 +159,7 @@ impl Simulation {
         let step = self.system.step;
         for o in &mut self.observers {
             if always || step.is_multiple_of(o.every().max(1)) {
+                o.observe_forces(&self.forces);
                 o.observe(&self.system, obs)?;
             }
         }

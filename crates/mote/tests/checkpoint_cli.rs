@@ -141,3 +141,124 @@ fn killed_run_resumes_bit_for_bit() {
     let late: f64 = kt[kt.len() - 10..].iter().sum::<f64>() / 10.0;
     assert!((late - 1.0).abs() < 0.1, "kT at the end {late}");
 }
+
+const GRANULAR: &str = r#"
+title = "spheres falling into a box (checkpoint test: contact histories and spins)"
+units = "si"
+seed = 5
+[run]
+integrator = "leapfrog"
+dt = 5e-5
+steps = 4000
+[field]
+g = [0.0, 0.0, -9.81]
+[granular]
+young = 1e6
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+rolling_friction = 0.02
+[[wall]]
+kind = "box"
+lo = [0.0, 0.0, 0.0]
+hi = [0.03, 0.03, 0.05]
+[[cloud]]
+n = 400
+min = [0.0, 0.0, 0.0]
+max = [0.03, 0.03, 0.05]
+radius = 0.0015
+spread = 0.2
+density = 2500.0
+[output]
+observables_every = 100
+trajectory_every = 0
+"#;
+
+/// A granular run killed mid-way resumes bit for bit: the checkpoint holds
+/// the angular velocities and the contact histories of pairs and walls.
+#[test]
+fn killed_granular_run_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("g.toml"), GRANULAR).unwrap();
+    let args = |out: &'static str| {
+        vec![
+            "run",
+            "g.toml",
+            "--threads",
+            "1",
+            "-q",
+            "-o",
+            out,
+            "--checkpoint-every",
+            "100",
+        ]
+    };
+    let o = mote(&args("whole"), dir.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let whole = mote_io::checkpoint::read(&dir.path().join("whole/checkpoint.mote")).unwrap();
+    assert_eq!(whole.step, 4000);
+    assert!(!whole.angular.is_empty() && !whole.carried.is_empty());
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(args("cut"))
+        .current_dir(dir.path())
+        .spawn()
+        .unwrap();
+    let cp_path = dir.path().join("cut/checkpoint.mote");
+    let start = Instant::now();
+    loop {
+        if let Ok(cp) = mote_io::checkpoint::read(&cp_path) {
+            // Past the impact on the floor, so histories are carried.
+            if cp.step >= 1500 {
+                break;
+            }
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no checkpoint appeared"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let at_kill = mote_io::checkpoint::read(&cp_path).unwrap();
+    assert!(at_kill.step < 4000, "finished before it could be killed");
+    assert!(
+        at_kill.carried.iter().any(|(_, v)| v.len() > 1),
+        "no contact history at the kill"
+    );
+
+    let o = mote(
+        &[
+            "run",
+            "--resume",
+            "cut/checkpoint.mote",
+            "--threads",
+            "1",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let resumed = mote_io::checkpoint::read(&cp_path).unwrap();
+    assert_eq!(resumed.step, 4000);
+    let bits = |v: &[[f64; 3]]| {
+        v.iter()
+            .flatten()
+            .map(|x| x.to_bits())
+            .collect::<Vec<u64>>()
+    };
+    assert_eq!(
+        bits(&resumed.positions),
+        bits(&whole.positions),
+        "positions differ (killed at {})",
+        at_kill.step
+    );
+    assert_eq!(
+        bits(&resumed.velocities),
+        bits(&whole.velocities),
+        "velocities differ"
+    );
+    assert_eq!(resumed.angular, whole.angular, "spins differ");
+    assert_eq!(resumed.carried, whole.carried, "contact histories differ");
+}

@@ -65,6 +65,20 @@ pub trait Interaction: Send {
     }
     /// The potential energy of the interaction; 0 for dissipative forces.
     fn potential_energy(&mut self, state: &State) -> f64;
+    /// What this interaction carries from one evaluation to the next (contact
+    /// histories), as plain numbers for checkpoints; empty if nothing.
+    fn carried_state(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    /// Restores what [`Interaction::carried_state`] gave, before the first
+    /// evaluation of a resumed run.
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        if state.is_empty() {
+            Ok(())
+        } else {
+            Err(format!("{} carries no state", self.name()))
+        }
+    }
     /// The force the particles exert on each wall of this interaction
     /// (name, force) at the last evaluation; empty for interactions without
     /// walls.

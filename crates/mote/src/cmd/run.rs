@@ -102,6 +102,8 @@ struct CheckpointWriter {
     path: PathBuf,
     every: u64,
     template: Checkpoint,
+    /// The interactions' carried state, taken just before `observe`.
+    carried: Vec<(usize, Vec<f64>)>,
 }
 
 impl Observer for CheckpointWriter {
@@ -109,9 +111,30 @@ impl Observer for CheckpointWriter {
         self.every
     }
 
+    fn observe_forces(&mut self, forces: &mote_md::ForceField) {
+        self.carried = forces
+            .interactions
+            .iter()
+            .enumerate()
+            .map(|(k, i)| (k, i.carried_state()))
+            .filter(|(_, v)| !v.is_empty())
+            .collect();
+    }
+
     fn observe(&mut self, sys: &System, _obs: &Observables) -> Result<(), MdError> {
         let p = &sys.particles;
+        let rotating = !sys.carried_angular_acceleration.is_empty();
         let cp = Checkpoint {
+            angular: if rotating {
+                p.angular_velocity
+                    .iter()
+                    .zip(&sys.carried_angular_acceleration)
+                    .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            carried: self.carried.clone(),
             time: sys.time,
             step: sys.step,
             positions: p.position.iter().map(|r| r.to_array()).collect(),
@@ -286,6 +309,33 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
             .iter()
             .map(|a| mote_md::DVec3::from(*a))
             .collect();
+        if !cp.angular.is_empty() {
+            if cp.angular.len() != sys.particles.len() {
+                bail!(
+                    "{}: the checkpoint's angular table has the wrong length",
+                    input.label
+                );
+            }
+            sys.carried_angular_acceleration.clear();
+            for (i, a) in cp.angular.iter().enumerate() {
+                sys.particles.angular_velocity[i] = mote_md::DVec3::new(a[0], a[1], a[2]);
+                sys.carried_angular_acceleration
+                    .push(mote_md::DVec3::new(a[3], a[4], a[5]));
+            }
+        }
+        let forces = &mut built.simulation.forces;
+        let count = forces.interactions.len();
+        for (k, values) in &cp.carried {
+            let interaction = forces.interactions.get_mut(*k).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{}: the checkpoint carries state for interaction {k}, the scene has {count}",
+                    input.label
+                )
+            })?;
+            interaction
+                .restore_carried_state(values)
+                .map_err(|m| anyhow::anyhow!("{}: {m}", input.label))?;
+        }
         built.simulation.sample_at_start = false;
     }
     let length =
@@ -349,6 +399,7 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
                 input_text: input.text.clone(),
                 ..Checkpoint::default()
             },
+            carried: Vec::new(),
         }));
     }
 

@@ -30,6 +30,8 @@ pub struct GranularContacts {
     history_start: Vec<u32>,
     history_partner: Vec<u32>,
     last_time: Option<f64>,
+    /// Histories restored from a checkpoint, placed at the next evaluation.
+    pending: Vec<(u32, u32, History)>,
     /// One (force, torque) buffer per extra block of particles.
     buffers: Vec<(Vec<DVec3>, Vec<DVec3>)>,
     contacts: usize,
@@ -50,6 +52,7 @@ impl GranularContacts {
             history_start: vec![0],
             history_partner: Vec::new(),
             last_time: None,
+            pending: Vec::new(),
             buffers: Vec::new(),
             contacts: 0,
             virial: 0.0,
@@ -70,6 +73,19 @@ impl GranularContacts {
             .binary_search(&(j as u32))
             .ok()?;
         Some(self.history[range.start + k])
+    }
+
+    /// Puts restored histories into the list (every touching pair is listed,
+    /// since touching means closer than 2 r_max).
+    fn place_pending(&mut self) {
+        for (i, j, h) in std::mem::take(&mut self.pending) {
+            let (i, j) = (i as usize, j);
+            let range = self.list.start[i] as usize..self.list.start[i + 1] as usize;
+            if let Ok(k) = self.list.neighbors[range.clone()].binary_search(&j) {
+                self.history[range.start + k] = h;
+                self.touching[range.start + k] = true;
+            }
+        }
     }
 
     /// Carries the history over to a freshly built list.
@@ -114,6 +130,9 @@ impl GranularContacts {
         if self.list.update(pos, &self.boundary) || self.history.len() != self.list.neighbors.len()
         {
             self.carry_history();
+        }
+        if !self.pending.is_empty() {
+            self.place_pending();
         }
         let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
         self.last_time = Some(state.time);
@@ -283,6 +302,48 @@ impl Interaction for GranularContacts {
         torque: &mut [DVec3],
     ) {
         self.evaluate(state, spin.angular_velocity, force, torque);
+    }
+
+    /// [time of the last evaluation (NaN: none), then per touching pair
+    /// i, j, ξ (3), ψ (3)].
+    fn carried_state(&self) -> Vec<f64> {
+        let mut out = vec![self.last_time.unwrap_or(f64::NAN)];
+        let n = self.list.start.len().saturating_sub(1);
+        for i in 0..n.min(self.history_start.len().saturating_sub(1)) {
+            for k in self.history_start[i] as usize..self.history_start[i + 1] as usize {
+                if self.touching.get(k) == Some(&true) {
+                    let h = self.history[k];
+                    out.extend([i as f64, self.history_partner[k] as f64]);
+                    out.extend(h.shear.to_array());
+                    out.extend(h.roll.to_array());
+                }
+            }
+        }
+        out
+    }
+
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        let Some((&t, rows)) = state.split_first() else {
+            return Ok(());
+        };
+        if rows.len() % 8 != 0 {
+            return Err("granular contact history: rows of 8 numbers expected".into());
+        }
+        self.last_time = (!t.is_nan()).then_some(t);
+        let n = self.radius.len();
+        self.pending.clear();
+        for r in rows.chunks(8) {
+            let (i, j) = (r[0] as usize, r[1] as usize);
+            if i >= n || j >= n || i >= j {
+                return Err(format!("granular contact history names pair ({i}, {j})"));
+            }
+            let h = History {
+                shear: DVec3::new(r[2], r[3], r[4]),
+                roll: DVec3::new(r[5], r[6], r[7]),
+            };
+            self.pending.push((i as u32, j as u32, h));
+        }
+        Ok(())
     }
 
     /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}.

@@ -270,6 +270,43 @@ impl Interaction for GranularWalls {
         self.evaluate(state, spin.angular_velocity, force, torque);
     }
 
+    /// [time of the last evaluation (NaN: none), then per touching
+    /// (particle, wall) slot: slot, ξ (3), ψ (3)].
+    fn carried_state(&self) -> Vec<f64> {
+        let mut out = vec![self.last_time.unwrap_or(f64::NAN)];
+        for (k, h) in self.history.iter().enumerate() {
+            if self.touching[k] {
+                out.push(k as f64);
+                out.extend(h.shear.to_array());
+                out.extend(h.roll.to_array());
+            }
+        }
+        out
+    }
+
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        let Some((&t, rows)) = state.split_first() else {
+            return Ok(());
+        };
+        if rows.len() % 7 != 0 {
+            return Err("wall contact history: rows of 7 numbers expected".into());
+        }
+        self.last_time = (!t.is_nan()).then_some(t);
+        self.touching.iter_mut().for_each(|x| *x = false);
+        for r in rows.chunks(7) {
+            let k = r[0] as usize;
+            if k >= self.history.len() {
+                return Err(format!("wall contact history names slot {k}"));
+            }
+            self.touching[k] = true;
+            self.history[k] = History {
+                shear: DVec3::new(r[1], r[2], r[3]),
+                roll: DVec3::new(r[4], r[5], r[6]),
+            };
+        }
+        Ok(())
+    }
+
     /// The Hertz elastic energy of the wall contacts, Σ (8/15) E* √R δ^{5/2}.
     fn potential_energy(&mut self, state: &State) -> f64 {
         let mut u = 0.0;
