@@ -1,2 +1,33 @@
 //! Rigid bodies made of overlapping spheres, moved by Mutze's Fast Rigid
-//! Bodies Integrator (seed 000).
+//! Bodies Integrator (seed 000, "Modeling the dynamics of irregularly shaped
+//! particles").
+//!
+//! - [`template`]: a union of spheres with material, charge and dipole
+//!   ([`ClumpSpec`]) becomes a shared [`BodyTemplate`] with mass properties
+//!   by randomised quasi-Monte Carlo integration (with error estimates);
+//! - [`shapes`]: dumbbells, trimers, random irregular clumps;
+//! - [`bodies`]: the state — placements `E(r, x)` and velocities `dE(ω, v)`
+//!   as a structure of arrays — and its observables;
+//! - [`interaction`]: the [`BodyInteraction`] trait and the world-frame view
+//!   of spheres and dipoles it reads (where contact models plug in);
+//! - [`sources`]: fields, gravity, drag, Coulomb, dipole–dipole;
+//! - [`frbi`]: `freeStep`, `react` and the many-body step.
+//!
+//! The algebra (E, dE, I, exp, log) is the crate `mote-geom`.
+
+pub mod bodies;
+pub mod frbi;
+pub mod interaction;
+pub mod shapes;
+pub mod sources;
+pub mod template;
+
+pub use bodies::{BodyObservables, RigidBodies};
+pub use frbi::{free_step, react, BodyEnergies, Frbi, FreeFlight, SpinUpdate};
+pub use interaction::{BodyInteraction, BodyView, WorldFrame};
+pub use shapes::{dumbbell, linear_trimer, IrregularClump};
+pub use sources::{AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity};
+pub use template::{
+    mass_properties, principal, BodyTemplate, ClumpSpec, Integration, MassErrors, MassProperties,
+    TemplateError,
+};

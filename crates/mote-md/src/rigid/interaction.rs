@@ -1,0 +1,127 @@
+//! Forces and torques on rigid bodies: the [`BodyInteraction`] trait and the
+//! world-frame view of the bodies it reads.
+//!
+//! Each interaction adds, per body, the wrench `dE(T, F)` — torque about the
+//! body's centre of mass and force on it (seed 000: "a force (on its center
+//! of mass) and a torque (around its center of mass)"). The integrator calls
+//! every interaction once per step, at t + Δt/2, with a [`BodyView`] that
+//! holds the sphere centres `x + cₖ * r` and dipoles `j * r` in the world
+//! frame (seed 000, FBI step 3), so a contact model (Hertz spheres, walls)
+//! can loop over spheres without touching the algebra.
+
+use glam::DVec3;
+use mote_geom::{rotation_matrix, DE};
+use rayon::prelude::*;
+
+use super::bodies::RigidBodies;
+
+/// A source of forces and torques on bodies; one virtual call per step.
+pub trait BodyInteraction: Send + Sync {
+    /// A short name for reports.
+    fn name(&self) -> &str;
+
+    /// Adds to `wrench[i]` the torque (about the centre of mass, in `omega`)
+    /// and force (in `v`) on body i at time `t`.
+    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]);
+
+    /// The potential energy at time `t` (zero for dissipative forces).
+    fn potential_energy(&self, _view: &BodyView<'_>, _t: f64) -> f64 {
+        0.0
+    }
+}
+
+/// The spheres and dipoles of all bodies in the world frame: scratch space
+/// the integrator refreshes before each force evaluation.
+#[derive(Clone, Debug, Default)]
+pub struct WorldFrame {
+    /// Sphere centres `x + cₖ * r`, body by body.
+    pub sphere_centre: Vec<DVec3>,
+    pub sphere_radius: Vec<f64>,
+    /// The body each sphere belongs to.
+    pub sphere_body: Vec<u32>,
+    /// Spheres of body i are `sphere_start[i]..sphere_start[i + 1]`.
+    pub sphere_start: Vec<u32>,
+    /// Magnetic dipoles `j * r`.
+    pub dipole: Vec<DVec3>,
+}
+
+impl WorldFrame {
+    /// Recomputes everything from the bodies' placements (parallel over
+    /// bodies for large systems; the result does not depend on threads).
+    pub fn update(&mut self, bodies: &RigidBodies) {
+        let n = bodies.len();
+        if self.sphere_start.len() != n + 1 || self.sphere_body.is_empty() && n > 0 {
+            self.sphere_start.clear();
+            self.sphere_body.clear();
+            self.sphere_radius.clear();
+            let mut k = 0u32;
+            for i in 0..n {
+                self.sphere_start.push(k);
+                let t = bodies.template(i);
+                k += t.sphere_count() as u32;
+                self.sphere_radius.extend_from_slice(&t.radii);
+                self.sphere_body
+                    .resize(self.sphere_body.len() + t.sphere_count(), i as u32);
+            }
+            self.sphere_start.push(k);
+            self.sphere_centre.resize(k as usize, DVec3::ZERO);
+        }
+        self.dipole.resize(n, DVec3::ZERO);
+        let fill = |i: usize, centres: &mut [DVec3], dipole: &mut DVec3| {
+            let t = bodies.template(i);
+            let m = rotation_matrix(bodies.rotation[i]);
+            let x = bodies.position[i];
+            for (c, b) in centres.iter_mut().zip(&t.centres) {
+                *c = x + m * *b;
+            }
+            *dipole = m * t.dipole;
+        };
+        if n >= 4096 {
+            // split the sphere array at body boundaries
+            let starts = &self.sphere_start;
+            let mut rest: &mut [DVec3] = &mut self.sphere_centre;
+            let mut parts = Vec::with_capacity(n);
+            for i in 0..n {
+                let len = (starts[i + 1] - starts[i]) as usize;
+                let (head, tail) = rest.split_at_mut(len);
+                parts.push(head);
+                rest = tail;
+            }
+            parts
+                .into_par_iter()
+                .zip(self.dipole.par_iter_mut())
+                .enumerate()
+                .for_each(|(i, (c, d))| fill(i, c, d));
+        } else {
+            for i in 0..n {
+                let (a, b) = (
+                    self.sphere_start[i] as usize,
+                    self.sphere_start[i + 1] as usize,
+                );
+                fill(i, &mut self.sphere_centre[a..b], &mut self.dipole[i]);
+            }
+        }
+    }
+}
+
+/// What an interaction sees: the bodies and their world-frame spheres.
+#[derive(Clone, Copy)]
+pub struct BodyView<'a> {
+    pub bodies: &'a RigidBodies,
+    pub world: &'a WorldFrame,
+}
+
+impl BodyView<'_> {
+    /// The velocity of the material point `p` of body i: `v + ω × (p − x)`.
+    #[inline]
+    pub fn point_velocity(&self, i: usize, p: DVec3) -> DVec3 {
+        self.bodies.velocity[i] + self.bodies.omega[i].cross(p - self.bodies.position[i])
+    }
+
+    /// The wrench of a force `f` applied at the point `p` of body i:
+    /// `dE((p − x) × f, f)` (for contact models).
+    #[inline]
+    pub fn wrench_at(&self, i: usize, p: DVec3, f: DVec3) -> DE {
+        DE::new((p - self.bodies.position[i]).cross(f), f)
+    }
+}
