@@ -80,7 +80,7 @@ impl Wall {
     /// For a sphere at x at time t: the gap along the normal from the wall
     /// surface to the centre, and the unit normal into the particle side.
     #[inline(always)]
-    fn gap(&self, x: DVec3, t: f64) -> (f64, DVec3) {
+    pub fn gap(&self, x: DVec3, t: f64) -> (f64, DVec3) {
         match self.shape {
             WallShape::Plane { point, normal } => {
                 ((x - point - self.velocity * t).dot(normal), normal)
@@ -102,7 +102,7 @@ impl Wall {
     /// The velocity of the wall's surface at the contact point
     /// x − gap·n of a sphere at x.
     #[inline]
-    fn surface_velocity(&self, x: DVec3, gap: f64, n: DVec3, t: f64) -> DVec3 {
+    pub fn surface_velocity(&self, x: DVec3, gap: f64, n: DVec3, t: f64) -> DVec3 {
         if self.angular_speed == 0.0 {
             return self.velocity;
         }
