@@ -271,61 +271,6 @@ pub fn fcc(
     )
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// 002 Table 1, with the N = 8 entry as corrected in shared/seeds/README.md.
-    #[test]
-    #[allow(clippy::approx_constant)] // 0.707107 is the table's entry, not 1/√2
-    fn choreography_sums_match_table_1() {
-        let table = [
-            (2, 0.707107),
-            (3, 1.632993),
-            (4, 2.707107),
-            (5, 3.892996),
-            (6, 5.168527),
-            (7, 6.518859),
-            (8, 7.933359),
-            (9, 9.404033),
-        ];
-        for (n, expected) in table {
-            let v = choreography_sum(n);
-            assert!((v - expected).abs() < 6e-7, "N = {n}: {v:.6} vs {expected}");
-            assert_eq!(format!("{v:.6}"), format!("{expected:.6}"), "N = {n}");
-        }
-    }
-
-    #[test]
-    fn lattice_springs_count_and_anchors() {
-        let t = ParticleInit::default();
-        let lat = lattice(
-            [8, 8, 1],
-            DVec3::ZERO,
-            DVec3::ONE,
-            &t,
-            Anchor::Boundary,
-            Some((1.0, 0.0, false)),
-        );
-        assert_eq!(lat.sites.len(), 64);
-        assert_eq!(lat.springs.len(), 2 * 8 * 7);
-        assert_eq!(
-            lat.sites.iter().filter(|p| p.free == [false; 3]).count(),
-            28
-        );
-        let lat = lattice(
-            [4, 2, 1],
-            DVec3::ZERO,
-            DVec3::ONE,
-            &t,
-            Anchor::FirstColumn,
-            Some((1.0, 0.0, true)),
-        );
-        assert_eq!(lat.springs.len(), 3 * 2 + 4 + 2 * 3);
-        assert!(lat.springs.iter().all(|s| s.rest_length > 0.99));
-    }
-}
-
 /// A cloud of non-overlapping spheres in the box [min, max] by random
 /// sequential addition (as Yade's `makeCloud`): radii uniform in
 /// r (1 ± spread), each sphere tried at up to `attempts` random places and
@@ -387,4 +332,59 @@ pub fn cloud(
         });
     }
     placed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 002 Table 1, with the N = 8 entry as corrected in shared/seeds/README.md.
+    #[test]
+    #[allow(clippy::approx_constant)] // 0.707107 is the table's entry, not 1/√2
+    fn choreography_sums_match_table_1() {
+        let table = [
+            (2, 0.707107),
+            (3, 1.632993),
+            (4, 2.707107),
+            (5, 3.892996),
+            (6, 5.168527),
+            (7, 6.518859),
+            (8, 7.933359),
+            (9, 9.404033),
+        ];
+        for (n, expected) in table {
+            let v = choreography_sum(n);
+            assert!((v - expected).abs() < 6e-7, "N = {n}: {v:.6} vs {expected}");
+            assert_eq!(format!("{v:.6}"), format!("{expected:.6}"), "N = {n}");
+        }
+    }
+
+    #[test]
+    fn lattice_springs_count_and_anchors() {
+        let t = ParticleInit::default();
+        let lat = lattice(
+            [8, 8, 1],
+            DVec3::ZERO,
+            DVec3::ONE,
+            &t,
+            Anchor::Boundary,
+            Some((1.0, 0.0, false)),
+        );
+        assert_eq!(lat.sites.len(), 64);
+        assert_eq!(lat.springs.len(), 2 * 8 * 7);
+        assert_eq!(
+            lat.sites.iter().filter(|p| p.free == [false; 3]).count(),
+            28
+        );
+        let lat = lattice(
+            [4, 2, 1],
+            DVec3::ZERO,
+            DVec3::ONE,
+            &t,
+            Anchor::FirstColumn,
+            Some((1.0, 0.0, true)),
+        );
+        assert_eq!(lat.springs.len(), 3 * 2 + 4 + 2 * 3);
+        assert!(lat.springs.iter().all(|s| s.rest_length > 0.99));
+    }
 }

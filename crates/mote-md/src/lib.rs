@@ -9,11 +9,13 @@
 #![allow(clippy::needless_range_loop)] // index loops over parallel arrays read best in numerical code
 
 pub mod boundary;
+pub mod brownian;
 pub mod eos;
 pub mod error;
 pub mod force;
 pub mod init;
 pub mod integrate;
+pub mod magnetic;
 pub mod neighbor;
 pub mod observe;
 pub mod output;

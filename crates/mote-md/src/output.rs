@@ -26,6 +26,7 @@ pub struct ObservablesCsv {
 }
 
 impl ObservablesCsv {
+    #[allow(clippy::too_many_arguments)]
     pub fn create(
         path: &Path,
         provenance: &Provenance,

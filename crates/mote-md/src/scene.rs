@@ -942,7 +942,12 @@ impl Scene {
             let v = g.get_ref();
             let radius: Vec<f64> = particles.radius.clone();
             let bad = |msg: &str| Err(err(g.span(), msg.to_string()));
-            if !(v.young > 0.0) || !(-1.0 < v.poisson && v.poisson < 0.5) {
+            if v.young.is_nan()
+                || v.young <= 0.0
+                || v.poisson.is_nan()
+                || v.poisson <= -1.0
+                || v.poisson >= 0.5
+            {
                 return bad("[granular] needs young > 0 and −1 < poisson < 0.5");
             }
             if !(v.restitution > 0.0 && v.restitution <= 1.0) {
@@ -988,7 +993,7 @@ impl Scene {
             law.adhesion = v.adhesion;
             let d_min = radius.iter().cloned().fold(f64::INFINITY, f64::min) * 2.0;
             let skin = v.skin.unwrap_or(0.25 * d_min);
-            if !(skin > 0.0) {
+            if skin.is_nan() || skin <= 0.0 {
                 return bad("[granular] skin must be positive");
             }
             forces.push(GranularContacts::new(law, &radius, skin, boundary));
@@ -1148,7 +1153,7 @@ fn wall_of(w: &WallSpec, index: usize) -> Result<Vec<Wall>, String> {
         "cylinder" => {
             let axis = need(w.axis, "axis")?;
             let radius = w.radius.ok_or("a cylinder wall needs `radius`")?;
-            if axis.length() == 0.0 || !(radius > 0.0) {
+            if axis.length() == 0.0 || radius.is_nan() || radius <= 0.0 {
                 return Err("a cylinder needs a non-zero axis and radius > 0".into());
             }
             vec![Wall::cylinder(&name, need(w.point, "point")?, axis, radius)]
