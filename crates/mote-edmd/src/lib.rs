@@ -5,20 +5,24 @@
 //! axis, and advances them from event to event (pair collisions, wall
 //! collisions, neighbour-list renewals). See [`system`] for the algorithm and its
 //! sources, [`scene`] for the settings a scene file gives, [`theory`] for the
-//! results the tests compare with.
+//! results the tests compare with, [`pack`] for packings by growth
+//! (Lubachevsky–Stillinger) and [`analyse`] for their structure.
 
 // Component loops `for d in 0..D` over several arrays read as the math does.
 #![allow(clippy::needless_range_loop)]
 
+pub mod analyse;
 pub mod init;
+pub mod pack;
 pub mod queue;
 pub mod scene;
 pub mod system;
 pub mod theory;
 pub mod vecd;
 
+pub use pack::{PackOutcome, PackSettings, Packer, SizeSpec, Stop};
 pub use scene::{Run, Scene};
-pub use system::{pair_time, shell_factor, Boundary, Counters, SimBox, System};
+pub use system::{growing_pair_time, pair_time, shell_factor, Boundary, Counters, SimBox, System};
 
 /// Errors of the event-driven engine.
 #[derive(Debug, thiserror::Error)]

@@ -16,9 +16,15 @@
 //! particle keeps its own time `t_i` and is advanced only when it takes part
 //! in an event).
 //!
-//! Growth (issue 5) fits in by replacing the contact distance σ_ij with
-//! σ_ij(t) = σ_ij(0)(1 + δt) in [`pair_time`] and widening the cells; the
-//! event loop itself does not change.
+//! Growth (Lubachevsky–Stillinger; 003 §III.1, KTS Eq. 17): with a growth
+//! rate δ ≠ 0 ([`System::with_growth`]) every radius is r_i(t) = r_i(0)(1 + δt),
+//! the contact distance σ_ij(t) = σ_ij(0)(1 + δt) grows at s = σ_ij(0)δ, the
+//! prediction solves |r + vt|² = (σ + st)² ([`growing_pair_time`]) and a
+//! collision reflects the normal relative velocity in the frame of the growing
+//! surfaces, u_n → 2s − u_n. Neighbour lists and cells are built for the
+//! radii at a *horizon* time t_h (R_i = r_i(t_h)), so they stay valid up to
+//! t_h; the caller (the packer, [`crate::pack`]) starts a fresh system there.
+//! The event loop itself does not change; δ = 0 runs the original code.
 
 use crate::queue::EventQueue;
 use crate::vecd::{add_scaled, dot, sub};
@@ -185,6 +191,12 @@ pub struct System<const D: usize> {
     now: f64,
     counters: Counters,
     max_radius: f64,
+    /// Relative growth rate δ: r_i(t) = r_i(0)(1 + δt); 0 for plain EDMD.
+    growth: f64,
+    /// Lists and cells are valid up to this time (+∞ without growth).
+    horizon: f64,
+    /// r_i(horizon)/r_i(0): lists are built for radii R_i = r_i(0)·factor.
+    list_factor: f64,
 }
 
 /// Time until two particles at relative position `r` with relative velocity
@@ -212,6 +224,51 @@ pub fn pair_time<const D: usize>(r: &[f64; D], v: &[f64; D], sigma: f64) -> f64 
     c / (-b + disc.sqrt())
 }
 
+/// Time until a pair at relative position `r`, relative velocity `v` and
+/// contact distance `sigma` growing at rate `s` touches, or +∞: the earlier
+/// positive root of A t² + 2B t + C = 0 with A = v·v − s², B = r·v − σs,
+/// C = r·r − σ² (|r + vt| = σ + st). As in [`pair_time`] (Bannerman et al.),
+/// a pair inside contact that approaches in the growing frame (B < 0)
+/// collides now; the root C/(−B + √(B² − AC)) is free of cancellation and
+/// also holds for A < 0 (growth faster than the relative speed), where a
+/// receding pair is still caught.
+#[inline]
+pub fn growing_pair_time<const D: usize>(r: &[f64; D], v: &[f64; D], sigma: f64, s: f64) -> f64 {
+    let b = dot(r, v) - sigma * s;
+    let a = dot(v, v) - s * s;
+    let c = dot(r, r) - sigma * sigma;
+    growing_root(a, b, c, f64::INFINITY)
+}
+
+/// The root of [`growing_pair_time`] from its coefficients; +∞ when it
+/// cannot come before `best`.
+#[inline(always)]
+fn growing_root(a: f64, b: f64, c: f64, best: f64) -> f64 {
+    if c <= 0.0 {
+        return if b < 0.0 {
+            0.0
+        } else if a < 0.0 {
+            // momentarily receding, overlapping by round-off: meet when the
+            // growth takes over
+            -b / a
+        } else {
+            f64::INFINITY
+        };
+    }
+    if b >= 0.0 && a >= 0.0 {
+        return f64::INFINITY;
+    }
+    // for a ≥ 0 the root is ≥ c/(−2b): cannot beat the current best
+    if a >= 0.0 && c >= -2.0 * b * best {
+        return f64::INFINITY;
+    }
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return f64::INFINITY;
+    }
+    c / (-b + disc.sqrt())
+}
+
 impl<const D: usize> System<D> {
     /// Builds a system; checks that particles lie inside the box and do not
     /// overlap (relative tolerance 1e-9 of the contact distance), and
@@ -223,6 +280,45 @@ impl<const D: usize> System<D> {
         radii: Vec<f64>,
         masses: Vec<f64>,
     ) -> Result<Self, EdmdError> {
+        Self::with_growth(
+            simbox,
+            positions,
+            velocities,
+            radii,
+            masses,
+            0.0,
+            f64::INFINITY,
+        )
+    }
+
+    /// A system of growing particles: `radii` are the radii at time 0 and
+    /// grow as r_i(t) = r_i(0)(1 + `growth`·t) (KTS, 003 Eq. 17). Neighbour
+    /// lists and cells hold for the radii at `horizon` (finite when growth ≠
+    /// 0); events after it must not be processed ([`System::horizon`]).
+    pub fn with_growth(
+        simbox: SimBox<D>,
+        positions: Vec<[f64; D]>,
+        velocities: Vec<[f64; D]>,
+        radii: Vec<f64>,
+        masses: Vec<f64>,
+        growth: f64,
+        horizon: f64,
+    ) -> Result<Self, EdmdError> {
+        let (growth, horizon) = if growth == 0.0 {
+            (0.0, f64::INFINITY)
+        } else {
+            (growth, horizon)
+        };
+        let g_end = if growth == 0.0 {
+            1.0
+        } else {
+            1.0 + growth * horizon
+        };
+        if !(growth >= 0.0 && growth.is_finite() && g_end.is_finite() && g_end >= 1.0) {
+            return Err(EdmdError::Invalid(format!(
+                "growth rate {growth} and horizon {horizon} must be finite and non-negative"
+            )));
+        }
         let n = positions.len();
         if velocities.len() != n || radii.len() != n || masses.len() != n {
             return Err(EdmdError::Invalid(
@@ -245,6 +341,8 @@ impl<const D: usize> System<D> {
             }
         }
         let max_radius = radii.iter().cloned().fold(0.0, f64::max);
+        // cells and shells are sized for the radii at the horizon
+        let max_list_radius = max_radius * g_end;
         let unit = if D == 2 {
             std::f64::consts::PI
         } else {
@@ -255,7 +353,7 @@ impl<const D: usize> System<D> {
         // periodic axes need three cells of width s·(largest diameter)
         for d in 0..D {
             if simbox.boundary[d] == Boundary::Periodic && max_radius > 0.0 {
-                let smax = simbox.size[d] / (3.0 * 2.0 * max_radius * (1.0 + 1e-9));
+                let smax = simbox.size[d] / (3.0 * 2.0 * max_list_radius * (1.0 + 4e-9));
                 shell = shell.min(smax);
             }
         }
@@ -263,10 +361,10 @@ impl<const D: usize> System<D> {
             return Err(EdmdError::Invalid(format!(
                 "periodic box {:?} too small for diameter {}: each periodic length must exceed 3.15 largest diameters",
                 simbox.size,
-                2.0 * max_radius
+                2.0 * max_list_radius
             )));
         }
-        let dmax = shell * 2.0 * max_radius;
+        let dmax = shell * 2.0 * max_list_radius;
         let mut ncell = [1usize; D];
         let mut cwidth = [0.0; D];
         for d in 0..D {
@@ -393,6 +491,9 @@ impl<const D: usize> System<D> {
             now: 0.0,
             counters: Counters::default(),
             max_radius,
+            growth,
+            horizon,
+            list_factor: g_end,
         };
         for i in 0..n {
             for d in 0..D {
@@ -420,7 +521,7 @@ impl<const D: usize> System<D> {
             sys.cidx[i] = c;
             sys.xn[i] = ListPos {
                 x: sys.p[i].x,
-                r: sys.p[i].r,
+                r: sys.p[i].r * g_end,
             };
             sys.insert(i);
         }
@@ -541,10 +642,28 @@ impl<const D: usize> System<D> {
     }
     /// Radii in the caller's numbering (as are all per-particle accessors).
     pub fn radii(&self) -> Vec<f64> {
-        self.slot.iter().map(|&k| self.p[k as usize].r).collect()
+        self.slot.iter().map(|&k| self.rad(k as usize)).collect()
     }
     pub fn radius(&self, i: usize) -> f64 {
-        self.p[self.slot[i] as usize].r
+        self.rad(self.slot[i] as usize)
+    }
+    /// Radius of internal particle k now.
+    #[inline]
+    fn rad(&self, k: usize) -> f64 {
+        self.p[k].r * self.growth_factor()
+    }
+    /// r_i(now)/r_i(0) = 1 + δ·now (1 without growth).
+    #[inline]
+    pub fn growth_factor(&self) -> f64 {
+        1.0 + self.growth * self.now
+    }
+    /// The relative growth rate δ.
+    pub fn growth_rate(&self) -> f64 {
+        self.growth
+    }
+    /// The time up to which neighbour lists and cells hold.
+    pub fn horizon(&self) -> f64 {
+        self.horizon
     }
     pub fn velocity(&self, i: usize) -> [f64; D] {
         self.p[self.slot[i] as usize].v
@@ -566,9 +685,9 @@ impl<const D: usize> System<D> {
     pub fn shell(&self) -> f64 {
         self.shell
     }
-    /// Largest radius.
+    /// Largest radius (now).
     pub fn max_radius(&self) -> f64 {
-        self.max_radius
+        self.max_radius * self.growth_factor()
     }
 
     /// Position of particle `i` at the current time (inside the box, up to
@@ -640,6 +759,7 @@ impl<const D: usize> System<D> {
             .iter()
             .map(|p| unit * p.r.powi(D as i32))
             .sum::<f64>()
+            * self.growth_factor().powi(D as i32)
             / self.simbox.volume()
     }
 
@@ -733,7 +853,7 @@ impl<const D: usize> System<D> {
         for i in 0..n {
             for d in 0..D {
                 if self.simbox.boundary[d] == Boundary::Wall {
-                    let r = self.p[i].r;
+                    let r = self.rad(i);
                     let l = self.simbox.size[d];
                     let depth = (r - pos[i][d]).max(pos[i][d] + r - l);
                     if depth > rel_tol * r {
@@ -754,7 +874,7 @@ impl<const D: usize> System<D> {
                     let ju = j as usize;
                     if ju > i {
                         let r = self.sep_int(i, ju);
-                        let s = self.p[i].r + self.p[ju].r;
+                        let s = self.rad(i) + self.rad(ju);
                         let dist = dot(&r, &r).sqrt();
                         if dist < s * (1.0 - rel_tol) {
                             let (a, b) = (self.id[i] as usize, self.id[ju] as usize);
@@ -791,6 +911,17 @@ impl<const D: usize> System<D> {
     /// earliest of its neighbour-list expiry, wall hits and collisions with
     /// listed neighbours.
     fn predict(&mut self, i: usize) {
+        if self.growth == 0.0 {
+            self.predict_with::<false>(i)
+        } else {
+            self.predict_with::<true>(i)
+        }
+    }
+
+    /// [`System::predict`] for fixed (`GROW = false`, the original code) or
+    /// growing radii.
+    #[inline(always)]
+    fn predict_with<const GROW: bool>(&mut self, i: usize) {
         self.advance(i);
         let Particle {
             x: xi,
@@ -799,13 +930,18 @@ impl<const D: usize> System<D> {
             ..
         } = self.p[i];
         let now = self.now;
+        let (g, delta) = if GROW {
+            (1.0 + self.growth * now, self.growth)
+        } else {
+            (1.0, 0.0)
+        };
         let a = dot(&vi, &vi);
         let mut best = f64::INFINITY;
         let mut ev = NO_EVENT;
         if a > 0.0 {
-            // |x + v t − x_n| = (s − 1) r_i, the outer root
+            // |x + v t − x_n| = (s − 1) R_i, the outer root
             let dr = sub(&xi, &self.xn[i].x);
-            let m = (self.shell - 1.0) * ri;
+            let m = (self.shell - 1.0) * self.xn[i].r;
             let c = dot(&dr, &dr) - m * m;
             best = if c >= 0.0 {
                 0.0
@@ -825,23 +961,33 @@ impl<const D: usize> System<D> {
                 continue;
             }
             let v = vi[d];
-            let dt = if v > 0.0 {
-                (self.simbox.size[d] - ri - xi[d]) / v
-            } else if v < 0.0 {
-                (ri - xi[d]) / v
+            // the surfaces move at v ± ṙ (ṙ = r_i(0)δ): a growing particle
+            // at rest still reaches a wall
+            let (rn, rdot) = if GROW {
+                (ri * g, ri * delta)
             } else {
-                continue;
-            }
-            .max(0.0);
-            if dt < best {
-                best = dt;
-                ev = Event {
-                    kind: Kind::Wall,
-                    partner: NONE,
-                    axis: d as u8,
-                    up: v > 0.0,
-                    partner_count: 0,
-                };
+                (ri, 0.0)
+            };
+            for up in [true, false] {
+                let u = if up { v + rdot } else { v - rdot };
+                let dt = if up && u > 0.0 {
+                    (self.simbox.size[d] - rn - xi[d]) / u
+                } else if !up && u < 0.0 {
+                    (rn - xi[d]) / u
+                } else {
+                    continue;
+                }
+                .max(0.0);
+                if dt < best {
+                    best = dt;
+                    ev = Event {
+                        kind: Kind::Wall,
+                        partner: NONE,
+                        axis: d as u8,
+                        up,
+                        partner_count: 0,
+                    };
+                }
             }
         }
         let mut partner = NONE;
@@ -873,26 +1019,39 @@ impl<const D: usize> System<D> {
                     }
                 }
             }
-            // Bannerman et al.: approaching pairs only; overlapping ones now
-            let b = dot(&r, &v);
-            if b >= 0.0 {
-                continue;
-            }
-            let sigma = ri + pj.r;
-            let c = dot(&r, &r) - sigma * sigma;
-            let dt = if c <= 0.0 {
-                0.0
+            let dt = if GROW {
+                let sigma0 = ri + pj.r;
+                let (sigma, sdot) = (sigma0 * g, sigma0 * delta);
+                let b = dot(&r, &v) - sigma * sdot;
+                let av = dot(&v, &v) - sdot * sdot;
+                let c = dot(&r, &r) - sigma * sigma;
+                let t = growing_root(av, b, c, best);
+                if t == f64::INFINITY {
+                    continue;
+                }
+                t
             } else {
-                // t ≥ c/(−2b): cannot beat the current best
-                if c >= -2.0 * b * best {
+                // Bannerman et al.: approaching pairs only; overlapping ones now
+                let b = dot(&r, &v);
+                if b >= 0.0 {
                     continue;
                 }
-                let av = dot(&v, &v);
-                let disc = b * b - av * c;
-                if disc < 0.0 {
-                    continue;
+                let sigma = ri + pj.r;
+                let c = dot(&r, &r) - sigma * sigma;
+                if c <= 0.0 {
+                    0.0
+                } else {
+                    // t ≥ c/(−2b): cannot beat the current best
+                    if c >= -2.0 * b * best {
+                        continue;
+                    }
+                    let av = dot(&v, &v);
+                    let disc = b * b - av * c;
+                    if disc < 0.0 {
+                        continue;
+                    }
+                    c / (-b + disc.sqrt())
                 }
-                c / (-b + disc.sqrt())
             };
             if dt < best {
                 best = dt;
@@ -918,7 +1077,7 @@ impl<const D: usize> System<D> {
     fn scan_neighbours(&mut self, i: usize, only_greater: bool) {
         let ci = self.cidx[i];
         let xi = self.xn[i].x;
-        let ri = self.p[i].r;
+        let ri = self.xn[i].r;
         for o in 0..self.offsets.len() {
             let off = self.offsets[o];
             let Some(cc) = self.neighbour_cell(&ci, &off) else {
@@ -985,7 +1144,7 @@ impl<const D: usize> System<D> {
         }
         self.xn[i] = ListPos {
             x: self.p[i].x,
-            r: self.p[i].r,
+            r: self.p[i].r * self.list_factor,
         };
         self.remove(i);
         self.cidx[i] = self.cell_of(&self.xn[i].x);
@@ -1042,10 +1201,13 @@ impl<const D: usize> System<D> {
                 self.advance(i);
                 let d = ev.axis as usize;
                 let v = self.p[i].v[d];
-                if (v > 0.0) == ev.up {
-                    self.p[i].v[d] = -v;
+                // in the frame of the growing surface (ṙ = 0 without growth)
+                let rdot = self.p[i].r * self.growth;
+                let u = if ev.up { v + rdot } else { v - rdot };
+                if (u > 0.0) == ev.up && u != 0.0 {
+                    self.p[i].v[d] = v - 2.0 * u;
                     self.counters.wall_hits += 1;
-                    self.counters.wall_impulse_sum += 2.0 * self.mass[i] * v.abs();
+                    self.counters.wall_impulse_sum += 2.0 * self.mass[i] * u.abs();
                     self.count[i] += 1;
                 }
                 self.predict(i);
@@ -1054,7 +1216,9 @@ impl<const D: usize> System<D> {
         true
     }
 
-    /// Elastic collision of i and j at the current time, 002 Eq. (9a,b).
+    /// Elastic collision of i and j at the current time, 002 Eq. (9a,b);
+    /// with growth, elastic in the frame of the growing surfaces (KTS rule,
+    /// seeds/README.md): u_n → 2s − u_n with s = σ_ij(0)δ, momentum kept.
     fn collide(&mut self, i: usize, j: usize) {
         self.advance(i);
         self.advance(j);
@@ -1076,13 +1240,19 @@ impl<const D: usize> System<D> {
         let r2 = dot(&r, &r);
         let (mi, mj) = (self.mass[i], self.mass[j]);
         let mu = mi * mj / (mi + mj);
-        // Δp_i = −2 μ (b / r²) r
-        let f = -2.0 * mu * b / r2;
+        // Δp_i = −2 μ (b / r²) r; growing: −2 μ ((b − s|r|) / r²) r
+        let (f, virial) = if self.growth == 0.0 {
+            (-2.0 * mu * b / r2, -2.0 * mu * b)
+        } else {
+            let s = (self.p[i].r + self.p[j].r) * self.growth;
+            let bs = b - s * r2.sqrt();
+            (-2.0 * mu * bs / r2, -2.0 * mu * bs)
+        };
         for d in 0..D {
             self.p[i].v[d] += f / mi * r[d];
             self.p[j].v[d] -= f / mj * r[d];
         }
-        self.counters.virial += -2.0 * mu * b;
+        self.counters.virial += virial;
         self.counters.collisions += 1;
         self.count[i] += 1;
         self.count[j] += 1;
@@ -1099,6 +1269,18 @@ impl<const D: usize> System<D> {
             self.now = t_end;
         }
         k
+    }
+
+    /// Runs until `count` more pair collisions have happened or the next
+    /// event comes after `t_end`; true if the collisions were reached.
+    pub fn run_collisions_until(&mut self, count: u64, t_end: f64) -> bool {
+        let target = self.counters.collisions + count;
+        while self.counters.collisions < target {
+            if !self.step(t_end) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Runs until `count` more pair collisions have happened.

@@ -26,6 +26,8 @@ pub struct Observables {
     /// The force the particles exert on each wall (name, force), from the
     /// last force evaluation.
     pub wall_forces: Vec<(String, DVec3)>,
+    /// Total magnetic moment Σ m_i of the dipoles.
+    pub magnetisation: DVec3,
 }
 
 impl Observables {
@@ -74,6 +76,7 @@ impl Observables {
             potential,
             momentum,
             angular_momentum,
+            magnetisation: p.dipole.iter().sum(),
             wall_forces: ff
                 .interactions
                 .iter()

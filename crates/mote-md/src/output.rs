@@ -15,14 +15,15 @@ use crate::simulation::Observer;
 use crate::units::UnitSystem;
 
 /// observables.csv: time, energies, momentum, angular momentum, step, k_B T,
-/// the pressure (only for a box periodic on every axis), probes, the force
-/// on each wall.
+/// the pressure (only for a box periodic on every axis), probes, the total
+/// magnetic moment (when there are dipoles), the force on each wall.
 pub struct ObservablesCsv {
     writer: CsvWriter,
     every: u64,
     probes: Vec<Probe>,
     pressure: bool,
     walls: usize,
+    magnetic: bool,
 }
 
 impl ObservablesCsv {
@@ -35,6 +36,7 @@ impl ObservablesCsv {
         probes: Vec<Probe>,
         pressure: bool,
         walls: &[String],
+        magnetic: bool,
         append: bool,
     ) -> Result<Self, MdError> {
         let [l, t, m, e] = units.labels();
@@ -70,6 +72,13 @@ impl ObservablesCsv {
             };
             unit_row.push(unit);
         }
+        // The total magnetic moment of the dipoles.
+        if magnetic {
+            for axis in ["x", "y", "z"] {
+                columns.push(format!("M{axis}"));
+                unit_row.push("moment".into());
+            }
+        }
         // The force on each wall, F = −Σ (contact forces on the particles).
         for wall in walls {
             for axis in ["x", "y", "z"] {
@@ -87,6 +96,7 @@ impl ObservablesCsv {
             probes,
             pressure,
             walls: walls.len(),
+            magnetic,
         })
     }
 }
@@ -102,6 +112,10 @@ impl Observer for ObservablesCsv {
             row.pop();
         }
         row.extend(self.probes.iter().map(|p| p.read(sys)));
+        if self.magnetic {
+            let m = obs.magnetisation;
+            row.extend([m.x, m.y, m.z]);
+        }
         for k in 0..self.walls {
             let f = obs.wall_forces.get(k).map_or(DVec3::NAN, |w| w.1);
             row.extend([f.x, f.y, f.z]);

@@ -48,6 +48,11 @@ pub struct Scene {
     pub lennard_jones: Option<Spanned<LennardJonesSettings>>,
     pub thermostat: Option<Spanned<ThermostatSettings>>,
     pub granular: Option<Spanned<GranularSettings>>,
+    pub dipolar: Option<Spanned<DipolarSettings>>,
+    pub magnetic_field: Option<Spanned<MagneticFieldSettings>>,
+    pub brownian: Option<Spanned<BrownianSettings>>,
+    #[serde(default)]
+    pub plummer: Vec<Spanned<PlummerSpec>>,
     #[serde(default)]
     pub wall: Vec<Spanned<WallSpec>>,
     #[serde(rename = "box")]
@@ -200,6 +205,90 @@ pub struct GravitySettings {
     pub g: Option<f64>,
     #[serde(default)]
     pub softening: f64,
+    /// `direct` (default: every pair, exact) or `tree` (Barnes–Hut).
+    #[serde(default = "direct")]
+    pub method: String,
+    /// Opening angle θ of the tree (default 0.5).
+    pub theta: Option<f64>,
+}
+
+fn direct() -> String {
+    "direct".into()
+}
+
+/// `[dipolar]`: magnetic dipole–dipole forces and torques (004 Eq. 8)
+/// between particles with a `dipole`, optionally with WCA repulsion.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DipolarSettings {
+    /// μ₀ (default: the unit system's; 4π in LJ units).
+    pub mu0: Option<f64>,
+    /// Cut-off with the minimum image (periodic boxes); absent: all pairs.
+    pub cutoff: Option<f64>,
+    /// Verlet skin of the cut-off list (default 0.3).
+    pub skin: Option<f64>,
+    /// Relative permeability of the reaction field beyond the cut-off;
+    /// `"conducting"` for ε_RF = ∞ (absent: none).
+    pub reaction_field: Option<toml::Value>,
+    /// WCA repulsion `{ epsilon, sigma }` in the same pair loop.
+    pub wca: Option<WcaSettings>,
+    /// Turn every dipole into a random direction (same |m|) at the start.
+    #[serde(default)]
+    pub random_orientation: bool,
+}
+
+/// `{ epsilon, sigma }` of a WCA repulsion.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WcaSettings {
+    pub epsilon: f64,
+    pub sigma: f64,
+}
+
+/// `[magnetic_field]`: an applied field H acting on the dipoles (Zeeman,
+/// 004 Eq. 10): uniform `h = [..]`, or rotating with `amplitude`,
+/// `angular_frequency` (rad per time), `axis`, `phase`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MagneticFieldSettings {
+    pub h: Option<[f64; 3]>,
+    pub amplitude: Option<f64>,
+    pub angular_frequency: Option<f64>,
+    pub axis: Option<[f64; 3]>,
+    #[serde(default)]
+    pub phase: f64,
+    pub mu0: Option<f64>,
+}
+
+/// `[brownian]`: overdamped Brownian dynamics at `kt` with friction
+/// coefficients `translational` ξ_t and `rotational` ξ_r, or the Stokes
+/// drag of each sphere in a liquid of `viscosity`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BrownianSettings {
+    pub kt: f64,
+    pub translational: Option<f64>,
+    pub rotational: Option<f64>,
+    pub viscosity: Option<f64>,
+    /// Turn the dipoles (rotational diffusion and torques; default true).
+    #[serde(default = "yes")]
+    pub rotate: bool,
+}
+
+/// `[[plummer]]`: a Plummer sphere (Aarseth, Hénon & Wielen 1974) of `n`
+/// particles, total mass `total_mass`, scale radius `scale_radius`, in
+/// virial equilibrium, truncated at `max_radius` (default 20 scale radii).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlummerSpec {
+    pub n: usize,
+    #[serde(default = "one")]
+    pub total_mass: f64,
+    #[serde(default = "one")]
+    pub scale_radius: f64,
+    pub max_radius: Option<f64>,
+    #[serde(default = "white")]
+    pub color: [f64; 3],
 }
 
 /// `[field]`: uniform gravitational acceleration (MPPphys `grav`).
@@ -305,6 +394,10 @@ pub struct Properties {
     pub radius: f64,
     /// Mass density ρ: when given, the mass is ρ (4/3)π r³ (solid spheres).
     pub density: Option<f64>,
+    /// Magnetic dipole moment m (a vector).
+    #[serde(default)]
+    pub dipole: [f64; 3],
+
     #[serde(default = "white")]
     pub color: [f64; 3],
     /// Per axis: may the particle move? (MPPphys `vfix` 1 1 1 = all free.)
@@ -319,6 +412,7 @@ impl Default for Properties {
             charge: 0.0,
             radius: 0.0,
             density: None,
+            dipole: [0.0; 3],
             color: white(),
             free: all_free(),
         }
@@ -335,6 +429,7 @@ impl Properties {
             radius: self.radius,
             color: self.color,
             free: self.free,
+            dipole: DVec3::from(self.dipole),
             ..ParticleInit::default()
         }
     }
@@ -803,6 +898,36 @@ impl Scene {
                 displacements.push(DVec3::ZERO);
             }
         }
+        for spec in &self.plummer {
+            let s = spec.get_ref();
+            if s.n == 0
+                || s.total_mass.is_nan()
+                || s.total_mass <= 0.0
+                || s.scale_radius.is_nan()
+                || s.scale_radius <= 0.0
+            {
+                return Err(err(
+                    spec.span(),
+                    "a plummer sphere needs n ≥ 1, total_mass > 0 and scale_radius > 0".into(),
+                ));
+            }
+            let sphere = crate::tree::PlummerSphere {
+                n: s.n,
+                mass: s.total_mass,
+                radius: s.scale_radius,
+                g: g_const,
+                max_radius: Some(s.max_radius.unwrap_or(20.0 * s.scale_radius)),
+            };
+            let template = ParticleInit {
+                mass: s.total_mass / s.n as f64,
+                color: s.color,
+                ..ParticleInit::default()
+            };
+            for p in sphere.particles(&template, &mut rng) {
+                inits.push(p);
+                displacements.push(DVec3::ZERO);
+            }
+        }
         for spec in &self.lammps_data {
             let s = spec.get_ref();
             let path = std::path::Path::new(file)
@@ -893,7 +1018,34 @@ impl Scene {
                     "[gravity] softening must not be negative",
                 ));
             }
-            forces.push(DirectGravity::new(g_const, g.softening));
+            match (g.method.as_str(), g.theta) {
+                ("direct", None) => forces.push(DirectGravity::new(g_const, g.softening)),
+                ("tree", theta) => {
+                    let theta = theta.unwrap_or(0.5);
+                    if !(0.0..1.2).contains(&theta) {
+                        return Err(ParseError::new(
+                            file,
+                            0,
+                            format!("[gravity] theta must be in [0, 1.2), found {theta}"),
+                        ));
+                    }
+                    forces.push(crate::tree::TreeGravity::new(g_const, g.softening, theta));
+                }
+                ("direct", Some(_)) => {
+                    return Err(ParseError::new(
+                        file,
+                        0,
+                        "[gravity] theta needs method = \"tree\"",
+                    ))
+                }
+                (other, _) => {
+                    return Err(ParseError::new(
+                        file,
+                        0,
+                        format!("[gravity] unknown method '{other}': expected direct or tree"),
+                    ))
+                }
+            }
         }
         if !springs.is_empty() {
             forces.push(SpringNetwork { springs });
@@ -1024,6 +1176,115 @@ impl Scene {
                 "[[wall]] needs a [granular] section for its contact law".into(),
             ));
         }
+        let mu0_default = crate::force::dipolar::vacuum_permeability(self.units);
+        if let Some(d) = &self.dipolar {
+            let v = d.get_ref();
+            let mu0 = v
+                .mu0
+                .or(mu0_default)
+                .ok_or_else(|| err(d.span(), "[dipolar] needs mu0 in these units".into()))?;
+            if v.random_orientation {
+                use rand::Rng;
+                for m in particles.dipole.iter_mut() {
+                    let len = m.length();
+                    let u: f64 = 2.0 * rng.gen::<f64>() - 1.0;
+                    let phi = 2.0 * std::f64::consts::PI * rng.gen::<f64>();
+                    let s = (1.0 - u * u).sqrt();
+                    *m = DVec3::new(s * phi.cos(), s * phi.sin(), u) * len;
+                }
+            }
+            let mut pair = match v.cutoff {
+                None => crate::force::dipolar::DipoleDipole::all_pairs(mu0),
+                Some(rc) => crate::force::dipolar::DipoleDipole::cut_off(
+                    mu0,
+                    rc,
+                    v.skin.unwrap_or(0.3),
+                    boundary,
+                )
+                .map_err(|e| err(d.span(), format!("[dipolar] {e}")))?,
+            };
+            match &v.reaction_field {
+                None => {}
+                Some(toml::Value::String(s)) if s == "conducting" => {
+                    pair = pair.with_reaction_field(f64::INFINITY)
+                }
+                Some(toml::Value::Float(x)) if *x >= 1.0 => pair = pair.with_reaction_field(*x),
+                Some(toml::Value::Integer(x)) if *x >= 1 => {
+                    pair = pair.with_reaction_field(*x as f64)
+                }
+                Some(other) => {
+                    return Err(err(
+                        d.span(),
+                        format!("[dipolar] reaction_field must be \"conducting\" or a permeability ≥ 1, found {other}"),
+                    ))
+                }
+            }
+            if let Some(w) = &v.wca {
+                pair = pair
+                    .with_repulsion(crate::force::dipolar::PairRepulsion::wca(
+                        w.epsilon, w.sigma,
+                    ))
+                    .map_err(|e| err(d.span(), format!("[dipolar] {e}")))?;
+            }
+            forces.push(pair);
+        }
+        if let Some(f) = &self.magnetic_field {
+            let v = f.get_ref();
+            let mu0 = v
+                .mu0
+                .or(mu0_default)
+                .ok_or_else(|| err(f.span(), "[magnetic_field] needs mu0 in these units".into()))?;
+            use crate::force::dipolar::{AppliedField, Zeeman};
+            let field = match (v.h, v.amplitude, v.angular_frequency) {
+                (Some(h), None, None) => AppliedField::Uniform(DVec3::from(h)),
+                (None, Some(amplitude), Some(angular_frequency)) => AppliedField::Rotating {
+                    amplitude,
+                    angular_frequency,
+                    axis: DVec3::from(v.axis.unwrap_or([0.0, 0.0, 1.0])).normalize(),
+                    phase: v.phase,
+                },
+                _ => {
+                    return Err(err(
+                        f.span(),
+                        "[magnetic_field] takes h = [..] (uniform) or amplitude and angular_frequency (rotating)".into(),
+                    ))
+                }
+            };
+            forces.push(Zeeman::new(mu0, field));
+        }
+        let brownian = match &self.brownian {
+            None => None,
+            Some(b) => {
+                let v = b.get_ref();
+                use crate::brownian::{BrownianStepper, Friction};
+                let friction = match (v.translational, v.rotational, v.viscosity) {
+                    (Some(t), Some(r), None) if t > 0.0 && r > 0.0 => Friction::Uniform {
+                        translational: t,
+                        rotational: r,
+                    },
+                    (None, None, Some(eta)) if eta > 0.0 => {
+                        if particles.radius.iter().any(|r| *r <= 0.0) {
+                            return Err(err(
+                                b.span(),
+                                "[brownian] viscosity needs every particle's radius > 0".into(),
+                            ));
+                        }
+                        Friction::Stokes { viscosity: eta }
+                    }
+                    _ => return Err(err(
+                        b.span(),
+                        "[brownian] needs translational > 0 and rotational > 0, or viscosity > 0"
+                            .into(),
+                    )),
+                };
+                if v.kt.is_nan() || v.kt < 0.0 {
+                    return Err(err(b.span(), "[brownian] needs kt ≥ 0".into()));
+                }
+                let mut bd = BrownianStepper::new(v.kt, friction);
+                bd.rotate = v.rotate;
+                Some(bd)
+            }
+        };
         let thermostat = match &self.thermostat {
             None => None,
             Some(t) => {
@@ -1120,6 +1381,7 @@ impl Scene {
                 thermostat,
                 seed,
                 sample_at_start: true,
+                brownian,
             },
             length,
             probes,
@@ -1209,6 +1471,7 @@ impl Scene {
                         charge: p.charge,
                         radius: p.radius,
                         density: None,
+                        dipole: [0.0; 3],
                         color: p.color,
                         free: p.free,
                     },
@@ -1220,6 +1483,8 @@ impl Scene {
                 scene.gravity = Some(GravitySettings {
                     g: Some(pf.k2.unwrap_or(UnitSystem::Astro.gravitational_constant())),
                     softening: pf.softening.unwrap_or(0.0),
+                    method: direct(),
+                    theta: None,
                 });
             }
             PlistSystem::Springs => {

@@ -84,6 +84,9 @@ pub struct Simulation {
     /// Hand the starting state to the observers (false when resuming: the
     /// interrupted run already wrote it).
     pub sample_at_start: bool,
+    /// Overdamped Brownian dynamics instead of the inertial `stepper`
+    /// (004 Eqs. 14–16); its noise is counter-based like the thermostat's.
+    pub brownian: Option<crate::brownian::BrownianStepper>,
 }
 
 impl Simulation {
@@ -107,8 +110,19 @@ impl Simulation {
             self.sample(true, &initial)?;
         }
         for k in 1..=steps {
-            self.stepper
-                .step(&mut self.system, &mut self.forces, self.dt);
+            if let Some(bd) = &mut self.brownian {
+                let index = self.system.step + 1;
+                bd.step(
+                    &mut self.system,
+                    &mut self.forces,
+                    self.dt,
+                    index,
+                    self.seed,
+                );
+            } else {
+                self.stepper
+                    .step(&mut self.system, &mut self.forces, self.dt);
+            }
             if let Some(t) = self.thermostat {
                 let mut rng = self.noise(self.system.step);
                 t.apply(&mut self.system, self.dt, &mut rng);

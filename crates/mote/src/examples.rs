@@ -8,7 +8,7 @@ pub struct Example {
 
 const CHOREOGRAPHY: &str = include_str!("../../../examples/choreography.toml");
 
-const SCENES: [(&str, &str); 9] = [
+const SCENES: [(&str, &str); 11] = [
     (
         "sun-earth",
         include_str!("../../../examples/sun-earth.toml"),
@@ -38,6 +38,11 @@ const SCENES: [(&str, &str); 9] = [
     (
         "rotating-drum",
         include_str!("../../../examples/rotating-drum.toml"),
+    ),
+    ("plummer", include_str!("../../../examples/plummer.toml")),
+    (
+        "ferrofluid",
+        include_str!("../../../examples/ferrofluid.toml"),
     ),
 ];
 

@@ -82,6 +82,8 @@ fn examples_are_listed_and_written_and_each_one_runs() {
         "settling",
         "column-collapse",
         "rotating-drum",
+        "plummer",
+        "ferrofluid",
     ] {
         assert!(list.contains(name), "{name} missing from {list}");
     }
@@ -302,4 +304,23 @@ fn picture_of_the_final_state() {
     let width = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
     let height = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
     assert_eq!((width, height), (1920, 1080));
+}
+
+/// A scene with a `[rigid]` table runs the rigid-body engine (FRBI).
+#[test]
+fn rigid_scene_runs_through_mote_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/rigid/magnet-in-field.toml"
+    );
+    let o = mote(&["run", scene, "-q", "-o", "rigid"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = mote_io::csv::read_table(&dir.path().join("rigid/observables.csv")).unwrap();
+    // A free body in a homogeneous field keeps its linear momentum.
+    let px = t.column("px").unwrap();
+    assert!(px.len() > 10);
+    assert!(px
+        .iter()
+        .all(|p| (p - px[0]).abs() <= 1e-12 * px[0].abs().max(1.0)));
 }

@@ -8,7 +8,7 @@
 //! step.
 
 use glam::DVec3;
-use mote_geom::{compose_rotations, Inertia, DE};
+use mote_geom::{compose_rotations, rotation_matrix, DMat3, Inertia, DE};
 use rayon::prelude::*;
 
 use super::bodies::RigidBodies;
@@ -71,13 +71,22 @@ pub fn free_step(
     flight: FreeFlight,
     spin: SpinUpdate,
 ) {
+    // I = I₀ ∘ g acts as ω ↦ P (J ⊙ Pᵀω) with P = R(r)·A, A the template's
+    // principal axes (columns) and J its moments; I_c = I ∘ g_c uses
+    // R(r_c)·P. The same algebra as `Inertia::rotated`, with one rotation
+    // matrix per placement instead of three vector rotations per use.
+    let a = DMat3::from_cols(inertia0.axes[0], inertia0.axes[1], inertia0.axes[2]);
+    let j = DVec3::from(inertia0.moments);
+    let j_inv = DVec3::ONE / j;
     let tau = 0.5 * dt;
     let w = *omega;
-    let inertia = inertia0.rotated(*rotation);
+    let p = matrix(*rotation) * a;
+    let apply = |p: &DMat3, d: DVec3, x: DVec3| *p * (d * (p.transpose() * x));
+    let l = apply(&p, j, w);
     let r_c = DE::exp_rotation(w, tau);
-    let inertia_c = inertia.rotated(r_c);
-    let dl = inertia.angular(w) - inertia_c.angular(w);
-    let dw = inertia.inverse().angular(dl);
+    let p_c = matrix(r_c) * p;
+    let dl = l - apply(&p_c, j, w);
+    let dw = apply(&p, j_inv, dl);
     let w_c = w + dw;
     match flight {
         FreeFlight::Straight => {
@@ -92,11 +101,27 @@ pub fn free_step(
     }
     *omega = match spin {
         SpinUpdate::Seed => w_c + dw,
-        SpinUpdate::KeepMomentum => inertia0
-            .rotated(*rotation)
-            .inverse()
-            .angular(inertia.angular(w)),
+        SpinUpdate::KeepMomentum => apply(&(matrix(*rotation) * a), j_inv, l),
     };
+}
+
+/// The matrix of `x ↦ x * r` (`mote_geom::rotate`):
+/// `((1 − r²)·1 + 2 r rᵀ + 2 [r]ₓ) / (1 + r²)`.
+#[inline(always)]
+fn matrix(r: DVec3) -> DMat3 {
+    let rr = r.dot(r);
+    if rr > 1e100 {
+        return rotation_matrix(r);
+    }
+    let s = 1.0 / (1.0 + rr);
+    let c = (1.0 - rr) * s;
+    let t = 2.0 * s;
+    let (x, y, z) = (r.x, r.y, r.z);
+    DMat3::from_cols(
+        DVec3::new(c + t * x * x, t * (x * y + z), t * (x * z - y)),
+        DVec3::new(t * (x * y - z), c + t * y * y, t * (y * z + x)),
+        DVec3::new(t * (x * z + y), t * (y * z - x), c + t * z * z),
+    )
 }
 
 /// `react(h̃)` of seed 000: `Δh := I⁻¹ h̃`, `h := h + Δh`, where
@@ -110,9 +135,11 @@ pub fn react(
     velocity: &mut DVec3,
     impulse: DE,
 ) {
-    let inv = inertia0.rotated(rotation).inverse();
-    *omega += inv.angular(impulse.omega);
-    *velocity += impulse.v * inv.mass;
+    let a = DMat3::from_cols(inertia0.axes[0], inertia0.axes[1], inertia0.axes[2]);
+    let p = matrix(rotation) * a;
+    let j_inv = DVec3::ONE / DVec3::from(inertia0.moments);
+    *omega += p * (j_inv * (p.transpose() * impulse.omega));
+    *velocity += impulse.v * (1.0 / inertia0.mass);
 }
 
 /// One body's (index, ((r, x), (ω, v))) in the zipped state arrays.

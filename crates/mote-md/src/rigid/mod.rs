@@ -11,18 +11,24 @@
 //! - [`interaction`]: the [`BodyInteraction`] trait and the world-frame view
 //!   of spheres and dipoles it reads (where contact models plug in);
 //! - [`sources`]: fields, gravity, drag, Coulomb, dipole–dipole;
+//! - [`contacts`]: Hertz–Mindlin contacts between spheres of different
+//!   bodies and with walls;
+//! - [`scene`]: the `[rigid]` scene format and its runner;
 //! - [`frbi`]: `freeStep`, `react` and the many-body step.
 //!
 //! The algebra (E, dE, I, exp, log) is the crate `mote-geom`.
 
 pub mod bodies;
+pub mod contacts;
 pub mod frbi;
 pub mod interaction;
+pub mod scene;
 pub mod shapes;
 pub mod sources;
 pub mod template;
 
 pub use bodies::{BodyObservables, RigidBodies};
+pub use contacts::RigidContacts;
 pub use frbi::{free_step, react, BodyEnergies, Frbi, FreeFlight, SpinUpdate};
 pub use interaction::{BodyInteraction, BodyView, WorldFrame};
 pub use shapes::{dumbbell, linear_trimer, IrregularClump};

@@ -1,0 +1,622 @@
+//! Random close packings by growing spheres: the Lubachevsky–Stillinger
+//! algorithm in the Kansal–Torquato–Stillinger form (seed 003 §III.1 and its
+//! KTS appendix; Skoge, Donev, Stillinger & Torquato, PRE 74, 041127 (2006)).
+//!
+//! Spheres (disks) move ballistically and grow as r_i(t) = r_i(0)(1 + δt)
+//! (003 Eq. 17: size-proportional, so the size distribution is kept);
+//! collisions are elastic in the frame of the growing surfaces (u_n → 2s −
+//! u_n, see [`crate::system`]) and heat the system, so the velocities are
+//! rescaled to the initial kinetic energy every `rescale_every` collisions
+//! per particle. The user-facing rate is spheropack's
+//!
+//! Γ = (1/v_th) d⟨d⟩/dt,   v_th = √(kT/m),
+//!
+//! with ⟨d⟩ the arithmetic mean diameter (all masses equal, kT = m = 1, so
+//! v_th = 1 at each rescale). The run is a sequence of *epochs*: a
+//! [`System`] whose neighbour lists and cells are built for the radii at the
+//! epoch's end (a growth of a few per cent), then a fresh system from the
+//! synchronised state, with δ set again so that d⟨d⟩/dt = Γ v_th.
+//!
+//! The reduced pressure Z = PV/(N kT) is measured from the collision virial
+//! over each rescaling window (Alder & Wainwright); Z → ∞ at jamming as
+//! Z ≈ D/(1 − φ/φ_J).
+
+use std::time::{Duration, Instant};
+
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use crate::init::{ball_volume, normal, random_placement, thermal_velocities};
+use crate::system::{Boundary, SimBox, System};
+use crate::EdmdError;
+
+/// A size distribution of the packed particles (diameters up to a common
+/// scale).
+#[derive(Debug, Clone, PartialEq)]
+pub enum SizeSpec {
+    /// All diameters equal.
+    Monodisperse,
+    /// Two sizes: diameter ratio large/small ≥ 1 and the number fraction of
+    /// the large ones.
+    Bidisperse { ratio: f64, large_fraction: f64 },
+    /// Lognormal number distribution of log-width σ (003 Eq. 10; the same
+    /// [`mote_rcp::Population::Lognormal`] that `mote rcp` estimates).
+    Lognormal { sigma: f64 },
+    /// Given radii (their number fixes N).
+    Radii(Vec<f64>),
+}
+
+impl SizeSpec {
+    /// Parses `mono`, `bi:RATIO:FRACTION` (number fraction of the large),
+    /// `lognormal:SIGMA`; radii files are read by the caller.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let parts: Vec<&str> = text.split(':').collect();
+        let num = |s: &str, what: &str| -> Result<f64, String> {
+            s.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("{what} `{s}` is not a number"))
+        };
+        match parts.as_slice() {
+            ["mono"] | ["monodisperse"] => Ok(SizeSpec::Monodisperse),
+            ["bi", ratio, frac] | ["bidisperse", ratio, frac] => {
+                let ratio = num(ratio, "diameter ratio")?;
+                let large_fraction = num(frac, "number fraction")?;
+                if ratio < 1.0 {
+                    return Err(format!("diameter ratio {ratio} must be ≥ 1 (large/small)"));
+                }
+                if !(0.0..=1.0).contains(&large_fraction) {
+                    return Err(format!(
+                        "number fraction {large_fraction} of the large particles must lie in [0, 1]"
+                    ));
+                }
+                Ok(SizeSpec::Bidisperse {
+                    ratio,
+                    large_fraction,
+                })
+            }
+            ["lognormal", sigma] | ["logn", sigma] => {
+                let sigma = num(sigma, "lognormal width σ")?;
+                if !(0.0..=2.0).contains(&sigma) {
+                    return Err(format!("lognormal width σ = {sigma} must lie in [0, 2]"));
+                }
+                Ok(SizeSpec::Lognormal { sigma })
+            }
+            _ => Err(format!(
+                "unknown size distribution `{text}`: use mono, bi:RATIO:FRACTION, lognormal:SIGMA or file:PATH"
+            )),
+        }
+    }
+
+    /// `n` diameters (any common scale), drawn with `rng` where random.
+    pub fn diameters(&self, n: usize, rng: &mut Xoshiro256PlusPlus) -> Vec<f64> {
+        match self {
+            SizeSpec::Monodisperse => vec![1.0; n],
+            SizeSpec::Bidisperse {
+                ratio,
+                large_fraction,
+            } => {
+                let large = (large_fraction * n as f64).round() as usize;
+                (0..n)
+                    .map(|i| if i < large { *ratio } else { 1.0 })
+                    .collect()
+            }
+            SizeSpec::Lognormal { sigma } => {
+                // number median D0 = d43·e^(−7σ²/2) (003 Eqs. 11–12), d43 = 1
+                let d0 = (-3.5 * sigma * sigma).exp();
+                (0..n).map(|_| d0 * (sigma * normal(rng)).exp()).collect()
+            }
+            SizeSpec::Radii(r) => r.iter().map(|r| 2.0 * r).collect(),
+        }
+    }
+
+    /// The same distribution as `mote rcp` describes it (occluded volumes
+    /// from number fractions, 003 Eqs. 15–16), for its RCP estimate; `None`
+    /// for a file of radii.
+    pub fn rcp_distribution(&self) -> Option<mote_rcp::SizeDistribution> {
+        use mote_rcp::Population;
+        let pops = match self {
+            SizeSpec::Monodisperse => vec![Population::monodisperse(1.0, 1.0)],
+            SizeSpec::Bidisperse {
+                ratio,
+                large_fraction,
+            } => vec![
+                Population::monodisperse(1.0, 1.0 - large_fraction),
+                Population::monodisperse(*ratio, large_fraction * ratio.powi(3)),
+            ],
+            SizeSpec::Lognormal { sigma } => vec![Population::lognormal(1.0, *sigma, 1.0)],
+            SizeSpec::Radii(_) => return None,
+        };
+        mote_rcp::SizeDistribution::new(pops).ok()
+    }
+}
+
+/// Settings of a packing run.
+#[derive(Debug, Clone)]
+pub struct PackSettings {
+    /// Number of particles (ignored for [`SizeSpec::Radii`]).
+    pub n: usize,
+    pub sizes: SizeSpec,
+    /// Γ = (1/v_th) d⟨d⟩/dt.
+    pub rate: f64,
+    /// Packing fraction of the random start (spheropack starts from points;
+    /// any dilute start forgets itself long before jamming).
+    pub phi_start: f64,
+    /// Hard walls on these axes (periodic otherwise).
+    pub walls: Vec<bool>,
+    /// Stop when the reduced pressure exceeds this (1e12: jammed).
+    pub max_pressure: f64,
+    /// Stop at this packing fraction.
+    pub target_phi: Option<f64>,
+    /// Stop after this many pair collisions.
+    pub max_collisions: Option<u64>,
+    /// Stop after this wall-clock time.
+    pub wall_clock: Option<Duration>,
+    /// Collisions per particle between kinetic-energy rescalings (also the
+    /// pressure window; 10 as in spheropack).
+    pub rescale_every: f64,
+    /// A quasi-static finish for jammed (isostatic) packings, or `None` for
+    /// growth at Γ to the end.
+    pub finish: Option<Finish>,
+    pub seed: u64,
+}
+
+/// The quasi-static finish for jammed packings (the protocol of spheropack's
+/// `Jammed` criterion): once a window's pressure passes `start_pressure`, the
+/// radii alternate between `relax_windows` windows at fixed size (energy
+/// conserved; the pressure spikes of fast-colliding clusters relax away and
+/// Z becomes the equilibrium pressure) and a growth step of the relative size
+/// `step`/Z, spread over the duration of one window. Near jamming
+/// Z ≈ D/(1 − φ/φ_J), so 1/Z estimates the relative growth left and each step
+/// closes the fraction `step` of it. The run stops when a relaxed window's Z
+/// passes the pressure threshold: the pressure then spreads over the whole
+/// contact network, which becomes isostatic (mean contact number 2D of the
+/// non-rattlers).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Finish {
+    pub start_pressure: f64,
+    pub relax_windows: usize,
+    pub step: f64,
+}
+
+impl Default for Finish {
+    fn default() -> Self {
+        Finish {
+            start_pressure: 1e3,
+            relax_windows: 4,
+            step: 0.2,
+        }
+    }
+}
+
+impl Default for PackSettings {
+    fn default() -> Self {
+        PackSettings {
+            n: 1000,
+            sizes: SizeSpec::Monodisperse,
+            rate: 0.01,
+            phi_start: 0.1,
+            walls: Vec::new(),
+            max_pressure: 1e12,
+            target_phi: None,
+            max_collisions: None,
+            wall_clock: None,
+            rescale_every: 10.0,
+            finish: None,
+            seed: 1,
+        }
+    }
+}
+
+/// Which stop criterion ended the run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// Reduced pressure above the threshold: jammed.
+    Pressure,
+    /// The target packing fraction was reached.
+    TargetPhi,
+    /// The collision budget was spent.
+    Collisions,
+    /// The wall-clock limit passed.
+    WallClock,
+}
+
+impl Stop {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Stop::Pressure => "pressure",
+            Stop::TargetPhi => "target-phi",
+            Stop::Collisions => "collisions",
+            Stop::WallClock => "wall-clock",
+        }
+    }
+}
+
+/// One pressure window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Pair collisions since the start.
+    pub collisions: u64,
+    /// Simulated time since the start.
+    pub time: f64,
+    /// Packing fraction at the end of the window.
+    pub phi: f64,
+    /// Reduced pressure Z = PV/(N kT) over the window.
+    pub pressure: f64,
+}
+
+/// What a finished run reports.
+#[derive(Debug, Clone)]
+pub struct PackOutcome {
+    pub stop: Stop,
+    pub phi: f64,
+    /// Reduced pressure of the last complete window (NaN if none).
+    pub pressure: f64,
+    pub collisions: u64,
+    pub time: f64,
+    /// Systems built (one per growth epoch).
+    pub epochs: u64,
+    pub history: Vec<Sample>,
+}
+
+/// A growing-sphere packing in progress.
+pub struct Packer<const D: usize> {
+    sys: System<D>,
+    settings: PackSettings,
+    /// Kinetic energy kept by the rescaling: D N kT/2 with kT = 1.
+    ke_target: f64,
+    /// Simulated time of earlier epochs.
+    t_before: f64,
+    collisions: u64,
+    epochs: u64,
+    // the current window
+    win_virial: f64,
+    win_time: f64,
+    win_coll: u64,
+    last_pressure: f64,
+    history: Vec<Sample>,
+}
+
+/// Relative growth of the radii over one epoch: lists are built for radii
+/// this much larger, so a bigger step costs more neighbours per list.
+fn epoch_growth(phi: f64, dim: usize) -> f64 {
+    let dense = if dim == 2 { 0.6 } else { 0.45 };
+    if phi < dense {
+        0.08
+    } else {
+        0.02
+    }
+}
+
+impl<const D: usize> Packer<D> {
+    /// A dilute random start: diameters from the distribution, scaled so that
+    /// the box (a cube of side L) holds them at `phi_start`, with L chosen
+    /// so that the mean diameter is about 1 at jamming.
+    pub fn new(settings: PackSettings) -> Result<Self, EdmdError> {
+        let invalid = |m: String| EdmdError::Invalid(m);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(settings.seed);
+        let n = match &settings.sizes {
+            SizeSpec::Radii(r) => r.len(),
+            _ => settings.n,
+        };
+        if n < 2 {
+            return Err(invalid(format!("need at least 2 particles, got {n}")));
+        }
+        if !(settings.rate > 0.0 && settings.rate.is_finite()) {
+            return Err(invalid(format!(
+                "growth rate Γ = {} must be positive",
+                settings.rate
+            )));
+        }
+        if !(settings.phi_start > 0.0 && settings.phi_start < 0.3) {
+            return Err(invalid(format!(
+                "starting packing fraction {} must lie in (0, 0.3)",
+                settings.phi_start
+            )));
+        }
+        if let Some(t) = settings.target_phi {
+            if !(t > settings.phi_start && t < 1.0) {
+                return Err(invalid(format!(
+                    "target packing fraction {t} must lie between the start {} and 1",
+                    settings.phi_start
+                )));
+            }
+        }
+        if !(settings.rescale_every > 0.0 && settings.rescale_every.is_finite()) {
+            return Err(invalid("rescale interval must be positive".into()));
+        }
+        if settings.max_pressure.is_nan() || settings.max_pressure <= 1.0 {
+            return Err(invalid(format!(
+                "pressure threshold {} must exceed 1 (the ideal gas)",
+                settings.max_pressure
+            )));
+        }
+        let d = settings.sizes.diameters(n, &mut rng);
+        if let Some(k) = d.iter().position(|x| !(*x > 0.0 && x.is_finite())) {
+            return Err(invalid(format!(
+                "radius {} (particle {k}) must be positive and finite",
+                d[k] / 2.0
+            )));
+        }
+        // box for ⟨d⟩ ≈ 1 near jamming
+        let mean_d = d.iter().sum::<f64>() / n as f64;
+        let vol: f64 = d.iter().map(|x| ball_volume(D, 0.5 * x / mean_d)).sum();
+        let phi_guess = if D == 2 { 0.84 } else { 0.64 };
+        let side = (vol / phi_guess).powf(1.0 / D as f64);
+        let scale = (settings.phi_start / phi_guess).powf(1.0 / D as f64) / mean_d;
+        let radii: Vec<f64> = d.iter().map(|x| 0.5 * x * scale).collect();
+        let mut walls = [false; D];
+        for (k, w) in settings.walls.iter().enumerate().take(D) {
+            walls[k] = *w;
+        }
+        let simbox = SimBox {
+            size: [side; D],
+            boundary: walls.map(|w| {
+                if w {
+                    Boundary::Wall
+                } else {
+                    Boundary::Periodic
+                }
+            }),
+        };
+        let largest = radii.iter().cloned().fold(0.0, f64::max) / scale;
+        if 2.0 * largest >= 0.3 * side {
+            return Err(invalid(format!(
+                "{n} particles are too few for the largest diameter ({:.3} of the box side at jamming): use more particles or a narrower distribution",
+                2.0 * largest / side
+            )));
+        }
+        let pos = random_placement(&radii, simbox.size, walls.map(|w| !w), &mut rng, 100_000)
+            .ok_or_else(|| invalid("could not place the particles at random".into()))?;
+        let masses = vec![1.0; n];
+        let vel = thermal_velocities::<D, _>(&masses, 1.0, &mut rng);
+        let ke_target = 0.5 * D as f64 * n as f64;
+        if let Some(f) = settings.finish {
+            if !(f.start_pressure > 1.0 && f.step > 0.0 && f.step <= 0.5 && f.relax_windows >= 1) {
+                return Err(invalid(format!(
+                    "quasi-static finish: start pressure {} must exceed 1, step {} lie in (0, 0.5] and relax windows {} be ≥ 1",
+                    f.start_pressure, f.step, f.relax_windows
+                )));
+            }
+        }
+        let sys = Self::epoch(simbox, pos, vel, radii, masses, &settings)?;
+        Ok(Packer {
+            sys,
+            settings,
+            ke_target,
+            t_before: 0.0,
+            collisions: 0,
+            epochs: 1,
+            win_virial: 0.0,
+            win_time: 0.0,
+            win_coll: 0,
+            last_pressure: f64::NAN,
+            history: Vec::new(),
+        })
+    }
+
+    /// A system growing at d⟨d⟩/dt = Γ v_th (v_th = 1) from the given state,
+    /// valid for one epoch of growth.
+    fn epoch(
+        simbox: SimBox<D>,
+        pos: Vec<[f64; D]>,
+        vel: Vec<[f64; D]>,
+        radii: Vec<f64>,
+        masses: Vec<f64>,
+        settings: &PackSettings,
+    ) -> Result<System<D>, EdmdError> {
+        let n = radii.len() as f64;
+        let mean_d = 2.0 * radii.iter().sum::<f64>() / n;
+        let delta = settings.rate / mean_d;
+        let phi = radii.iter().map(|r| ball_volume(D, *r)).sum::<f64>() / simbox.volume();
+        let horizon = epoch_growth(phi, D) / delta;
+        System::with_growth(simbox, pos, vel, radii, masses, delta, horizon)
+    }
+
+    pub fn system(&self) -> &System<D> {
+        &self.sys
+    }
+
+    /// Pair collisions so far.
+    pub fn collisions(&self) -> u64 {
+        self.collisions
+    }
+
+    /// Time at which the packing fraction reaches `phi` in the current
+    /// system's clock.
+    fn time_of_phi(&self, phi: f64) -> f64 {
+        let g_now = self.sys.growth_factor();
+        let g = g_now * (phi / self.sys.packing_fraction()).powf(1.0 / D as f64);
+        (g - 1.0) / self.sys.growth_rate()
+    }
+
+    fn harvest(&mut self) {
+        let c = *self.sys.counters();
+        self.win_virial += c.virial;
+        self.win_coll += c.collisions;
+        self.win_time += self.sys.time() - c.since;
+        self.collisions += c.collisions;
+        self.sys.reset_counters();
+    }
+
+    /// A fresh system from the synchronised state growing at Γ for one
+    /// epoch.
+    fn new_epoch(&mut self) -> Result<(), EdmdError> {
+        let n = self.sys.len() as f64;
+        let mean_d = 2.0 * self.sys.radii().iter().sum::<f64>() / n;
+        let delta = self.settings.rate / mean_d;
+        let horizon = epoch_growth(self.sys.packing_fraction(), D) / delta;
+        self.restart(delta, horizon)
+    }
+
+    /// A fresh system from the synchronised state with growth rate δ
+    /// (relative to the current radii) valid up to `horizon`.
+    fn restart(&mut self, delta: f64, horizon: f64) -> Result<(), EdmdError> {
+        self.harvest();
+        self.sys.synchronize();
+        self.t_before += self.sys.time();
+        let sys = &self.sys;
+        let next = System::with_growth(
+            *sys.simbox(),
+            sys.positions(),
+            sys.velocities(),
+            sys.radii(),
+            sys.masses(),
+            delta,
+            horizon,
+        )?;
+        self.sys = next;
+        self.epochs += 1;
+        Ok(())
+    }
+
+    /// Ends the current pressure window: Z = 1 + Σ r·Δp / (2 K t) with K the
+    /// window's mean, a sample, and the kinetic energy rescaled.
+    fn close_window(
+        &mut self,
+        progress: &mut impl FnMut(&Sample),
+    ) -> Result<(f64, f64), EdmdError> {
+        let ke_end = self.sys.kinetic_energy();
+        if !ke_end.is_finite() || ke_end <= 0.0 {
+            return Err(EdmdError::Invalid(format!(
+                "kinetic energy {ke_end} after {} collisions: the run went unstable",
+                self.collisions
+            )));
+        }
+        let ke = 0.5 * (self.ke_target + ke_end);
+        let z = 1.0 + self.win_virial / (2.0 * ke * self.win_time);
+        self.last_pressure = z;
+        let sample = Sample {
+            collisions: self.collisions,
+            time: self.t_before + self.sys.time(),
+            phi: self.sys.packing_fraction(),
+            pressure: z,
+        };
+        self.history.push(sample);
+        progress(&sample);
+        if (ke_end / self.ke_target - 1.0).abs() > 1e-12 {
+            self.sys.scale_velocities((self.ke_target / ke_end).sqrt());
+        }
+        let t = self.win_time;
+        self.win_virial = 0.0;
+        self.win_time = 0.0;
+        self.win_coll = 0;
+        Ok((z, t))
+    }
+
+    /// The quasi-static finish ([`Finish`]).
+    fn finish(
+        &mut self,
+        f: Finish,
+        window: u64,
+        start: Instant,
+        progress: &mut impl FnMut(&Sample),
+    ) -> Result<Stop, EdmdError> {
+        loop {
+            // relax at fixed radii
+            self.restart(0.0, f64::INFINITY)?;
+            let (mut z, mut t_w) = (f64::NAN, 0.0);
+            for _ in 0..f.relax_windows {
+                let mut want = window;
+                if let Some(budget) = self.settings.max_collisions {
+                    if self.collisions >= budget {
+                        return Ok(Stop::Collisions);
+                    }
+                    want = want.min(budget - self.collisions);
+                }
+                self.sys.run_collisions_until(want, f64::INFINITY);
+                self.harvest();
+                if self.win_coll < window {
+                    continue;
+                }
+                (z, t_w) = self.close_window(progress)?;
+                if let Some(limit) = self.settings.wall_clock {
+                    if start.elapsed() >= limit {
+                        return Ok(Stop::WallClock);
+                    }
+                }
+            }
+            if z > self.settings.max_pressure {
+                return Ok(Stop::Pressure);
+            }
+            if !(z > 1.0 && t_w > 0.0) {
+                return Ok(Stop::Collisions);
+            }
+            // grow by step/Z over one window's duration
+            let delta = f.step / (z * t_w);
+            self.restart(delta, t_w)?;
+            let done = self.sys.run_collisions_until(10 * window, t_w);
+            if !done {
+                self.sys.run_until(t_w);
+            }
+            self.harvest();
+            self.win_virial = 0.0;
+            self.win_time = 0.0;
+            self.win_coll = 0;
+        }
+    }
+
+    /// Runs until a stop criterion fires; `progress` sees every pressure
+    /// window.
+    pub fn run(&mut self, mut progress: impl FnMut(&Sample)) -> Result<PackOutcome, EdmdError> {
+        let start = Instant::now();
+        let n = self.sys.len() as f64;
+        let window = ((self.settings.rescale_every * n).round() as u64).max(1);
+        let stop = loop {
+            let mut want = window - self.win_coll;
+            if let Some(budget) = self.settings.max_collisions {
+                if self.collisions >= budget {
+                    break Stop::Collisions;
+                }
+                want = want.min(budget - self.collisions);
+            }
+            let t_target = match self.settings.target_phi {
+                Some(p) => self.time_of_phi(p),
+                None => f64::INFINITY,
+            };
+            let horizon = self.sys.horizon();
+            let t_end = t_target.min(horizon);
+            let done = self.sys.run_collisions_until(want, t_end);
+            if !done {
+                // nothing more before t_end (or no events at all)
+                if t_end.is_finite() {
+                    self.sys.run_until(t_end);
+                }
+                if t_target <= horizon {
+                    self.harvest();
+                    break Stop::TargetPhi;
+                }
+                self.new_epoch()?;
+                continue;
+            }
+            self.harvest();
+            if self.win_coll >= window {
+                let (z, _) = self.close_window(&mut progress)?;
+                if z > self.settings.max_pressure {
+                    break Stop::Pressure;
+                }
+                if let Some(f) = self.settings.finish {
+                    if z > f.start_pressure {
+                        break self.finish(f, window, start, &mut progress)?;
+                    }
+                }
+            }
+            if let Some(limit) = self.settings.wall_clock {
+                if start.elapsed() >= limit {
+                    break Stop::WallClock;
+                }
+            }
+        };
+        self.sys.synchronize();
+        Ok(PackOutcome {
+            stop,
+            phi: self.sys.packing_fraction(),
+            pressure: self.last_pressure,
+            collisions: self.collisions,
+            time: self.t_before + self.sys.time(),
+            epochs: self.epochs,
+            history: self.history.clone(),
+        })
+    }
+}

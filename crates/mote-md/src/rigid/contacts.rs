@@ -1,0 +1,396 @@
+//! Hertz–Mindlin contacts for rigid bodies of overlapping spheres: between
+//! spheres of *different* bodies and between spheres and walls (seed 000,
+//! "Modeling the dynamics of irregularly shaped particles": bodies touch
+//! through their spheres; the short-range issue's contact law).
+//!
+//! - Neighbour search: a half Verlet list over all world-frame sphere
+//!   centres ([`crate::neighbor::VerletList`]); after each rebuild the pairs
+//!   of one body are dropped, so the loop sees only pairs of different
+//!   bodies. Every listed pair carries its contact history (tangential and
+//!   rolling elongations) beside the list; a rebuild carries the histories
+//!   of pairs still listed over by merging the sorted partner lists.
+//! - Walls: the granular [`Wall`]s, with one history per (sphere, wall).
+//! - The law is [`ContactLaw::force`] with R* of the two spheres and, for
+//!   the damping, m* = m_a m_b/(m_a + m_b) of the two *bodies* (m* = m_a
+//!   against a wall). This is the common choice: LAMMPS `fix rigid` with the
+//!   granular pair styles passes, per atom, the mass of the body the atom
+//!   belongs to, and LIGGGHTS multisphere does the same.
+//! - Velocities at the contact point come from the bodies' dE(ω, v)
+//!   ([`BodyView::point_velocity`]); each contact force is put into the two
+//!   bodies' wrenches at the sphere centres ([`BodyView::wrench_at`]) plus
+//!   the law's torque about each sphere centre, which together are the
+//!   force applied at the contact point (and the rolling couple), so the
+//!   pair's total force and torque about any point vanish.
+//! - The FRBI evaluates forces once per step at t + Δt/2; successive
+//!   evaluations are Δt apart (for a constant step; for a varying step the
+//!   mean of two steps), and the tangential history advances by the time
+//!   since the previous evaluation, which is stored.
+
+use std::sync::{Arc, Mutex};
+
+use glam::DVec3;
+use mote_geom::DE;
+
+use super::interaction::{BodyInteraction, BodyView};
+use crate::boundary::Boundary;
+use crate::force::granular::{ContactLaw, History, Wall, WallShape};
+use crate::neighbor::VerletList;
+
+/// Contact parameters shared by all sphere pairs and walls. Stiffness comes
+/// from the law's E*, G*; the per-pair effective radius and mass are taken
+/// from the spheres and bodies.
+#[derive(Debug)]
+pub struct RigidContacts {
+    /// The law between spheres of two bodies.
+    pub law: ContactLaw,
+    /// The law between a sphere and a wall.
+    pub wall_law: ContactLaw,
+    pub walls: Vec<Wall>,
+    /// Periodic axes (with their box) for the sphere–sphere search; bodies
+    /// are not wrapped, their spheres are wrapped for the search only.
+    pub boundary: Boundary,
+    state: Arc<Mutex<ContactState>>,
+}
+
+/// The mutable part: neighbour list, histories, wall forces.
+#[derive(Debug, Clone, Default)]
+struct ContactState {
+    list: VerletList,
+    skin: f64,
+    /// Wrapped sphere centres (periodic boundaries only).
+    wrapped: Vec<DVec3>,
+    /// Pairs of different bodies: `partner[start[s]..start[s + 1]]` (sorted).
+    start: Vec<u32>,
+    partner: Vec<u32>,
+    history: Vec<History>,
+    touching: Vec<bool>,
+    /// history[s · walls + w]: sphere s against wall w.
+    wall_history: Vec<History>,
+    wall_touching: Vec<bool>,
+    wall_force: Vec<DVec3>,
+    last_time: Option<f64>,
+    contacts: usize,
+    wall_contacts: usize,
+}
+
+impl RigidContacts {
+    /// Contacts with law `law` between bodies and `wall_law` against
+    /// `walls`; `skin` is the Verlet skin of the sphere search.
+    pub fn new(law: ContactLaw, wall_law: ContactLaw, walls: Vec<Wall>, skin: f64) -> Self {
+        let n_walls = walls.len();
+        Self {
+            law,
+            wall_law,
+            walls,
+            boundary: Boundary::open(),
+            state: Arc::new(Mutex::new(ContactState {
+                skin,
+                wall_force: vec![DVec3::ZERO; n_walls],
+                start: vec![0],
+                ..Default::default()
+            })),
+        }
+    }
+
+    /// Search with periodic axes (x, y of a slab, for example).
+    pub fn with_boundary(mut self, boundary: Boundary) -> Self {
+        self.boundary = boundary;
+        self
+    }
+
+    /// The force the spheres exert on each wall at the last evaluation.
+    pub fn wall_forces(&self) -> Vec<(String, DVec3)> {
+        let s = self.state.lock().unwrap();
+        self.walls
+            .iter()
+            .zip(&s.wall_force)
+            .map(|(w, f)| (w.name.clone(), *f))
+            .collect()
+    }
+
+    /// Touching sphere pairs and sphere–wall contacts at the last evaluation.
+    pub fn contact_counts(&self) -> (usize, usize) {
+        let s = self.state.lock().unwrap();
+        (s.contacts, s.wall_contacts)
+    }
+
+    /// Number of neighbour-list builds so far.
+    pub fn list_builds(&self) -> u64 {
+        self.state.lock().unwrap().list.builds
+    }
+
+    /// The contact history of spheres (a, b) of different bodies, if listed.
+    pub fn history(&self, a: usize, b: usize) -> Option<History> {
+        let s = self.state.lock().unwrap();
+        let (a, b) = if a < b { (a, b) } else { (b, a) };
+        let range = *s.start.get(a)? as usize..*s.start.get(a + 1)? as usize;
+        let k = s.partner[range.clone()].binary_search(&(b as u32)).ok()?;
+        Some(s.history[range.start + k])
+    }
+}
+
+impl ContactState {
+    /// Refreshes the list; after a rebuild drops same-body pairs and carries
+    /// the histories of pairs still listed.
+    fn refresh(&mut self, centres: &[DVec3], body: &[u32], r_max: f64, boundary: &Boundary) {
+        let cutoff = 2.0 * r_max;
+        if self.list.cutoff != cutoff || !self.list.half {
+            let skin = self.skin;
+            self.list = VerletList::half(cutoff, skin);
+        }
+        let pos: &[DVec3] = if boundary.is_periodic() {
+            self.wrapped.clear();
+            self.wrapped
+                .extend(centres.iter().map(|c| boundary.wrap(*c)));
+            &self.wrapped
+        } else {
+            centres
+        };
+        let rebuilt = self.list.update(pos, boundary);
+        if !rebuilt && self.start.len() == centres.len() + 1 {
+            return;
+        }
+        let n = centres.len();
+        let mut start = Vec::with_capacity(n + 1);
+        let mut partner = Vec::with_capacity(self.list.neighbors.len());
+        start.push(0u32);
+        for (s, &bs) in body.iter().enumerate().take(n) {
+            partner.extend(self.list.of(s).iter().filter(|&&j| body[j as usize] != bs));
+            start.push(partner.len() as u32);
+        }
+        let mut history = vec![History::default(); partner.len()];
+        let mut touching = vec![false; partner.len()];
+        let old_n = self.start.len().saturating_sub(1);
+        for s in 0..n.min(old_n) {
+            let (mut a, a_end) = (self.start[s] as usize, self.start[s + 1] as usize);
+            let (mut b, b_end) = (start[s] as usize, start[s + 1] as usize);
+            while a < a_end && b < b_end {
+                match self.partner[a].cmp(&partner[b]) {
+                    std::cmp::Ordering::Less => a += 1,
+                    std::cmp::Ordering::Greater => b += 1,
+                    std::cmp::Ordering::Equal => {
+                        history[b] = self.history[a];
+                        touching[b] = self.touching[a];
+                        a += 1;
+                        b += 1;
+                    }
+                }
+            }
+        }
+        self.start = start;
+        self.partner = partner;
+        self.history = history;
+        self.touching = touching;
+    }
+}
+
+impl BodyInteraction for RigidContacts {
+    fn name(&self) -> &str {
+        "contacts"
+    }
+
+    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+        let world = view.world;
+        let bodies = view.bodies;
+        let centres = &world.sphere_centre;
+        let radius = &world.sphere_radius;
+        let body = &world.sphere_body;
+        let n = centres.len();
+        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+        let mut guard = self.state.lock().unwrap();
+        let st = &mut *guard;
+        st.refresh(centres, body, r_max, &self.boundary);
+        let dt = st.last_time.map_or(0.0, |t0| t - t0);
+        st.last_time = Some(t);
+        let image = self.boundary.image();
+        let periodic = self.boundary.is_periodic();
+        let pos: &[DVec3] = if periodic { &st.wrapped } else { centres };
+        let law = &self.law;
+        let mut contacts = 0usize;
+
+        // Sphere–sphere.
+        for s in 0..n {
+            let lo = st.start[s] as usize;
+            let hi = st.start[s + 1] as usize;
+            if lo == hi {
+                continue;
+            }
+            let (cs, rs) = (pos[s], radius[s]);
+            let a = body[s] as usize;
+            let (xa, va, wa) = (bodies.position[a], bodies.velocity[a], bodies.omega[a]);
+            let ma = bodies.template(a).mass();
+            for k in lo..hi {
+                let o = st.partner[k] as usize;
+                let d = if periodic {
+                    image.apply(cs - pos[o])
+                } else {
+                    cs - pos[o]
+                };
+                let reach = rs + radius[o];
+                let r2 = d.length_squared();
+                if r2 >= reach * reach {
+                    if st.touching[k] {
+                        st.touching[k] = false;
+                        st.history[k] = History::default();
+                    }
+                    continue;
+                }
+                st.touching[k] = true;
+                let r = r2.sqrt();
+                let nrm = d / r;
+                let delta = reach - r;
+                let (arm_s, arm_o) = (rs - 0.5 * delta, radius[o] - 0.5 * delta);
+                let b = body[o] as usize;
+                // The contact point relative to each body's centre (true
+                // centres, not wrapped: arms from the unwrapped spheres).
+                let ps = centres[s] - nrm * arm_s - xa;
+                let po = centres[o] + nrm * arm_o - bodies.position[b];
+                let v_rel = va + wa.cross(ps) - bodies.velocity[b] - bodies.omega[b].cross(po);
+                let mb = bodies.template(b).mass();
+                let c = law.force(
+                    delta,
+                    nrm,
+                    v_rel,
+                    wa - bodies.omega[b],
+                    arm_s,
+                    arm_o,
+                    rs * radius[o] / reach,
+                    ma * mb / (ma + mb),
+                    dt,
+                    &mut st.history[k],
+                );
+                let wa_ = view.wrench_at(a, centres[s], c.force);
+                wrench[a].omega += wa_.omega + c.torque_i;
+                wrench[a].v += wa_.v;
+                let wb_ = view.wrench_at(b, centres[o], -c.force);
+                wrench[b].omega += wb_.omega + c.torque_j;
+                wrench[b].v += wb_.v;
+                contacts += 1;
+            }
+        }
+        st.contacts = contacts;
+
+        // Sphere–wall.
+        let n_walls = self.walls.len();
+        st.wall_force.clear();
+        st.wall_force.resize(n_walls, DVec3::ZERO);
+        st.wall_contacts = 0;
+        if n_walls == 0 {
+            return;
+        }
+        if st.wall_history.len() != n * n_walls {
+            st.wall_history = vec![History::default(); n * n_walls];
+            st.wall_touching = vec![false; n * n_walls];
+        }
+        let planes: Vec<Option<(DVec3, f64)>> = self
+            .walls
+            .iter()
+            .map(|w| match w.shape {
+                WallShape::Plane { point, normal } => {
+                    Some((normal, (point + w.velocity * t).dot(normal)))
+                }
+                WallShape::Cylinder { .. } => None,
+            })
+            .collect();
+        let wl = &self.wall_law;
+        for s in 0..n {
+            let (x, rs) = (centres[s], radius[s]);
+            let a = body[s] as usize;
+            for (w, wall) in self.walls.iter().enumerate() {
+                let slot = s * n_walls + w;
+                let (gap, nrm) = match planes[w] {
+                    Some((normal, offset)) => (x.dot(normal) - offset, normal),
+                    None => wall.gap(x, t),
+                };
+                if gap >= rs || gap <= -rs {
+                    if st.wall_touching[slot] {
+                        st.wall_touching[slot] = false;
+                        st.wall_history[slot] = History::default();
+                    }
+                    continue;
+                }
+                st.wall_touching[slot] = true;
+                let delta = rs - gap;
+                let arm = rs - 0.5 * delta;
+                let p = x - nrm * arm;
+                let v_rel = view.point_velocity(a, p) - wall.surface_velocity(x, gap, nrm, t);
+                let c = wl.force(
+                    delta,
+                    nrm,
+                    v_rel,
+                    bodies.omega[a],
+                    arm,
+                    0.0,
+                    rs,
+                    bodies.template(a).mass(),
+                    dt,
+                    &mut st.wall_history[slot],
+                );
+                let wr = view.wrench_at(a, x, c.force);
+                wrench[a].omega += wr.omega + c.torque_i;
+                wrench[a].v += wr.v;
+                st.wall_force[w] -= c.force;
+                st.wall_contacts += 1;
+            }
+        }
+    }
+
+    /// The Hertz elastic energy Σ (8/15) E* √R* δ^{5/2} of all sphere pairs
+    /// of different bodies and sphere–wall contacts at the view's placement
+    /// (pairs taken from the list of the last force evaluation, whose skin
+    /// covers the half step since).
+    fn potential_energy(&self, view: &BodyView<'_>, t: f64) -> f64 {
+        let world = view.world;
+        let centres = &world.sphere_centre;
+        let radius = &world.sphere_radius;
+        let n = centres.len();
+        let mut guard = self.state.lock().unwrap();
+        let st = &mut *guard;
+        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+        st.refresh(centres, &world.sphere_body, r_max, &self.boundary);
+        let image = self.boundary.image();
+        let pos: &[DVec3] = if self.boundary.is_periodic() {
+            &st.wrapped
+        } else {
+            centres
+        };
+        let mut u = 0.0;
+        for s in 0..n {
+            for &o in &st.partner[st.start[s] as usize..st.start[s + 1] as usize] {
+                let o = o as usize;
+                let reach = radius[s] + radius[o];
+                let r = image.apply(pos[s] - pos[o]).length();
+                if r < reach {
+                    let r_eff = radius[s] * radius[o] / reach;
+                    u += 8.0 / 15.0 * self.law.e_star * r_eff.sqrt() * (reach - r).powf(2.5);
+                }
+            }
+        }
+        for wall in &self.walls {
+            for s in 0..n {
+                let r = radius[s];
+                let (gap, _) = wall.gap(centres[s], t);
+                if gap < r && gap > -r {
+                    u += 8.0 / 15.0 * self.wall_law.e_star * r.sqrt() * (r - gap).powf(2.5);
+                }
+            }
+        }
+        u
+    }
+}
+
+/// A shared interaction (keep an `Arc` to read wall forces while the
+/// integrator owns a clone).
+impl<T: BodyInteraction> BodyInteraction for Arc<T> {
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+
+    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+        (**self).add_wrenches(view, t, wrench)
+    }
+
+    fn potential_energy(&self, view: &BodyView<'_>, t: f64) -> f64 {
+        (**self).potential_energy(view, t)
+    }
+}

@@ -1,0 +1,1091 @@
+//! The `[rigid]` scene format and its runner: templates of overlapping
+//! spheres, bodies placed one by one or by generators, fields, contacts
+//! and walls, integrated by the FRBI, with observables (CSV) and the
+//! spheres' trajectory (extended XYZ).
+//!
+//! ```toml
+//! seed = 7
+//! [rigid]
+//! free_flight = "straight"     # or "screw" (the seed's literal free step)
+//! spin_update = "keep_momentum" # or "seed"
+//!
+//! [[rigid.template]]
+//! name = "bead"
+//! generator = "irregular"      # or "sphere", "dumbbell", "trimer"; or spheres = [[x, y, z, r], ...]
+//! radius = 1.0
+//! lobes = 8
+//! density = 1.0                # or mass = ... (density is then set to give it)
+//! dipole = [0.0, 0.0, 1.0]
+//! charge = 0.0
+//!
+//! [[rigid.body]]
+//! template = "bead"
+//! position = [0.0, 0.0, 1.0]
+//! rotation = [0.0, 0.0, 0.0]   # rotation vector n·tan(φ/2); or axis + angle
+//! velocity = [0.0, 0.0, 0.0]
+//! omega = [0.0, 0.0, 0.0]
+//!
+//! [[rigid.lattice]]            # n bodies on a simple cubic lattice in [lo, hi]
+//! template = "bead"
+//! n = 100
+//! lo = [0.0, 0.0, 0.0]
+//! hi = [10.0, 10.0, 10.0]
+//! spacing = 2.5
+//! random_orientation = true
+//!
+//! [[rigid.random]]             # n bodies at random, bounding spheres not overlapping
+//! template = "bead"
+//! n = 50
+//! lo = [0.0, 0.0, 0.0]
+//! hi = [10.0, 10.0, 10.0]
+//!
+//! [rigid.fields]
+//! gravity = [0.0, 0.0, -9.81]
+//! electric = [0.0, 0.0, 0.0]
+//! magnetic = { amplitude = 1.0, axis = [0, 0, 1], start = [1, 0, 0], frequency = 0.5 }
+//! coulomb = 8.99e9             # k of Coulomb forces between charges (off if absent)
+//! dipole_dipole = 1e-7         # k = μ0/4π of dipole–dipole forces (off if absent)
+//! drag = { viscosity = 1.8e-5, air_density = 1.2, drag_coefficient = 0.47 }
+//!
+//! [rigid.contacts]
+//! young = 1e7
+//! poisson = 0.3
+//! restitution = 0.5
+//! friction = 0.5
+//! rolling_friction = 0.0
+//! skin = 0.2                   # Verlet skin (default 0.2 × the largest sphere diameter)
+//! periodic = [true, true, false]  # with box_lo, box_hi: periodic axes
+//!
+//! [[rigid.wall]]               # as the granular [[wall]]
+//! kind = "box"
+//! lo = [0.0, 0.0, 0.0]
+//! hi = [10.0, 10.0, 10.0]
+//!
+//! [run]
+//! dt = 1e-4
+//! steps = 10000                # or until = 1.0
+//!
+//! [output]
+//! dir = "out"
+//! observables_every = 100
+//! trajectory_every = 1000
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::DVec3;
+use mote_geom::{from_axis_angle, DE, E};
+use mote_io::csv::CsvWriter;
+use mote_io::xyz::{Frame, XyzWriter};
+use mote_io::{ParseError, Provenance};
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::bodies::RigidBodies;
+use super::contacts::RigidContacts;
+use super::frbi::{Frbi, FreeFlight, SpinUpdate};
+use super::shapes::{dumbbell, linear_trimer, IrregularClump};
+use super::sources::{AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity};
+use super::template::{BodyTemplate, ClumpSpec, Integration};
+use crate::boundary::Boundary;
+use crate::error::MdError;
+use crate::force::granular::{ContactLaw, Damping, Material, Wall};
+
+/// A whole rigid scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidScene {
+    #[serde(default)]
+    pub seed: Option<u64>,
+    /// Free text, ignored.
+    #[serde(default)]
+    pub title: Option<String>,
+    pub rigid: Spanned<RigidSettings>,
+    pub run: Spanned<RunSettings>,
+    #[serde(default)]
+    pub output: OutputSettings,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidSettings {
+    #[serde(default)]
+    pub free_flight: Option<Spanned<String>>,
+    #[serde(default)]
+    pub spin_update: Option<Spanned<String>>,
+    #[serde(default)]
+    pub template: Vec<Spanned<TemplateSpec>>,
+    #[serde(default)]
+    pub body: Vec<Spanned<BodySpec>>,
+    #[serde(default)]
+    pub lattice: Vec<Spanned<PlacementSpec>>,
+    #[serde(default)]
+    pub random: Vec<Spanned<PlacementSpec>>,
+    #[serde(default)]
+    pub fields: Option<Spanned<FieldSettings>>,
+    #[serde(default)]
+    pub contacts: Option<Spanned<ContactSettings>>,
+    #[serde(default)]
+    pub wall: Vec<Spanned<WallSpec>>,
+}
+
+/// `[[rigid.template]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemplateSpec {
+    pub name: String,
+    /// Explicit spheres `[x, y, z, r]`.
+    #[serde(default)]
+    pub spheres: Option<Vec<[f64; 4]>>,
+    /// "sphere", "dumbbell", "trimer", "irregular".
+    #[serde(default)]
+    pub generator: Option<String>,
+    #[serde(default)]
+    pub radius: Option<f64>,
+    /// Centre distance of neighbouring spheres (dumbbell, trimer).
+    #[serde(default)]
+    pub distance: Option<f64>,
+    #[serde(default)]
+    pub lobes: Option<usize>,
+    #[serde(default)]
+    pub lobe_radius: Option<[f64; 2]>,
+    #[serde(default)]
+    pub offset: Option<[f64; 2]>,
+    /// Shape seed of the irregular generator (default: the scene seed).
+    #[serde(default)]
+    pub seed: Option<u64>,
+    #[serde(default)]
+    pub density: Option<f64>,
+    #[serde(default)]
+    pub mass: Option<f64>,
+    #[serde(default)]
+    pub young: Option<f64>,
+    #[serde(default)]
+    pub poisson: Option<f64>,
+    #[serde(default)]
+    pub charge: f64,
+    #[serde(default)]
+    pub dipole: [f64; 3],
+}
+
+/// `[[rigid.body]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub template: String,
+    pub position: [f64; 3],
+    #[serde(default)]
+    pub rotation: Option<[f64; 3]>,
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    /// Degrees.
+    #[serde(default)]
+    pub angle: Option<f64>,
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(default)]
+    pub omega: [f64; 3],
+}
+
+/// `[[rigid.lattice]]` / `[[rigid.random]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlacementSpec {
+    pub template: String,
+    pub n: usize,
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+    /// Lattice spacing (default: the template's bounding diameter).
+    #[serde(default)]
+    pub spacing: Option<f64>,
+    #[serde(default = "yes")]
+    pub random_orientation: bool,
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Random velocities of this magnitude in random directions, added.
+    #[serde(default)]
+    pub speed: f64,
+}
+
+fn yes() -> bool {
+    true
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum FieldSpec {
+    Constant([f64; 3]),
+    Rotating {
+        amplitude: f64,
+        axis: [f64; 3],
+        start: [f64; 3],
+        frequency: f64,
+        #[serde(default)]
+        phase: f64,
+        #[serde(default)]
+        offset: [f64; 3],
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DragSpec {
+    #[serde(default)]
+    pub viscosity: f64,
+    #[serde(default)]
+    pub air_density: f64,
+    #[serde(default)]
+    pub drag_coefficient: f64,
+    #[serde(default)]
+    pub wind: [f64; 3],
+}
+
+/// `[rigid.fields]`.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct FieldSettings {
+    #[serde(default)]
+    pub gravity: Option<[f64; 3]>,
+    #[serde(default)]
+    pub electric: Option<FieldSpec>,
+    #[serde(default)]
+    pub magnetic: Option<FieldSpec>,
+    #[serde(default)]
+    pub coulomb: Option<f64>,
+    #[serde(default)]
+    pub dipole_dipole: Option<f64>,
+    #[serde(default)]
+    pub drag: Option<DragSpec>,
+}
+
+/// `[rigid.contacts]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSettings {
+    pub young: f64,
+    #[serde(default = "default_poisson")]
+    pub poisson: f64,
+    pub restitution: f64,
+    #[serde(default)]
+    pub friction: f64,
+    #[serde(default)]
+    pub rolling_friction: f64,
+    #[serde(default)]
+    pub adhesion: f64,
+    #[serde(default)]
+    pub limit_damping: bool,
+    #[serde(default)]
+    pub skin: Option<f64>,
+    #[serde(default)]
+    pub periodic: Option<[bool; 3]>,
+    #[serde(default)]
+    pub box_lo: Option<[f64; 3]>,
+    #[serde(default)]
+    pub box_hi: Option<[f64; 3]>,
+}
+
+fn default_poisson() -> f64 {
+    0.3
+}
+
+/// `[[rigid.wall]]`: the keys of the granular `[[wall]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSpec {
+    pub kind: String,
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub point: Option<[f64; 3]>,
+    #[serde(default)]
+    pub normal: Option<[f64; 3]>,
+    #[serde(default)]
+    pub lo: Option<[f64; 3]>,
+    #[serde(default)]
+    pub hi: Option<[f64; 3]>,
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    #[serde(default)]
+    pub radius: Option<f64>,
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(default)]
+    pub angular_speed: f64,
+}
+
+/// `[run]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSettings {
+    pub dt: f64,
+    #[serde(default)]
+    pub steps: Option<u64>,
+    #[serde(default)]
+    pub until: Option<f64>,
+}
+
+/// `[output]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSettings {
+    #[serde(default = "default_dir")]
+    pub dir: String,
+    #[serde(default = "default_every")]
+    pub observables_every: u64,
+    /// 0: no trajectory.
+    #[serde(default)]
+    pub trajectory_every: u64,
+}
+
+impl Default for OutputSettings {
+    fn default() -> Self {
+        Self {
+            dir: default_dir(),
+            observables_every: default_every(),
+            trajectory_every: 0,
+        }
+    }
+}
+
+fn default_dir() -> String {
+    "out".into()
+}
+
+fn default_every() -> u64 {
+    100
+}
+
+/// The built scene: bodies, the integrator and what to run.
+pub struct BuiltRigid {
+    pub bodies: RigidBodies,
+    pub frbi: Frbi,
+    /// The contact model (shared with the integrator), if any.
+    pub contacts: Option<Arc<RigidContacts>>,
+    pub dt: f64,
+    pub steps: u64,
+    pub seed: u64,
+}
+
+/// What a run did.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub bodies: usize,
+    pub spheres: usize,
+    pub steps: u64,
+    pub time: f64,
+    pub wall_seconds: f64,
+    pub kinetic_energy: f64,
+    pub potential_energy: f64,
+    pub linear_momentum: DVec3,
+    pub angular_momentum: DVec3,
+    /// The force on each wall at the last step.
+    pub wall_forces: Vec<(String, DVec3)>,
+    pub files: Vec<PathBuf>,
+}
+
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())]
+        .bytes()
+        .filter(|b| *b == b'\n')
+        .count()
+        + 1
+}
+
+/// Whether a scene text is a rigid-body scene (has a `[rigid]` table).
+pub fn is_rigid_scene(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .map(|t| t.contains_key("rigid"))
+        .unwrap_or(false)
+}
+
+impl RigidScene {
+    /// Parses a scene; errors are `file:line: message`.
+    pub fn parse(text: &str, file: &str) -> Result<Self, ParseError> {
+        toml::from_str::<RigidScene>(text).map_err(|e| {
+            let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(0);
+            ParseError::new(file, line, e.message().trim().to_string())
+        })
+    }
+
+    /// Builds bodies and integrator; `seed` overrides the scene's.
+    pub fn build(
+        &self,
+        text: &str,
+        file: &str,
+        seed: Option<u64>,
+    ) -> Result<BuiltRigid, ParseError> {
+        let err = |span: std::ops::Range<usize>, msg: String| {
+            ParseError::new(file, line_of(text, span.start), msg)
+        };
+        let seed = seed.or(self.seed).unwrap_or(1);
+        let rigid = self.rigid.get_ref();
+        let mut frbi = Frbi::new();
+        if let Some(f) = &rigid.free_flight {
+            frbi.flight = match f.get_ref().as_str() {
+                "straight" => FreeFlight::Straight,
+                "screw" => FreeFlight::Screw,
+                o => {
+                    return Err(err(
+                        f.span(),
+                        format!("unknown free_flight '{o}': expected straight or screw"),
+                    ))
+                }
+            };
+        }
+        if let Some(s) = &rigid.spin_update {
+            frbi.spin = match s.get_ref().as_str() {
+                "keep_momentum" => SpinUpdate::KeepMomentum,
+                "seed" => SpinUpdate::Seed,
+                o => {
+                    return Err(err(
+                        s.span(),
+                        format!("unknown spin_update '{o}': expected keep_momentum or seed"),
+                    ))
+                }
+            };
+        }
+        let contact = rigid.contacts.as_ref();
+        let material = contact.map(|c| Material {
+            young: c.get_ref().young,
+            poisson: c.get_ref().poisson,
+        });
+
+        // Templates.
+        let mut bodies = RigidBodies::new();
+        let mut names: Vec<(String, u32)> = Vec::new();
+        for (k, t) in rigid.template.iter().enumerate() {
+            let (span, ts) = (t.span(), t.get_ref());
+            if names.iter().any(|(n, _)| *n == ts.name) {
+                return Err(err(
+                    span,
+                    format!("template '{}' is defined twice", ts.name),
+                ));
+            }
+            let spec = template_spec(ts, seed.wrapping_add(k as u64), material)
+                .map_err(|m| err(span.clone(), m))?;
+            let tpl = BodyTemplate::new(&spec, Integration::default())
+                .map_err(|e| err(span.clone(), format!("template '{}': {e}", ts.name)))?;
+            let tpl = match ts.mass {
+                Some(m) => {
+                    // Scale the density to give the asked mass.
+                    let mut spec = spec;
+                    spec.density *= m / tpl.mass();
+                    BodyTemplate::new(&spec, Integration::default())
+                        .map_err(|e| err(span.clone(), format!("template '{}': {e}", ts.name)))?
+                }
+                None => tpl,
+            };
+            names.push((ts.name.clone(), bodies.add_template(tpl)));
+        }
+        let kind_of = |name: &str, span: std::ops::Range<usize>| -> Result<u32, ParseError> {
+            names
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, k)| *k)
+                .ok_or_else(|| err(span, format!("unknown template '{name}'")))
+        };
+
+        // Bodies.
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        for b in &rigid.body {
+            let (span, bs) = (b.span(), b.get_ref());
+            let k = kind_of(&bs.template, span.clone())?;
+            let r = match (bs.rotation, bs.axis, bs.angle) {
+                (Some(r), None, None) => DVec3::from(r),
+                (None, Some(a), Some(deg)) => {
+                    let a = DVec3::from(a);
+                    if a.length() == 0.0 {
+                        return Err(err(span, "the rotation axis must not be zero".into()));
+                    }
+                    from_axis_angle(a.normalize(), deg.to_radians())
+                }
+                (None, None, None) => DVec3::ZERO,
+                _ => {
+                    return Err(err(
+                        span,
+                        "give either `rotation` or both `axis` and `angle`".into(),
+                    ))
+                }
+            };
+            bodies.push(
+                k,
+                E::new(r, DVec3::from(bs.position)),
+                DE::new(DVec3::from(bs.omega), DVec3::from(bs.velocity)),
+            );
+        }
+        for (random, list) in [(false, &rigid.lattice), (true, &rigid.random)] {
+            for p in list {
+                let (span, ps) = (p.span(), p.get_ref());
+                let k = kind_of(&ps.template, span.clone())?;
+                let bound = bodies.templates[k as usize].props.bounding_radius;
+                let (lo, hi) = (DVec3::from(ps.lo), DVec3::from(ps.hi));
+                if (0..3).any(|d| hi[d] < lo[d]) {
+                    return Err(err(span, "lo must not exceed hi".into()));
+                }
+                let sites = if random {
+                    random_sites(ps.n, lo, hi, bound, &bodies, &mut rng)
+                } else {
+                    lattice_sites(ps.n, lo, hi, ps.spacing.unwrap_or(2.0 * bound))
+                }
+                .map_err(|m| err(span.clone(), m))?;
+                for x in sites {
+                    let r = if ps.random_orientation {
+                        random_rotation(&mut rng)
+                    } else {
+                        DVec3::ZERO
+                    };
+                    let v = DVec3::from(ps.velocity) + ps.speed * random_unit(&mut rng);
+                    bodies.push(k, E::new(r, x), DE::new(DVec3::ZERO, v));
+                }
+            }
+        }
+        if bodies.is_empty() {
+            return Err(ParseError::new(
+                file,
+                line_of(text, self.rigid.span().start),
+                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]] or [[rigid.random]]",
+            ));
+        }
+
+        // Fields.
+        if let Some(f) = &rigid.fields {
+            let fs = f.get_ref();
+            if let Some(g) = fs.gravity {
+                frbi.push(Box::new(Gravity { g: DVec3::from(g) }));
+            }
+            if fs.electric.is_some() || fs.magnetic.is_some() {
+                let conv = |s: &Option<FieldSpec>| -> Result<Field, String> {
+                    Ok(match s {
+                        None => Field::zero(),
+                        Some(FieldSpec::Constant(v)) => Field::Constant(DVec3::from(*v)),
+                        Some(FieldSpec::Rotating {
+                            amplitude,
+                            axis,
+                            start,
+                            frequency,
+                            phase,
+                            offset,
+                        }) => {
+                            let (axis, start) = (DVec3::from(*axis), DVec3::from(*start));
+                            if axis.length() == 0.0 || start.cross(axis).length() == 0.0 {
+                                return Err("a rotating field needs a non-zero axis and a start direction not along it".into());
+                            }
+                            let axis = axis.normalize();
+                            let start = (start - axis * start.dot(axis)).normalize();
+                            Field::Rotating {
+                                offset: DVec3::from(*offset),
+                                amplitude: *amplitude,
+                                axis,
+                                start,
+                                frequency: *frequency,
+                                phase: *phase,
+                            }
+                        }
+                    })
+                };
+                let electric = conv(&fs.electric).map_err(|m| err(f.span(), m))?;
+                let magnetic = conv(&fs.magnetic).map_err(|m| err(f.span(), m))?;
+                frbi.push(Box::new(ExternalFields { electric, magnetic }));
+            }
+            if let Some(k) = fs.coulomb {
+                frbi.push(Box::new(Coulomb { k }));
+            }
+            if let Some(k) = fs.dipole_dipole {
+                frbi.push(Box::new(DipoleDipole { k }));
+            }
+            if let Some(d) = &fs.drag {
+                frbi.push(Box::new(AirDrag {
+                    viscosity: d.viscosity,
+                    air_density: d.air_density,
+                    drag_coefficient: d.drag_coefficient,
+                    wind: DVec3::from(d.wind),
+                }));
+            }
+        }
+
+        // Contacts and walls.
+        let mut walls = Vec::new();
+        for (k, w) in rigid.wall.iter().enumerate() {
+            walls.extend(wall_of(w.get_ref(), k).map_err(|m| err(w.span(), m))?);
+        }
+        let mut contacts = None;
+        match contact {
+            Some(c) => {
+                let (span, cs) = (c.span(), c.get_ref());
+                if !positive(cs.young) || !(0.0..0.5).contains(&cs.poisson) {
+                    return Err(err(
+                        span,
+                        "contacts need young > 0 and 0 <= poisson < 0.5".into(),
+                    ));
+                }
+                if !(0.0..=1.0).contains(&cs.restitution) || cs.friction < 0.0 {
+                    return Err(err(
+                        span,
+                        "contacts need 0 <= restitution <= 1 and friction >= 0".into(),
+                    ));
+                }
+                let m = material.unwrap();
+                let mut law = ContactLaw::new(
+                    m,
+                    m,
+                    cs.restitution,
+                    cs.friction,
+                    Damping::Exact,
+                    cs.limit_damping,
+                );
+                law.rolling_friction = cs.rolling_friction;
+                law.adhesion = cs.adhesion;
+                let r_max = bodies
+                    .templates
+                    .iter()
+                    .flat_map(|t| t.radii.iter().cloned())
+                    .fold(0.0, f64::max);
+                let skin = cs.skin.unwrap_or(0.4 * r_max);
+                let mut model = RigidContacts::new(law, law, walls, skin);
+                if let Some(p) = cs.periodic {
+                    let (Some(lo), Some(hi)) = (cs.box_lo, cs.box_hi) else {
+                        return Err(err(span, "periodic axes need box_lo and box_hi".into()));
+                    };
+                    let (lo, hi) = (DVec3::from(lo), DVec3::from(hi));
+                    for d in 0..3 {
+                        if p[d] && (hi[d] - lo[d]) < 3.0 * (2.0 * r_max + skin) {
+                            return Err(err(span, "a periodic axis must be at least three sphere diameters plus skins long".into()));
+                        }
+                    }
+                    model = model.with_boundary(Boundary {
+                        lo,
+                        hi,
+                        periodic: p,
+                    });
+                }
+                let model = Arc::new(model);
+                frbi.push(Box::new(model.clone()));
+                contacts = Some(model);
+            }
+            None if !walls.is_empty() => {
+                return Err(err(
+                    rigid.wall[0].span(),
+                    "walls need [rigid.contacts] (young, restitution, ...)".into(),
+                ));
+            }
+            None => {}
+        }
+
+        // Run length.
+        let (rspan, run) = (self.run.span(), self.run.get_ref());
+        if !positive(run.dt) {
+            return Err(err(rspan, "[run] dt must be > 0".into()));
+        }
+        let steps = match (run.steps, run.until) {
+            (Some(s), None) => s,
+            (None, Some(t)) => (t / run.dt).round() as u64,
+            _ => {
+                return Err(err(
+                    rspan,
+                    "[run] needs exactly one of `steps` and `until`".into(),
+                ))
+            }
+        };
+        Ok(BuiltRigid {
+            bodies,
+            frbi,
+            contacts,
+            dt: run.dt,
+            steps,
+            seed,
+        })
+    }
+}
+
+fn template_spec(
+    ts: &TemplateSpec,
+    seed: u64,
+    material: Option<Material>,
+) -> Result<ClumpSpec, String> {
+    let density = match (ts.density, ts.mass) {
+        (Some(d), None) => d,
+        (None, Some(_)) => 1.0,
+        (None, None) => return Err("a template needs `density` or `mass`".into()),
+        (Some(_), Some(_)) => return Err("give `density` or `mass`, not both".into()),
+    };
+    let radius = || {
+        ts.radius
+            .ok_or_else(|| "this generator needs `radius`".to_string())
+    };
+    let mut spec = match (&ts.spheres, ts.generator.as_deref()) {
+        (Some(s), None) => {
+            if s.is_empty() {
+                return Err("`spheres` is empty".into());
+            }
+            ClumpSpec {
+                centres: s.iter().map(|p| DVec3::new(p[0], p[1], p[2])).collect(),
+                radii: s.iter().map(|p| p[3]).collect(),
+                density,
+                youngs_modulus: 0.0,
+                poisson_ratio: 0.0,
+                charge: 0.0,
+                dipole: DVec3::ZERO,
+            }
+        }
+        (None, Some("sphere")) => ClumpSpec {
+            centres: vec![DVec3::ZERO],
+            radii: vec![radius()?],
+            density,
+            youngs_modulus: 0.0,
+            poisson_ratio: 0.0,
+            charge: 0.0,
+            dipole: DVec3::ZERO,
+        },
+        (None, Some("dumbbell")) => dumbbell(
+            radius()?,
+            ts.distance.ok_or("a dumbbell needs `distance`")?,
+            density,
+        ),
+        (None, Some("trimer")) => linear_trimer(
+            radius()?,
+            ts.distance.ok_or("a trimer needs `distance`")?,
+            density,
+        ),
+        (None, Some("irregular")) => {
+            let d = IrregularClump::default();
+            let g = IrregularClump {
+                radius: ts.radius.unwrap_or(d.radius),
+                lobes: ts.lobes.unwrap_or(d.lobes),
+                lobe_radius: ts.lobe_radius.map_or(d.lobe_radius, |r| (r[0], r[1])),
+                offset: ts.offset.map_or(d.offset, |r| (r[0], r[1])),
+                density,
+            };
+            if g.lobe_radius.0 > g.lobe_radius.1 || g.offset.0 > g.offset.1 {
+                return Err("lobe_radius and offset are [min, max] ranges".into());
+            }
+            g.generate(ts.seed.unwrap_or(seed))
+        }
+        (None, Some(o)) => {
+            return Err(format!(
+                "unknown generator '{o}': expected sphere, dumbbell, trimer or irregular"
+            ))
+        }
+        (Some(_), Some(_)) => return Err("give `spheres` or `generator`, not both".into()),
+        (None, None) => return Err("a template needs `spheres` or `generator`".into()),
+    };
+    if let Some(m) = material {
+        let (y, p) = (ts.young.unwrap_or(m.young), ts.poisson.unwrap_or(m.poisson));
+        if y != m.young || p != m.poisson {
+            return Err("per-template materials are not supported yet: set young and poisson in [rigid.contacts]".into());
+        }
+        spec.youngs_modulus = y;
+        spec.poisson_ratio = p;
+    } else {
+        spec.youngs_modulus = ts.young.unwrap_or(0.0);
+        spec.poisson_ratio = ts.poisson.unwrap_or(0.0);
+    }
+    spec.charge = ts.charge;
+    spec.dipole = DVec3::from(ts.dipole);
+    Ok(spec)
+}
+
+fn wall_of(w: &WallSpec, index: usize) -> Result<Vec<Wall>, String> {
+    let name = w.name.clone().unwrap_or_else(|| format!("wall{index}"));
+    let need = |v: Option<[f64; 3]>, key: &str| -> Result<DVec3, String> {
+        v.map(DVec3::from)
+            .ok_or_else(|| format!("a {} wall needs `{key}`", w.kind))
+    };
+    let mut walls = match w.kind.as_str() {
+        "plane" => {
+            let normal = need(w.normal, "normal")?;
+            if normal.length() == 0.0 {
+                return Err("the plane's normal must not be zero".into());
+            }
+            vec![Wall::plane(&name, need(w.point, "point")?, normal)]
+        }
+        "box" => {
+            let (lo, hi) = (need(w.lo, "lo")?, need(w.hi, "hi")?);
+            if (0..3).any(|k| hi[k] <= lo[k]) {
+                return Err("a box wall needs lo < hi on every axis".into());
+            }
+            Wall::closed_box(&name, lo, hi)
+        }
+        "cylinder" => {
+            let axis = need(w.axis, "axis")?;
+            let radius = w.radius.ok_or("a cylinder wall needs `radius`")?;
+            if axis.length() == 0.0 || !positive(radius) {
+                return Err("a cylinder needs a non-zero axis and radius > 0".into());
+            }
+            vec![Wall::cylinder(&name, need(w.point, "point")?, axis, radius)]
+        }
+        other => {
+            return Err(format!(
+                "unknown wall kind '{other}': expected plane, box or cylinder"
+            ))
+        }
+    };
+    for wall in &mut walls {
+        wall.velocity = DVec3::from(w.velocity);
+        wall.angular_speed = w.angular_speed;
+    }
+    Ok(walls)
+}
+
+/// x > 0 (false for NaN).
+fn positive(x: f64) -> bool {
+    x > 0.0
+}
+
+fn random_unit(rng: &mut Xoshiro256PlusPlus) -> DVec3 {
+    let z: f64 = rng.gen_range(-1.0..1.0);
+    let p: f64 = rng.gen_range(0.0..std::f64::consts::TAU);
+    let s = (1.0 - z * z).sqrt();
+    DVec3::new(s * p.cos(), s * p.sin(), z)
+}
+
+/// A uniformly random rotation as a rotation vector n·tan(φ/2) = q⃗/q₀ of a
+/// uniform unit quaternion (Shoemake), with q₀ ≥ 0.
+fn random_rotation(rng: &mut Xoshiro256PlusPlus) -> DVec3 {
+    let (u1, u2, u3): (f64, f64, f64) = (rng.gen(), rng.gen(), rng.gen());
+    let tau = std::f64::consts::TAU;
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let q = [
+        a * (tau * u2).sin(),
+        a * (tau * u2).cos(),
+        b * (tau * u3).sin(),
+        b * (tau * u3).cos(),
+    ];
+    let w = q[3].abs().max(1e-9) * q[3].signum();
+    DVec3::new(q[0], q[1], q[2]) / w
+}
+
+fn lattice_sites(n: usize, lo: DVec3, hi: DVec3, spacing: f64) -> Result<Vec<DVec3>, String> {
+    if !positive(spacing) {
+        return Err("spacing must be > 0".into());
+    }
+    let count = |k: usize| ((hi[k] - lo[k]) / spacing).floor() as usize + 1;
+    let (nx, ny, nz) = (count(0), count(1), count(2));
+    if nx * ny * nz < n {
+        return Err(format!(
+            "only {} lattice sites of spacing {spacing} fit in [lo, hi], {n} asked",
+            nx * ny * nz
+        ));
+    }
+    let mut out = Vec::with_capacity(n);
+    'fill: for iz in 0..nz {
+        for iy in 0..ny {
+            for ix in 0..nx {
+                if out.len() == n {
+                    break 'fill;
+                }
+                out.push(lo + spacing * DVec3::new(ix as f64, iy as f64, iz as f64));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Random sequential addition of bounding spheres (radius `bound`) with
+/// centres in [lo, hi], not overlapping each other or bodies already placed.
+fn random_sites(
+    n: usize,
+    lo: DVec3,
+    hi: DVec3,
+    bound: f64,
+    placed: &RigidBodies,
+    rng: &mut Xoshiro256PlusPlus,
+) -> Result<Vec<DVec3>, String> {
+    let mut taken: Vec<(DVec3, f64)> = (0..placed.len())
+        .map(|i| (placed.position[i], placed.template(i).props.bounding_radius))
+        .collect();
+    let first = taken.len();
+    let mut tries = 0usize;
+    while taken.len() - first < n {
+        tries += 1;
+        if tries > 1000 * (n + 10) {
+            return Err(format!(
+                "could place only {} of {n} bodies without overlap: enlarge [lo, hi]",
+                taken.len() - first
+            ));
+        }
+        let x = DVec3::new(
+            rng.gen_range(lo.x..=hi.x),
+            rng.gen_range(lo.y..=hi.y),
+            rng.gen_range(lo.z..=hi.z),
+        );
+        if taken
+            .iter()
+            .all(|(y, r)| (x - *y).length_squared() >= (r + bound) * (r + bound))
+        {
+            taken.push((x, bound));
+        }
+    }
+    Ok(taken[first..].iter().map(|(x, _)| *x).collect())
+}
+
+/// Runs a rigid scene: `text` is the TOML, `file_label` locates errors and
+/// goes into the provenance headers, `seed_override` replaces the scene's
+/// seed, `out_dir` replaces `[output] dir`. Writes `observables.csv` and,
+/// with `trajectory_every` > 0, `trajectory.xyz` (the spheres).
+pub fn run_rigid_scene(
+    text: &str,
+    file_label: &str,
+    seed_override: Option<u64>,
+    out_dir: Option<&Path>,
+    quiet: bool,
+) -> Result<Report, MdError> {
+    let scene = RigidScene::parse(text, file_label)?;
+    let mut built = scene.build(text, file_label, seed_override)?;
+    let dir = out_dir
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from(&scene.output.dir));
+    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
+    let provenance = Provenance {
+        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
+        scene: file_label.to_string(),
+        seed: built.seed,
+    };
+    let walls: Vec<String> = built
+        .contacts
+        .as_ref()
+        .map(|c| c.walls.iter().map(|w| w.name.clone()).collect())
+        .unwrap_or_default();
+    let mut columns: Vec<String> = [
+        "time",
+        "kinetic_energy",
+        "translational_energy",
+        "rotational_energy",
+        "potential_energy",
+        "total_energy",
+        "px",
+        "py",
+        "pz",
+        "lx",
+        "ly",
+        "lz",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for w in &walls {
+        for a in ["x", "y", "z"] {
+            columns.push(format!("{w}.f{a}"));
+        }
+    }
+    let csv_path = dir.join("observables.csv");
+    let mut csv = CsvWriter::create(&csv_path, &provenance, &columns, &[])?;
+    let mut files = vec![csv_path];
+    let every = scene.output.observables_every.max(1);
+    let traj_every = scene.output.trajectory_every;
+    let mut xyz = if traj_every > 0 {
+        let p = dir.join("trajectory.xyz");
+        files.push(p.clone());
+        Some(XyzWriter::create(&p, provenance.clone())?)
+    } else {
+        None
+    };
+    let b = &mut built.bodies;
+    let f = &mut built.frbi;
+    let contacts = built.contacts.clone();
+    let sample =
+        |b: &RigidBodies, f: &mut Frbi, csv: &mut CsvWriter| -> Result<(f64, f64), MdError> {
+            let e = f.energies(b);
+            let o = b.observables();
+            let mut row = vec![
+                b.time,
+                o.kinetic_energy(),
+                o.translational_energy,
+                o.rotational_energy,
+                e.potential,
+                o.kinetic_energy() + e.potential,
+            ];
+            row.extend(o.linear_momentum.to_array());
+            row.extend(o.angular_momentum.to_array());
+            if let Some(c) = &contacts {
+                for (_, w) in c.wall_forces() {
+                    row.extend(w.to_array());
+                }
+            }
+            csv.row(&row)?;
+            Ok((o.kinetic_energy(), e.potential))
+        };
+    let frame = |b: &RigidBodies, xyz: &mut XyzWriter| -> Result<(), MdError> {
+        let mut world = super::interaction::WorldFrame::default();
+        world.update(b);
+        let positions: Vec<[f64; 3]> = world.sphere_centre.iter().map(|c| c.to_array()).collect();
+        let velocities: Vec<[f64; 3]> = world
+            .sphere_centre
+            .iter()
+            .zip(&world.sphere_body)
+            .map(|(c, &k)| {
+                let k = k as usize;
+                (b.velocity[k] + b.omega[k].cross(*c - b.position[k])).to_array()
+            })
+            .collect();
+        let (cell, origin) = Frame::bounding_cell(&positions, &world.sphere_radius, 1.0);
+        let fr = Frame {
+            time: b.time,
+            cell,
+            origin,
+            pbc: [false; 3],
+            species: world
+                .sphere_body
+                .iter()
+                .map(|k| format!("B{}", b.kind[*k as usize]))
+                .collect(),
+            positions,
+            velocities,
+            radii: world.sphere_radius.clone(),
+        };
+        xyz.write(&fr)?;
+        Ok(())
+    };
+    let start = Instant::now();
+    sample(b, f, &mut csv)?;
+    if let Some(x) = xyz.as_mut() {
+        frame(b, x)?;
+    }
+    for step in 1..=built.steps {
+        f.step(b, built.dt);
+        if step % every == 0 || step == built.steps {
+            let (ke, _) = sample(b, f, &mut csv)?;
+            if !ke.is_finite() {
+                let i = (0..b.len())
+                    .find(|&i| !b.velocity[i].is_finite() || !b.omega[i].is_finite())
+                    .unwrap_or(0);
+                return Err(MdError::Unstable {
+                    step,
+                    time: b.time,
+                    particle: i,
+                    what: "a non-finite velocity".into(),
+                });
+            }
+            if !quiet {
+                eprintln!(
+                    "step {step}/{} t = {:.6e} KE = {ke:.6e}",
+                    built.steps, b.time
+                );
+            }
+        }
+        if let Some(x) = xyz.as_mut() {
+            if traj_every > 0 && step % traj_every == 0 {
+                frame(b, x)?;
+            }
+        }
+    }
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let e = f.energies(b);
+    let o = b.observables();
+    Ok(Report {
+        bodies: b.len(),
+        spheres: (0..b.len()).map(|i| b.template(i).sphere_count()).sum(),
+        steps: built.steps,
+        time: b.time,
+        wall_seconds,
+        kinetic_energy: o.kinetic_energy(),
+        potential_energy: e.potential,
+        linear_momentum: o.linear_momentum,
+        angular_momentum: o.angular_momentum,
+        wall_forces: contacts.map(|c| c.wall_forces()).unwrap_or_default(),
+        files,
+    })
+}

@@ -1,0 +1,123 @@
+//! The `[rigid]` scene format: the examples parse and build, the magnet
+//! example runs and keeps its momentum, errors carry `file:line`, and an
+//! ignored test runs any scene named by `MOTE_RIGID_SCENE` (for examples
+//! and benchmarks before `mote run` routes to the runner).
+
+use std::path::Path;
+
+use mote_md::rigid::scene::{is_rigid_scene, run_rigid_scene, RigidScene};
+
+fn example(name: &str) -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/rigid")
+        .join(name);
+    std::fs::read_to_string(p).unwrap()
+}
+
+#[test]
+fn examples_build() {
+    for name in [
+        "magnet-in-field.toml",
+        "clumps-settling.toml",
+        "chains-rotating-field.toml",
+    ] {
+        let text = example(name);
+        assert!(is_rigid_scene(&text));
+        let scene = RigidScene::parse(&text, name).unwrap_or_else(|e| panic!("{e}"));
+        let built = scene
+            .build(&text, name, None)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(!built.bodies.is_empty());
+    }
+    let bench = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench/clump.toml"),
+    )
+    .unwrap();
+    let built = RigidScene::parse(&bench, "clump.toml")
+        .unwrap()
+        .build(&bench, "clump.toml", None)
+        .unwrap();
+    assert_eq!(built.bodies.len(), 4608);
+}
+
+#[test]
+fn magnet_example_runs() {
+    let text = example("magnet-in-field.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let r = run_rigid_scene(&text, "magnet-in-field.toml", None, Some(dir.path()), true).unwrap();
+    assert_eq!(r.steps, 20000);
+    assert!((r.time - 200.0).abs() < 1e-9);
+    let table = mote_io::csv::read_table(&dir.path().join("observables.csv")).unwrap();
+    let e = table.column("total_energy").unwrap();
+    let px = table.column("px").unwrap();
+    let ly = table.column("ly").unwrap();
+    let spread = |v: &[f64]| {
+        v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)
+    };
+    println!(
+        "energy spread {:e} px spread {:e} ly spread {:e}",
+        spread(&e),
+        spread(&px),
+        spread(&ly)
+    );
+    assert!(spread(&px) < 1e-13);
+    assert!(spread(&ly) < 1e-10);
+    assert!(spread(&e) < 1e-2 * e[0].abs().max(1.0));
+}
+
+#[test]
+fn errors_name_the_line() {
+    let text = "seed = 1\n[rigid]\n[[rigid.template]]\nname = \"a\"\ngenerator = \"sphere\"\nradius = 1.0\ndensity = 1.0\n\n[[rigid.body]]\ntemplate = \"b\"\nposition = [0, 0, 0]\n\n[run]\ndt = 0.1\nsteps = 1\n";
+    let e = RigidScene::parse(text, "s.toml")
+        .unwrap()
+        .build(text, "s.toml", None)
+        .err()
+        .unwrap();
+    assert_eq!(e.line, 9, "{e}");
+    assert!(e.to_string().starts_with("s.toml:9:"), "{e}");
+    let bad = text.replace("density = 1.0", "density = 1.0\ncolour = 3");
+    let e = RigidScene::parse(&bad, "s.toml").err().unwrap();
+    assert_eq!(e.line, 8, "{e}");
+    let walls = text
+        .replace("template = \"b\"", "template = \"a\"")
+        .replace(
+            "[run]",
+            "[[rigid.wall]]\nkind = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 1]\n\n[run]",
+        );
+    let e = RigidScene::parse(&walls, "s.toml")
+        .unwrap()
+        .build(&walls, "s.toml", None)
+        .err()
+        .unwrap();
+    assert_eq!(e.line, 13, "{e}");
+}
+
+/// `MOTE_RIGID_SCENE=file [MOTE_RIGID_OUT=dir] cargo test --release --test
+/// rigid_scene run_scene_file -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn run_scene_file() {
+    let Ok(path) = std::env::var("MOTE_RIGID_SCENE") else {
+        return;
+    };
+    let text = std::fs::read_to_string(&path).unwrap();
+    let out = std::env::var("MOTE_RIGID_OUT").ok();
+    let r = run_rigid_scene(&text, &path, None, out.as_deref().map(Path::new), true)
+        .unwrap_or_else(|e| panic!("{e}"));
+    println!(
+        "{} bodies, {} spheres, {} steps, t = {}, {:.3} s wall, {:.4} µs per body-step\nKE {:e} PE {:e} P {} L {}",
+        r.bodies,
+        r.spheres,
+        r.steps,
+        r.time,
+        r.wall_seconds,
+        r.wall_seconds * 1e6 / (r.bodies as f64 * r.steps as f64),
+        r.kinetic_energy,
+        r.potential_energy,
+        r.linear_momentum,
+        r.angular_momentum
+    );
+    for (name, f) in r.wall_forces {
+        println!("wall {name}: {f}");
+    }
+}

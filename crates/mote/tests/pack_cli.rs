@@ -1,0 +1,142 @@
+//! `mote pack` and `mote pack analyse` from the command line: outputs, the
+//! summary, and errors for bad input.
+
+use std::process::Command;
+
+fn mote() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_mote"))
+}
+
+#[test]
+fn packs_writes_and_analyses() {
+    let dir = tempfile::tempdir().unwrap();
+    let xyz = dir.path().join("packing.xyz");
+    let out = mote()
+        .args([
+            "pack",
+            "--n",
+            "300",
+            "--rate",
+            "0.3",
+            "--seed",
+            "2",
+            "--max-pressure",
+            "1e7",
+            "-o",
+        ])
+        .arg(&xyz)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("300 spheres: phi = 0.6"), "{text}");
+    assert!(text.contains("stopped because the reduced pressure passed"));
+    assert!(text.contains("No overlaps"), "{text}");
+    assert!(text.contains("rattlers"));
+    // the three files, with provenance
+    let x = std::fs::read_to_string(&xyz).unwrap();
+    assert!(x.starts_with("300\n") && x.contains("radius:R:1") && x.contains("seed=2"));
+    let csv = std::fs::read_to_string(dir.path().join("packing.csv")).unwrap();
+    assert!(csv.starts_with("# program=") && csv.contains("collisions,time,phi,pressure"));
+    let last: Vec<f64> = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(last[3] > 1e7, "final pressure {}", last[3]);
+    let pov = std::fs::read_to_string(dir.path().join("packing.pov")).unwrap();
+    assert!(pov.contains("sphere"));
+    // analyse reads it back: same φ as the summary printed
+    let out = mote()
+        .args(["pack", "analyse"])
+        .arg(&xyz)
+        .arg("--gr")
+        .arg(dir.path().join("gr.csv"))
+        .output()
+        .unwrap();
+    let a = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{a}");
+    let phi_summary = text.split("phi = ").nth(1).unwrap()[..6].to_string();
+    assert!(
+        a.contains(&format!("packing fraction      {phi_summary}")),
+        "{a}\n{text}"
+    );
+    assert!(a.contains("Q6"));
+    let gr = std::fs::read_to_string(dir.path().join("gr.csv")).unwrap();
+    assert!(gr.lines().count() > 100);
+}
+
+#[test]
+fn disks_with_a_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("p.png");
+    let out = mote()
+        .args([
+            "pack",
+            "--dim",
+            "2",
+            "--n",
+            "200",
+            "--dist",
+            "bi:1.4:0.5",
+            "--rate",
+            "0.3",
+            "--max-pressure",
+            "1e6",
+            "--no-jam",
+            "--seed",
+            "1",
+            "--picture",
+        ])
+        .arg(&png)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("200 disks"), "{text}");
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let radii = dir.path().join("radii.txt");
+    std::fs::write(&radii, "# radii\n0.5\n0.6\nabc\n").unwrap();
+    let out = mote()
+        .args(["pack", "--dist"])
+        .arg(format!("file:{}", radii.display()))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("radii.txt:4: `abc` is not a number"), "{err}");
+    assert!(!err.contains("panicked"));
+    for args in [
+        vec!["pack", "--dist", "gauss:1"],
+        vec!["pack", "--rate", "-1"],
+        vec!["pack", "--dim", "4"],
+        vec!["pack", "--walls", "q"],
+        vec!["pack", "--n", "10"],
+        vec!["pack", "analyse", "/nonexistent/file.xyz"],
+    ] {
+        let out = mote().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(!err.trim().is_empty(), "{args:?}");
+    }
+    let out = mote().args(["pack", "--help"]).output().unwrap();
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("--rate"));
+}
