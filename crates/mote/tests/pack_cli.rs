@@ -10,7 +10,8 @@ fn mote() -> Command {
 #[test]
 fn packs_writes_and_analyses() {
     let dir = tempfile::tempdir().unwrap();
-    let xyz = dir.path().join("packing.xyz");
+    // The output folder does not exist yet: mote pack makes it.
+    let xyz = dir.path().join("out/packing.xyz");
     let out = mote()
         .args([
             "pack",
@@ -40,7 +41,7 @@ fn packs_writes_and_analyses() {
     // the three files, with provenance
     let x = std::fs::read_to_string(&xyz).unwrap();
     assert!(x.starts_with("300\n") && x.contains("radius:R:1") && x.contains("seed=2"));
-    let csv = std::fs::read_to_string(dir.path().join("packing.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("out/packing.csv")).unwrap();
     assert!(csv.starts_with("# program=") && csv.contains("collisions,time,phi,pressure"));
     let last: Vec<f64> = csv
         .lines()
@@ -50,7 +51,7 @@ fn packs_writes_and_analyses() {
         .map(|v| v.parse().unwrap())
         .collect();
     assert!(last[3] > 1e7, "final pressure {}", last[3]);
-    let pov = std::fs::read_to_string(dir.path().join("packing.pov")).unwrap();
+    let pov = std::fs::read_to_string(dir.path().join("out/packing.pov")).unwrap();
     assert!(pov.contains("sphere"));
     // analyse reads it back: same φ as the summary printed
     let out = mote()

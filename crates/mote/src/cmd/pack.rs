@@ -272,6 +272,12 @@ fn pack_dim<const D: usize>(
     let max_pressure = settings.max_pressure;
     let mut packer = Packer::<D>::new(settings).context("mote pack")?;
     let stem = a.output.as_ref().map(|p| p.with_extension(""));
+    if let Some(dir) = a.output.as_ref().and_then(|p| p.parent()) {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create the folder {}", dir.display()))?;
+        }
+    }
     let mut csv = match &stem {
         Some(s) => {
             let path = s.with_extension("csv");
