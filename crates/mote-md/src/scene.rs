@@ -1166,7 +1166,7 @@ impl Scene {
                 wall_law.adhesion = v.adhesion;
                 let mut walls = Vec::new();
                 for (k, w) in self.wall.iter().enumerate() {
-                    walls.extend(wall_of(w.get_ref(), k).map_err(|m| err(w.span(), m))?);
+                    walls.extend(w.get_ref().walls(k).map_err(|m| err(w.span(), m))?);
                 }
                 forces.push(GranularWalls::new(wall_law, walls, &radius));
             }
@@ -1390,47 +1390,51 @@ impl Scene {
     }
 }
 
-/// The walls a `[[wall]]` table makes (a box makes six).
-fn wall_of(w: &WallSpec, index: usize) -> Result<Vec<Wall>, String> {
-    let name = w.name.clone().unwrap_or_else(|| format!("wall{index}"));
-    let need = |v: Option<[f64; 3]>, key: &str| -> Result<DVec3, String> {
-        v.map(DVec3::from)
-            .ok_or_else(|| format!("a {} wall needs `{key}`", w.kind))
-    };
-    let mut walls = match w.kind.as_str() {
-        "plane" => {
-            let normal = need(w.normal, "normal")?;
-            if normal.length() == 0.0 {
-                return Err("the plane's normal must not be zero".into());
+impl WallSpec {
+    /// The walls this table makes (a box makes six); `index` names an
+    /// unnamed wall `wall<index>`.
+    pub fn walls(&self, index: usize) -> Result<Vec<Wall>, String> {
+        let w = self;
+        let name = w.name.clone().unwrap_or_else(|| format!("wall{index}"));
+        let need = |v: Option<[f64; 3]>, key: &str| -> Result<DVec3, String> {
+            v.map(DVec3::from)
+                .ok_or_else(|| format!("a {} wall needs `{key}`", w.kind))
+        };
+        let mut walls = match w.kind.as_str() {
+            "plane" => {
+                let normal = need(w.normal, "normal")?;
+                if normal.length() == 0.0 {
+                    return Err("the plane's normal must not be zero".into());
+                }
+                vec![Wall::plane(&name, need(w.point, "point")?, normal)]
             }
-            vec![Wall::plane(&name, need(w.point, "point")?, normal)]
-        }
-        "box" => {
-            let (lo, hi) = (need(w.lo, "lo")?, need(w.hi, "hi")?);
-            if (0..3).any(|k| hi[k] <= lo[k]) {
-                return Err("a box wall needs lo < hi on every axis".into());
+            "box" => {
+                let (lo, hi) = (need(w.lo, "lo")?, need(w.hi, "hi")?);
+                if (0..3).any(|k| hi[k] <= lo[k]) {
+                    return Err("a box wall needs lo < hi on every axis".into());
+                }
+                Wall::closed_box(&name, lo, hi)
             }
-            Wall::closed_box(&name, lo, hi)
-        }
-        "cylinder" => {
-            let axis = need(w.axis, "axis")?;
-            let radius = w.radius.ok_or("a cylinder wall needs `radius`")?;
-            if axis.length() == 0.0 || radius.is_nan() || radius <= 0.0 {
-                return Err("a cylinder needs a non-zero axis and radius > 0".into());
+            "cylinder" => {
+                let axis = need(w.axis, "axis")?;
+                let radius = w.radius.ok_or("a cylinder wall needs `radius`")?;
+                if axis.length() == 0.0 || radius.is_nan() || radius <= 0.0 {
+                    return Err("a cylinder needs a non-zero axis and radius > 0".into());
+                }
+                vec![Wall::cylinder(&name, need(w.point, "point")?, axis, radius)]
             }
-            vec![Wall::cylinder(&name, need(w.point, "point")?, axis, radius)]
+            other => {
+                return Err(format!(
+                    "unknown wall kind '{other}': expected plane, box or cylinder"
+                ))
+            }
+        };
+        for wall in &mut walls {
+            wall.velocity = DVec3::from(w.velocity);
+            wall.angular_speed = w.angular_speed;
         }
-        other => {
-            return Err(format!(
-                "unknown wall kind '{other}': expected plane, box or cylinder"
-            ))
-        }
-    };
-    for wall in &mut walls {
-        wall.velocity = DVec3::from(w.velocity);
-        wall.angular_speed = w.angular_speed;
+        Ok(walls)
     }
-    Ok(walls)
 }
 
 /// Which MPPphys model a particle file is run with.

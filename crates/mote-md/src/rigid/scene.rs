@@ -93,7 +93,7 @@ use super::sources::{AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Grav
 use super::template::{BodyTemplate, ClumpSpec, Integration};
 use crate::boundary::Boundary;
 use crate::error::MdError;
-use crate::force::granular::{ContactLaw, Damping, Material, Wall};
+use crate::force::granular::{ContactLaw, Damping, Material};
 
 /// A whole rigid scene file.
 #[derive(Debug, Deserialize)]
@@ -130,7 +130,8 @@ pub struct RigidSettings {
     #[serde(default)]
     pub contacts: Option<Spanned<ContactSettings>>,
     #[serde(default)]
-    pub wall: Vec<Spanned<WallSpec>>,
+    /// `[[rigid.wall]]`: the keys of the granular `[[wall]]`.
+    pub wall: Vec<Spanned<crate::scene::WallSpec>>,
 }
 
 /// `[[rigid.template]]`.
@@ -290,31 +291,6 @@ pub struct ContactSettings {
 
 fn default_poisson() -> f64 {
     0.3
-}
-
-/// `[[rigid.wall]]`: the keys of the granular `[[wall]]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct WallSpec {
-    pub kind: String,
-    #[serde(default)]
-    pub name: Option<String>,
-    #[serde(default)]
-    pub point: Option<[f64; 3]>,
-    #[serde(default)]
-    pub normal: Option<[f64; 3]>,
-    #[serde(default)]
-    pub lo: Option<[f64; 3]>,
-    #[serde(default)]
-    pub hi: Option<[f64; 3]>,
-    #[serde(default)]
-    pub axis: Option<[f64; 3]>,
-    #[serde(default)]
-    pub radius: Option<f64>,
-    #[serde(default)]
-    pub velocity: [f64; 3],
-    #[serde(default)]
-    pub angular_speed: f64,
 }
 
 /// `[run]`.
@@ -610,7 +586,7 @@ impl RigidScene {
         // Contacts and walls.
         let mut walls = Vec::new();
         for (k, w) in rigid.wall.iter().enumerate() {
-            walls.extend(wall_of(w.get_ref(), k).map_err(|m| err(w.span(), m))?);
+            walls.extend(w.get_ref().walls(k).map_err(|m| err(w.span(), m))?);
         }
         let mut contacts = None;
         match contact {
@@ -786,48 +762,6 @@ fn template_spec(
     spec.charge = ts.charge;
     spec.dipole = DVec3::from(ts.dipole);
     Ok(spec)
-}
-
-fn wall_of(w: &WallSpec, index: usize) -> Result<Vec<Wall>, String> {
-    let name = w.name.clone().unwrap_or_else(|| format!("wall{index}"));
-    let need = |v: Option<[f64; 3]>, key: &str| -> Result<DVec3, String> {
-        v.map(DVec3::from)
-            .ok_or_else(|| format!("a {} wall needs `{key}`", w.kind))
-    };
-    let mut walls = match w.kind.as_str() {
-        "plane" => {
-            let normal = need(w.normal, "normal")?;
-            if normal.length() == 0.0 {
-                return Err("the plane's normal must not be zero".into());
-            }
-            vec![Wall::plane(&name, need(w.point, "point")?, normal)]
-        }
-        "box" => {
-            let (lo, hi) = (need(w.lo, "lo")?, need(w.hi, "hi")?);
-            if (0..3).any(|k| hi[k] <= lo[k]) {
-                return Err("a box wall needs lo < hi on every axis".into());
-            }
-            Wall::closed_box(&name, lo, hi)
-        }
-        "cylinder" => {
-            let axis = need(w.axis, "axis")?;
-            let radius = w.radius.ok_or("a cylinder wall needs `radius`")?;
-            if axis.length() == 0.0 || !positive(radius) {
-                return Err("a cylinder needs a non-zero axis and radius > 0".into());
-            }
-            vec![Wall::cylinder(&name, need(w.point, "point")?, axis, radius)]
-        }
-        other => {
-            return Err(format!(
-                "unknown wall kind '{other}': expected plane, box or cylinder"
-            ))
-        }
-    };
-    for wall in &mut walls {
-        wall.velocity = DVec3::from(w.velocity);
-        wall.angular_speed = w.angular_speed;
-    }
-    Ok(walls)
 }
 
 /// x > 0 (false for NaN).
