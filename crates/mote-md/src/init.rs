@@ -273,7 +273,7 @@ pub fn fcc(
 
 /// A cloud of non-overlapping spheres in the box [min, max] by random
 /// sequential addition (as Yade's `makeCloud`): radii uniform in
-/// r (1 ± spread), each sphere tried at up to `attempts` random places and
+/// r (1 ± spread), each sphere tried at up to 20 000 random places and
 /// kept where it overlaps nothing. Returns fewer than `n` spheres if the box
 /// is too full; the caller reports that.
 pub fn cloud(
@@ -294,7 +294,7 @@ pub fn cloud(
         [0, 1, 2].map(|k| (((x[k] - min[k]) / span[k] * dims[k] as f64) as usize).min(dims[k] - 1))
     };
     let mut placed: Vec<ParticleInit> = Vec::with_capacity(n);
-    const ATTEMPTS: usize = 1000;
+    const ATTEMPTS: usize = 20_000;
     for _ in 0..n {
         let r = radius * (1.0 + spread * (2.0 * rng.gen::<f64>() - 1.0));
         let lo = min + DVec3::splat(r);
