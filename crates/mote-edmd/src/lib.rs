@@ -12,6 +12,8 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod analyse;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 pub mod init;
 pub mod pack;
 pub mod queue;

@@ -141,6 +141,13 @@ impl EventQueue {
         }
     }
 
+    /// Removes the earliest entry, which the caller has just had from
+    /// [`EventQueue::min`] and must file anew with [`EventQueue::update`].
+    #[inline]
+    pub fn pop(&mut self) {
+        self.heap.pop();
+    }
+
     /// Moves to the next non-empty block; false if there are no events.
     fn advance(&mut self) -> bool {
         let nb = self.buckets.len() as i64;

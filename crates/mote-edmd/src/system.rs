@@ -72,7 +72,7 @@ struct Event {
     axis: u8,
     up: bool,
     /// The partner's collision counter when the event was predicted.
-    partner_count: u64,
+    partner_count: u32,
 }
 
 const NO_EVENT: Event = Event {
@@ -135,6 +135,11 @@ struct Particle<const D: usize> {
     r: f64,
 }
 
+// The AVX-512 scan loads a record as one line of eight doubles:
+// x (D), v (D), t, r.
+const _: () = assert!(std::mem::size_of::<Particle<2>>() == 64);
+const _: () = assert!(std::mem::size_of::<Particle<3>>() == 64);
+
 /// Running totals since the last [`System::reset_counters`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Counters {
@@ -168,15 +173,23 @@ pub struct System<const D: usize> {
     /// Caller's index of internal particle k, and internal index of caller's i.
     id: Vec<u32>,
     slot: Vec<u32>,
-    count: Vec<u64>,
+    /// Collisions (and other velocity changes) of each particle, wrapping:
+    /// an event is stale when its partner's count moved on.
+    count: Vec<u32>,
     // cells
     ncell: [usize; D],
     cwidth: [f64; D],
     stride: [usize; D],
     cidx: Vec<[u32; D]>,
-    head: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
+    /// Cell f holds `cell_len[f]` particles in slots `f·ccap ..`: their
+    /// list positions (copies of `xn`, so a scan reads one contiguous run
+    /// per cell instead of chasing a linked list) and internal indices.
+    cell_pos: Vec<ListPos<D>>,
+    cell_id: Vec<u32>,
+    cell_len: Vec<u32>,
+    ccap: usize,
+    /// Slot of each particle within its cell.
+    at: Vec<u32>,
     offsets: Vec<[i32; D]>,
     // neighbour lists: row i of `nbr` (capacity `cap`) holds nn[i] entries
     /// Where each particle built its neighbour list, with its radius.
@@ -197,6 +210,8 @@ pub struct System<const D: usize> {
     horizon: f64,
     /// r_i(horizon)/r_i(0): lists are built for radii R_i = r_i(0)·factor.
     list_factor: f64,
+    /// Scan neighbour lists with AVX-512 (same results as the scalar loop).
+    simd: bool,
 }
 
 /// Time until two particles at relative position `r` with relative velocity
@@ -208,20 +223,7 @@ pub struct System<const D: usize> {
 /// computed as `c / (−b + √(b² − ac))`, which has no cancellation for b < 0.
 #[inline]
 pub fn pair_time<const D: usize>(r: &[f64; D], v: &[f64; D], sigma: f64) -> f64 {
-    let b = dot(r, v);
-    if b >= 0.0 {
-        return f64::INFINITY;
-    }
-    let c = dot(r, r) - sigma * sigma;
-    if c <= 0.0 {
-        return 0.0;
-    }
-    let a = dot(v, v);
-    let disc = b * b - a * c;
-    if disc < 0.0 {
-        return f64::INFINITY;
-    }
-    c / (-b + disc.sqrt())
+    approach_root(dot(v, v), dot(r, v), dot(r, r) - sigma * sigma)
 }
 
 /// Time until a pair at relative position `r`, relative velocity `v` and
@@ -237,13 +239,12 @@ pub fn growing_pair_time<const D: usize>(r: &[f64; D], v: &[f64; D], sigma: f64,
     let b = dot(r, v) - sigma * s;
     let a = dot(v, v) - s * s;
     let c = dot(r, r) - sigma * sigma;
-    growing_root(a, b, c, f64::INFINITY)
+    growing_root(a, b, c)
 }
 
-/// The root of [`growing_pair_time`] from its coefficients; +∞ when it
-/// cannot come before `best`.
+/// The root of [`growing_pair_time`] from its coefficients A, B, C.
 #[inline(always)]
-fn growing_root(a: f64, b: f64, c: f64, best: f64) -> f64 {
+fn growing_root(a: f64, b: f64, c: f64) -> f64 {
     if c <= 0.0 {
         return if b < 0.0 {
             0.0
@@ -255,18 +256,42 @@ fn growing_root(a: f64, b: f64, c: f64, best: f64) -> f64 {
             f64::INFINITY
         };
     }
-    if b >= 0.0 && a >= 0.0 {
-        return f64::INFINITY;
-    }
-    // for a ≥ 0 the root is ≥ c/(−2b): cannot beat the current best
-    if a >= 0.0 && c >= -2.0 * b * best {
-        return f64::INFINITY;
-    }
     let disc = b * b - a * c;
-    if disc < 0.0 {
-        return f64::INFINITY;
+    let root = c / (-b + disc.max(0.0).sqrt());
+    if (b < 0.0 || a < 0.0) && disc >= 0.0 {
+        root
+    } else {
+        f64::INFINITY
     }
-    c / (-b + disc.sqrt())
+}
+
+/// The contact time of [`pair_time`] from a = v·v, b = r·v, c = r·r − σ²,
+/// written without branches (selects only), so that a loop over
+/// neighbours runs without mispredictions: +∞ unless approaching (b < 0)
+/// with a real root; 0 when approaching inside contact (Bannerman et al.).
+#[inline(always)]
+fn approach_root(a: f64, b: f64, c: f64) -> f64 {
+    let disc = b * b - a * c;
+    let root = c / (-b + disc.max(0.0).sqrt());
+    let t = if c <= 0.0 { 0.0 } else { root };
+    if b < 0.0 && disc >= 0.0 {
+        t
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Whether the AVX-512 neighbour scan runs here (x86-64 with AVX-512F, and
+/// a record of at most eight doubles).
+fn simd_available<const D: usize>() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        2 * D + 2 <= 8 && crate::avx512::available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
 }
 
 impl<const D: usize> System<D> {
@@ -471,9 +496,17 @@ impl<const D: usize> System<D> {
             cwidth,
             stride,
             cidx: vec![[0; D]; n],
-            head: vec![NONE; tot],
-            next: vec![NONE; n],
-            prev: vec![NONE; n],
+            cell_pos: vec![
+                ListPos {
+                    x: [0.0; D],
+                    r: 0.0
+                };
+                tot * 8
+            ],
+            cell_id: vec![NONE; tot * 8],
+            cell_len: vec![0; tot],
+            ccap: 8,
+            at: vec![0; n],
             offsets,
             xn: vec![
                 ListPos {
@@ -494,6 +527,7 @@ impl<const D: usize> System<D> {
             growth,
             horizon,
             list_factor: g_end,
+            simd: simd_available::<D>(),
         };
         for i in 0..n {
             for d in 0..D {
@@ -599,30 +633,56 @@ impl<const D: usize> System<D> {
         f
     }
 
+    /// Puts particle `i` (with its list position `xn[i]`) into cell `cidx[i]`.
     #[inline]
     fn insert(&mut self, i: usize) {
         let f = self.flat(&self.cidx[i]);
-        let h = self.head[f];
-        self.next[i] = h;
-        self.prev[i] = NONE;
-        if h != NONE {
-            self.prev[h as usize] = i as u32;
+        if self.cell_len[f] as usize == self.ccap {
+            self.grow_cells();
         }
-        self.head[f] = i as u32;
+        let k = self.cell_len[f] as usize;
+        self.cell_pos[f * self.ccap + k] = self.xn[i];
+        self.cell_id[f * self.ccap + k] = i as u32;
+        self.at[i] = k as u32;
+        self.cell_len[f] += 1;
     }
 
+    /// Takes particle `i` out of cell `cidx[i]` (the cell's last entry
+    /// fills the hole).
     #[inline]
     fn remove(&mut self, i: usize) {
-        let (p, nx) = (self.prev[i], self.next[i]);
-        if p != NONE {
-            self.next[p as usize] = nx;
-        } else {
-            let f = self.flat(&self.cidx[i]);
-            self.head[f] = nx;
+        let f = self.flat(&self.cidx[i]);
+        let base = f * self.ccap;
+        let k = self.at[i] as usize;
+        let last = self.cell_len[f] as usize - 1;
+        let moved = self.cell_id[base + last];
+        self.cell_pos[base + k] = self.cell_pos[base + last];
+        self.cell_id[base + k] = moved;
+        self.at[moved as usize] = k as u32;
+        self.cell_len[f] -= 1;
+    }
+
+    /// Doubles the slots per cell.
+    fn grow_cells(&mut self) {
+        let cap = 2 * self.ccap;
+        let cells = self.cell_len.len();
+        let mut pos = vec![
+            ListPos {
+                x: [0.0; D],
+                r: 0.0
+            };
+            cells * cap
+        ];
+        let mut id = vec![NONE; cells * cap];
+        for f in 0..cells {
+            let k = self.cell_len[f] as usize;
+            let old = f * self.ccap;
+            pos[f * cap..f * cap + k].copy_from_slice(&self.cell_pos[old..old + k]);
+            id[f * cap..f * cap + k].copy_from_slice(&self.cell_id[old..old + k]);
         }
-        if nx != NONE {
-            self.prev[nx as usize] = p;
-        }
+        self.cell_pos = pos;
+        self.cell_id = id;
+        self.ccap = cap;
     }
 
     // ----- accessors -----------------------------------------------------
@@ -869,8 +929,8 @@ impl<const D: usize> System<D> {
                 let Some(cc) = self.neighbour_cell(&ci, off) else {
                     continue;
                 };
-                let mut j = self.head[self.flat(&cc)];
-                while j != NONE {
+                let f = self.flat(&cc);
+                for &j in &self.cell_id[f * self.ccap..f * self.ccap + self.cell_len[f] as usize] {
                     let ju = j as usize;
                     if ju > i {
                         let r = self.sep_int(i, ju);
@@ -881,7 +941,6 @@ impl<const D: usize> System<D> {
                             return Some((a.min(b), a.max(b), dist / s - 1.0));
                         }
                     }
-                    j = self.next[ju];
                 }
             }
         }
@@ -922,14 +981,17 @@ impl<const D: usize> System<D> {
     /// growing radii.
     #[inline(always)]
     fn predict_with<const GROW: bool>(&mut self, i: usize) {
-        self.advance(i);
-        let Particle {
-            x: xi,
-            v: vi,
-            r: ri,
-            ..
-        } = self.p[i];
+        // advance i to now, keeping its data in registers (reading the
+        // record back right after storing it would stall on the store)
         let now = self.now;
+        let (vi, ti, ri) = (self.p[i].v, self.p[i].t, self.p[i].r);
+        let xi = if now != ti {
+            add_scaled(&self.p[i].x, &vi, now - ti)
+        } else {
+            self.p[i].x
+        };
+        self.p[i].x = xi;
+        self.p[i].t = now;
         let (g, delta) = if GROW {
             (1.0 + self.growth * now, self.growth)
         } else {
@@ -995,12 +1057,48 @@ impl<const D: usize> System<D> {
         let size = self.simbox.size;
         let periodic = self.simbox.boundary.map(|b| b == Boundary::Periodic);
         let half = size.map(|l| 0.5 * l);
+        let nn = self.nn[i] as usize;
         // The neighbours' data are scattered in memory: ask for all of them
         // first so the cache misses overlap instead of queueing.
-        for k in 0..self.nn[i] as usize {
+        for k in 0..nn {
             prefetch(&self.p[self.nbr[base + k] as usize]);
         }
-        for k in 0..self.nn[i] as usize {
+        #[cfg(target_arch = "x86_64")]
+        if self.simd {
+            let probe = crate::avx512::Probe {
+                x: xi,
+                v: vi,
+                r: ri,
+                now,
+                size,
+                half,
+                periodic,
+                g,
+                delta,
+            };
+            // SAFETY: `simd` is set only where AVX-512F exists; list entries
+            // and `i` index `p`, whose records are 64-byte lines of 8 doubles.
+            let (t, k) = unsafe {
+                crate::avx512::earliest::<D, GROW>(
+                    self.p.as_ptr() as *const f64,
+                    i,
+                    &self.nbr[base..base + nn],
+                    &probe,
+                )
+            };
+            if let Some(k) = k {
+                if t < best {
+                    best = t;
+                    partner = self.nbr[base + k];
+                }
+            }
+            return self.schedule(i, best, ev, partner);
+        }
+        // Branch-free: every listed pair's time is computed (no early outs,
+        // whose outcome is a coin toss for the branch predictor and which
+        // chain each pair's test to the previous pair's division) and the
+        // earliest kept by selects; ties go to the first in the list.
+        for k in 0..nn {
             let j = self.nbr[base + k];
             let pj = &self.p[j as usize];
             let dtj = now - pj.t;
@@ -1012,11 +1110,9 @@ impl<const D: usize> System<D> {
             }
             for d in 0..D {
                 if periodic[d] {
-                    if r[d] > half[d] {
-                        r[d] -= size[d];
-                    } else if r[d] < -half[d] {
-                        r[d] += size[d];
-                    }
+                    let up = if r[d] > half[d] { size[d] } else { 0.0 };
+                    let down = if r[d] < -half[d] { size[d] } else { 0.0 };
+                    r[d] = r[d] - up + down;
                 }
             }
             let dt = if GROW {
@@ -1025,39 +1121,25 @@ impl<const D: usize> System<D> {
                 let b = dot(&r, &v) - sigma * sdot;
                 let av = dot(&v, &v) - sdot * sdot;
                 let c = dot(&r, &r) - sigma * sigma;
-                let t = growing_root(av, b, c, best);
-                if t == f64::INFINITY {
-                    continue;
-                }
-                t
+                growing_root(av, b, c)
             } else {
-                // Bannerman et al.: approaching pairs only; overlapping ones now
-                let b = dot(&r, &v);
-                if b >= 0.0 {
-                    continue;
-                }
-                let sigma = ri + pj.r;
-                let c = dot(&r, &r) - sigma * sigma;
-                if c <= 0.0 {
-                    0.0
-                } else {
-                    // t ≥ c/(−2b): cannot beat the current best
-                    if c >= -2.0 * b * best {
-                        continue;
-                    }
-                    let av = dot(&v, &v);
-                    let disc = b * b - av * c;
-                    if disc < 0.0 {
-                        continue;
-                    }
-                    c / (-b + disc.sqrt())
-                }
+                approach_root(
+                    dot(&v, &v),
+                    dot(&r, &v),
+                    dot(&r, &r) - (ri + pj.r) * (ri + pj.r),
+                )
             };
-            if dt < best {
-                best = dt;
-                partner = j;
-            }
+            let earlier = dt < best;
+            best = if earlier { dt } else { best };
+            partner = if earlier { j } else { partner };
         }
+        self.schedule(i, best, ev, partner)
+    }
+
+    /// Files the event `ev` of `i` (a collision with `partner` if that is
+    /// not `NONE`) at `now + dt`.
+    #[inline(always)]
+    fn schedule(&mut self, i: usize, dt: f64, mut ev: Event, partner: u32) {
         if partner != NONE {
             ev = Event {
                 kind: Kind::Collision,
@@ -1068,7 +1150,14 @@ impl<const D: usize> System<D> {
             };
         }
         self.events[i] = ev;
-        self.queue.update(i, now + best);
+        self.queue.update(i, self.now + dt);
+    }
+
+    /// Turns the AVX-512 neighbour scan off or back on (where the CPU has
+    /// it); results do not change, only speed. For tests and timings.
+    #[doc(hidden)]
+    pub fn set_simd(&mut self, on: bool) {
+        self.simd = on && simd_available::<D>();
     }
 
     /// Adds to the lists of `i` (and symmetrically to theirs) every particle
@@ -1078,19 +1167,30 @@ impl<const D: usize> System<D> {
         let ci = self.cidx[i];
         let xi = self.xn[i].x;
         let ri = self.xn[i].r;
+        for off in &self.offsets {
+            if let Some(cc) = self.neighbour_cell(&ci, off) {
+                let base = self.flat(&cc) * self.ccap;
+                prefetch(&self.cell_pos[base]);
+                prefetch(&self.cell_pos[base + 2]);
+                prefetch(&self.cell_id[base]);
+            }
+        }
+        let periodic = self.simbox.boundary.map(|b| b == Boundary::Periodic);
         for o in 0..self.offsets.len() {
             let off = self.offsets[o];
             let Some(cc) = self.neighbour_cell(&ci, &off) else {
                 continue;
             };
-            let mut j = self.head[self.flat(&cc)];
-            while j != NONE {
+            let f = self.flat(&cc);
+            let base = f * self.ccap;
+            for slot in base..base + self.cell_len[f] as usize {
+                let j = self.cell_id[slot];
                 let ju = j as usize;
                 if ju != i && (!only_greater || ju > i) {
-                    let ListPos { x: xj, r: rj } = self.xn[ju];
+                    let ListPos { x: xj, r: rj } = self.cell_pos[slot];
                     let mut r = sub(&xi, &xj);
                     for (d, rd) in r.iter_mut().enumerate() {
-                        if self.simbox.boundary[d] == Boundary::Periodic {
+                        if periodic[d] {
                             let l = self.simbox.size[d];
                             if *rd > 0.5 * l {
                                 *rd -= l;
@@ -1111,7 +1211,6 @@ impl<const D: usize> System<D> {
                         self.nn[ju] += 1;
                     }
                 }
-                j = self.next[ju];
             }
         }
     }
@@ -1151,6 +1250,9 @@ impl<const D: usize> System<D> {
         self.insert(i);
         let cap = self.cap;
         for k in 0..self.nn[i] as usize {
+            prefetch(&self.nbr[self.nbr[i * cap + k] as usize * cap]);
+        }
+        for k in 0..self.nn[i] as usize {
             let j = self.nbr[i * cap + k] as usize;
             let row = &mut self.nbr[j * cap..j * cap + self.nn[j] as usize];
             if let Some(pos) = row.iter().position(|&x| x as usize == i) {
@@ -1175,6 +1277,16 @@ impl<const D: usize> System<D> {
             return false;
         }
         self.now = t;
+        // Every branch below files a new event for i; take the old one out
+        // now and look up the event after it, so that its particle's data
+        // are fetched while this event is worked on.
+        self.queue.pop();
+        let next = self.queue.min().map(|(_, k)| k);
+        if let Some(k) = next {
+            prefetch(&self.events[k]);
+            prefetch(&self.p[k]);
+            prefetch(&self.nbr[k * self.cap]);
+        }
         let ev = self.events[i];
         match ev.kind {
             Kind::None => {
@@ -1208,9 +1320,19 @@ impl<const D: usize> System<D> {
                     self.p[i].v[d] = v - 2.0 * u;
                     self.counters.wall_hits += 1;
                     self.counters.wall_impulse_sum += 2.0 * self.mass[i] * u.abs();
-                    self.count[i] += 1;
+                    self.count[i] = self.count[i].wrapping_add(1);
                 }
                 self.predict(i);
+            }
+        }
+        // by now the next event itself is in cache: fetch its partner
+        if let Some(k) = next {
+            let e = self.events[k];
+            if e.kind == Kind::Collision {
+                let j = e.partner as usize;
+                prefetch(&self.p[j]);
+                prefetch(&self.count[j]);
+                prefetch(&self.mass[j]);
             }
         }
         true
@@ -1254,8 +1376,8 @@ impl<const D: usize> System<D> {
         }
         self.counters.virial += virial;
         self.counters.collisions += 1;
-        self.count[i] += 1;
-        self.count[j] += 1;
+        self.count[i] = self.count[i].wrapping_add(1);
+        self.count[j] = self.count[j].wrapping_add(1);
     }
 
     /// Runs until time `t_end` (all events up to and including `t_end`),
@@ -1301,7 +1423,7 @@ impl<const D: usize> System<D> {
             for d in 0..D {
                 self.p[i].v[d] *= s;
             }
-            self.count[i] += 1;
+            self.count[i] = self.count[i].wrapping_add(1);
         }
         for i in 0..self.len() {
             self.predict(i);
