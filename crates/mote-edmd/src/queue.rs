@@ -60,8 +60,8 @@ impl EventQueue {
     pub fn new(n: usize, t0: f64, dt: f64) -> Self {
         let nb = (n / 4).clamp(16, 1 << 20);
         Self {
-            time: vec![f64::INFINITY; n],
-            stamp: vec![0; n],
+            time: crate::system::huge_vec(n, f64::INFINITY),
+            stamp: crate::system::huge_vec(n, 0),
             heap: BinaryHeap::new(),
             buckets: vec![Vec::new(); nb],
             overflow: Vec::new(),

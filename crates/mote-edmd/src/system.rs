@@ -97,6 +97,33 @@ fn prefetch<T>(x: &T) {
     let _ = x;
 }
 
+/// `vec![value; n]` in memory the kernel may back with 2 MiB pages (Linux
+/// transparent huge pages, `madvise`): the event loop touches its arrays at
+/// random, and with 4 KiB pages a system of 10⁵–10⁶ particles spends much
+/// of its time on TLB misses. Elsewhere (or if refused) a plain vector.
+pub(crate) fn huge_vec<T: Clone>(n: usize, value: T) -> Vec<T> {
+    let mut v: Vec<T> = Vec::with_capacity(n);
+    #[cfg(target_os = "linux")]
+    {
+        const HUGE: usize = 2 << 20;
+        let bytes = n * std::mem::size_of::<T>();
+        if bytes >= 2 * HUGE {
+            let start = v.as_mut_ptr() as usize;
+            let lo = start.next_multiple_of(HUGE);
+            let hi = (start + bytes) / HUGE * HUGE;
+            if hi > lo {
+                // SAFETY: [lo, hi) lies inside the vector's fresh, untouched
+                // allocation; MADV_HUGEPAGE only changes how it is backed.
+                unsafe {
+                    libc::madvise(lo as *mut libc::c_void, hi - lo, libc::MADV_HUGEPAGE);
+                }
+            }
+        }
+    }
+    v.resize(n, value);
+    v
+}
+
 /// A list-building position and the radius: what a neighbour-list scan reads.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(32))]
@@ -474,16 +501,27 @@ impl<const D: usize> System<D> {
         for (k, &i) in order.iter().enumerate() {
             slot[i] = k as u32;
         }
-        let p = order
-            .iter()
-            .map(|&i| Particle {
+        let mut p = huge_vec(
+            n,
+            Particle {
+                x: [0.0; D],
+                v: [0.0; D],
+                t: 0.0,
+                r: 0.0,
+            },
+        );
+        for (k, &i) in order.iter().enumerate() {
+            p[k] = Particle {
                 x: positions[i],
                 v: velocities[i],
                 t: 0.0,
                 r: radii[i],
-            })
-            .collect();
-        let mass = order.iter().map(|&i| masses[i]).collect();
+            };
+        }
+        let mut mass = huge_vec(n, 0.0);
+        for (k, &i) in order.iter().enumerate() {
+            mass[k] = masses[i];
+        }
         let id = order.iter().map(|&i| i as u32).collect();
         let mut sys = System {
             simbox,
@@ -491,35 +529,35 @@ impl<const D: usize> System<D> {
             mass,
             id,
             slot,
-            count: vec![0; n],
+            count: huge_vec(n, 0),
             ncell,
             cwidth,
             stride,
             cidx: vec![[0; D]; n],
-            cell_pos: vec![
+            cell_pos: huge_vec(
+                tot * 8,
                 ListPos {
                     x: [0.0; D],
-                    r: 0.0
-                };
-                tot * 8
-            ],
-            cell_id: vec![NONE; tot * 8],
+                    r: 0.0,
+                },
+            ),
+            cell_id: huge_vec(tot * 8, NONE),
             cell_len: vec![0; tot],
             ccap: 8,
             at: vec![0; n],
             offsets,
-            xn: vec![
+            xn: huge_vec(
+                n,
                 ListPos {
                     x: [0.0; D],
-                    r: 0.0
-                };
-                n
-            ],
-            nbr: vec![0; n * 16],
+                    r: 0.0,
+                },
+            ),
+            nbr: huge_vec(n * 16, 0),
             nn: vec![0; n],
             cap: 16,
             shell,
-            events: vec![NO_EVENT; n],
+            events: huge_vec(n, NO_EVENT),
             queue: EventQueue::new(n, 0.0, 1.0),
             now: 0.0,
             counters: Counters::default(),
@@ -666,14 +704,14 @@ impl<const D: usize> System<D> {
     fn grow_cells(&mut self) {
         let cap = 2 * self.ccap;
         let cells = self.cell_len.len();
-        let mut pos = vec![
+        let mut pos = huge_vec(
+            cells * cap,
             ListPos {
                 x: [0.0; D],
-                r: 0.0
-            };
-            cells * cap
-        ];
-        let mut id = vec![NONE; cells * cap];
+                r: 0.0,
+            },
+        );
+        let mut id = huge_vec(cells * cap, NONE);
         for f in 0..cells {
             let k = self.cell_len[f] as usize;
             let old = f * self.ccap;
@@ -1218,7 +1256,7 @@ impl<const D: usize> System<D> {
     fn grow_lists(&mut self) {
         let n = self.len();
         let cap = self.cap * 2;
-        let mut nbr = vec![0u32; n * cap];
+        let mut nbr = huge_vec(n * cap, 0u32);
         for i in 0..n {
             let k = self.nn[i] as usize;
             nbr[i * cap..i * cap + k].copy_from_slice(&self.nbr[i * self.cap..i * self.cap + k]);
@@ -1285,6 +1323,7 @@ impl<const D: usize> System<D> {
         if let Some(k) = next {
             prefetch(&self.events[k]);
             prefetch(&self.p[k]);
+            prefetch(&self.xn[k]);
             prefetch(&self.nbr[k * self.cap]);
         }
         let ev = self.events[i];
@@ -1333,6 +1372,8 @@ impl<const D: usize> System<D> {
                 prefetch(&self.p[j]);
                 prefetch(&self.count[j]);
                 prefetch(&self.mass[j]);
+                prefetch(&self.xn[j]);
+                prefetch(&self.nbr[j * self.cap]);
             }
         }
         true
