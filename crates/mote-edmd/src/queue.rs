@@ -9,9 +9,6 @@
 //! and in cache. A particle's newer event makes its older entries stale; they
 //! are recognised by a per-particle stamp and dropped when they come up.
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
-
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     t: f64,
@@ -19,22 +16,79 @@ struct Entry {
     stamp: u32,
 }
 
-impl PartialEq for Entry {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
+impl Entry {
+    /// Earlier first; ties go to the lower particle index (deterministic).
+    #[inline(always)]
+    fn before(&self, o: &Entry) -> bool {
+        self.t < o.t || (self.t == o.t && self.i < o.i)
     }
 }
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
+
+/// A binary min-heap of entries whose sift-down picks the smaller child
+/// without a branch (the comparison's outcome is a coin toss, so a branch
+/// would be mispredicted at every other level) and uses Floyd's
+/// bottom-up removal: the hole goes down to a leaf, the last entry then
+/// climbs from there.
+#[derive(Debug, Clone, Default)]
+struct MinHeap {
+    v: Vec<Entry>,
 }
-impl Ord for Entry {
-    /// Reversed, so that `BinaryHeap` (a max-heap) yields the earliest first;
-    /// ties go to the lower particle index (deterministic).
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.t.total_cmp(&self.t).then(o.i.cmp(&self.i))
+
+impl MinHeap {
+    #[inline]
+    fn len(&self) -> usize {
+        self.v.len()
+    }
+
+    #[inline]
+    fn peek(&self) -> Option<&Entry> {
+        self.v.first()
+    }
+
+    #[inline]
+    fn push(&mut self, e: Entry) {
+        self.v.push(e);
+        self.sift_up(self.v.len() - 1);
+    }
+
+    #[inline]
+    fn sift_up(&mut self, mut k: usize) {
+        let e = self.v[k];
+        while k > 0 {
+            let parent = (k - 1) / 2;
+            if !e.before(&self.v[parent]) {
+                break;
+            }
+            self.v[k] = self.v[parent];
+            k = parent;
+        }
+        self.v[k] = e;
+    }
+
+    #[inline]
+    fn pop(&mut self) -> Option<Entry> {
+        let last = self.v.pop()?;
+        let n = self.v.len();
+        if n == 0 {
+            return Some(last);
+        }
+        let top = self.v[0];
+        // move the hole from the root down to a leaf along smaller children
+        let mut hole = 0;
+        let mut child = 1;
+        while child + 1 < n {
+            child += self.v[child + 1].before(&self.v[child]) as usize;
+            self.v[hole] = self.v[child];
+            hole = child;
+            child = 2 * hole + 1;
+        }
+        if child < n {
+            self.v[hole] = self.v[child];
+            hole = child;
+        }
+        self.v[hole] = last;
+        self.sift_up(hole);
+        Some(top)
     }
 }
 
@@ -43,7 +97,7 @@ impl Ord for Entry {
 pub struct EventQueue {
     time: Vec<f64>,
     stamp: Vec<u32>,
-    heap: BinaryHeap<Entry>,
+    heap: MinHeap,
     buckets: Vec<Vec<Entry>>,
     overflow: Vec<Entry>,
     /// Entries (live or stale) in the buckets.
@@ -52,7 +106,19 @@ pub struct EventQueue {
     dt: f64,
     /// Index of the current block (times in [t0 + cur·dt, t0 + (cur+1)·dt)).
     cur: i64,
+    /// Events taken out in the current block, and blocks and events over
+    /// the current window of [`WINDOW`] blocks (to keep `dt` tuned).
+    pops_in_block: u64,
+    window_blocks: u32,
+    window_pops: u64,
 }
+
+/// Events per block the calendar aims at.
+const TARGET: f64 = 32.0;
+/// A block holding this many events is far too long: retune at once.
+const TOO_MANY: u64 = 1024;
+/// Blocks over which the mean number of events per block is watched.
+const WINDOW: u32 = 64;
 
 impl EventQueue {
     /// A queue of `n` particles, all without event (time +∞), with blocks
@@ -62,13 +128,16 @@ impl EventQueue {
         Self {
             time: crate::system::huge_vec(n, f64::INFINITY),
             stamp: crate::system::huge_vec(n, 0),
-            heap: BinaryHeap::new(),
+            heap: MinHeap::default(),
             buckets: vec![Vec::new(); nb],
             overflow: Vec::new(),
             in_buckets: 0,
             t0,
             dt: if dt > 0.0 && dt.is_finite() { dt } else { 1.0 },
             cur: 0,
+            pops_in_block: 0,
+            window_blocks: 0,
+            window_pops: 0,
         }
     }
 
@@ -143,9 +212,20 @@ impl EventQueue {
 
     /// Removes the earliest entry, which the caller has just had from
     /// [`EventQueue::min`] and must file anew with [`EventQueue::update`].
+    ///
+    /// The event rate can change by orders of magnitude within a run (a
+    /// packing approaching jamming collides ever faster): when one block
+    /// has yielded [`TOO_MANY`] events, the calendar is rebuilt with blocks
+    /// short enough for [`TARGET`] events each.
     #[inline]
     pub fn pop(&mut self) {
-        self.heap.pop();
+        let Some(top) = self.heap.pop() else { return };
+        self.pops_in_block += 1;
+        if self.pops_in_block >= TOO_MANY {
+            let dt = self.dt * TARGET / self.pops_in_block as f64;
+            // every live event is at or after the one just taken
+            self.retune(top.t, dt);
+        }
     }
 
     /// Moves to the next non-empty block; false if there are no events.
@@ -165,6 +245,23 @@ impl EventQueue {
         if self.cur.rem_euclid(nb) == 0 {
             self.redistribute_overflow();
         }
+        // Blocks far too short for the event rate (most of them empty) make
+        // every event pay for many block changes, blocks too long a deep
+        // heap: retune when the mean is off by more than 4× either way.
+        self.window_blocks += 1;
+        self.window_pops += self.pops_in_block;
+        self.pops_in_block = 0;
+        if self.window_blocks == WINDOW {
+            let per_block = self.window_pops as f64 / WINDOW as f64;
+            self.window_blocks = 0;
+            self.window_pops = 0;
+            if !(TARGET / 4.0..=4.0 * TARGET).contains(&per_block) {
+                let start = self.t0 + self.cur as f64 * self.dt;
+                let dt = self.dt * TARGET / per_block.max(TARGET / 256.0);
+                self.retune(start, dt);
+                return true;
+            }
+        }
         let k = self.cur.rem_euclid(nb) as usize;
         let bucket = std::mem::take(&mut self.buckets[k]);
         self.in_buckets -= bucket.len();
@@ -177,6 +274,14 @@ impl EventQueue {
         let mut bucket = bucket;
         bucket.clear();
         self.buckets[k] = bucket;
+        // a block that starts with far more events than aimed at: shorter
+        // blocks (a heap of 10³ entries costs twice one of 30 per event)
+        let live = self.heap.len();
+        if live as f64 > 8.0 * TARGET {
+            let start = self.t0 + self.cur as f64 * self.dt;
+            let dt = self.dt * TARGET / live as f64;
+            self.retune(start, dt);
+        }
         true
     }
 
