@@ -66,6 +66,7 @@ pub struct XyzWriter {
     path: PathBuf,
     out: BufWriter<File>,
     provenance: Provenance,
+    exact: bool,
 }
 
 impl XyzWriter {
@@ -75,6 +76,7 @@ impl XyzWriter {
             path: path.to_path_buf(),
             out: BufWriter::new(file),
             provenance,
+            exact: false,
         })
     }
 
@@ -88,11 +90,21 @@ impl XyzWriter {
             path: path.to_path_buf(),
             out: BufWriter::new(file),
             provenance,
+            exact: false,
         })
     }
 
+    /// Writes every number so that it reads back bit for bit (shortest
+    /// round-trip form; up to 17 digits) instead of 11 digits for positions
+    /// and velocities and 7 for radii: for packings, whose contacts are
+    /// gaps of 10⁻¹⁰ and less.
+    pub fn exact(mut self) -> Self {
+        self.exact = true;
+        self
+    }
+
     pub fn write(&mut self, frame: &Frame) -> Result<(), IoError> {
-        write_frame(&mut self.out, frame, &self.provenance)
+        write_frame_as(&mut self.out, frame, &self.provenance, self.exact)
             .and_then(|_| self.out.flush())
             .map_err(|e| IoError::os(&self.path, e))
     }
@@ -115,6 +127,17 @@ pub fn write_frame(
     out: &mut impl Write,
     frame: &Frame,
     provenance: &Provenance,
+) -> std::io::Result<()> {
+    write_frame_as(out, frame, provenance, false)
+}
+
+/// Writes one frame in extended XYZ; `exact`: numbers that read back bit
+/// for bit (see [`XyzWriter::exact`]).
+pub fn write_frame_as(
+    out: &mut impl Write,
+    frame: &Frame,
+    provenance: &Provenance,
+    exact: bool,
 ) -> std::io::Result<()> {
     let n = frame.positions.len();
     let c = &frame.cell;
@@ -146,11 +169,19 @@ pub fn write_frame(
         let v = frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
         let r = frame.radii.get(i).copied().unwrap_or(0.0);
         let s = frame.species.get(i).map(String::as_str).unwrap_or("X");
-        writeln!(
-            out,
-            "{s} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.6e}",
-            p[0], p[1], p[2], v[0], v[1], v[2], r
-        )?;
+        if exact {
+            writeln!(
+                out,
+                "{s} {:e} {:e} {:e} {:e} {:e} {:e} {:e}",
+                p[0], p[1], p[2], v[0], v[1], v[2], r
+            )?;
+        } else {
+            writeln!(
+                out,
+                "{s} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.6e}",
+                p[0], p[1], p[2], v[0], v[1], v[2], r
+            )?;
+        }
     }
     Ok(())
 }
@@ -187,6 +218,15 @@ pub fn read_frames(path: &Path) -> Result<Vec<Frame>, IoError> {
                 .collect();
             if v.len() == 9 {
                 frame.cell = [[v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]];
+            }
+        }
+        if let Some(flags) = key_value(comment, "pbc") {
+            let v: Vec<bool> = flags
+                .split_whitespace()
+                .map(|s| matches!(s, "T" | "t" | "True" | "true" | "1"))
+                .collect();
+            if v.len() == 3 {
+                frame.pbc = [v[0], v[1], v[2]];
             }
         }
         if let Some(o) = key_value(comment, "Origin") {
@@ -292,6 +332,32 @@ mod tests {
             }
         }
         assert_eq!(back[0].species, frame.species);
+        assert_eq!(back[0].pbc, frame.pbc);
+        // exact mode: every number reads back bit for bit
+        let exact = dir.path().join("exact.xyz");
+        let prov = Provenance {
+            program: "mote test".into(),
+            scene: "unit".into(),
+            seed: 7,
+        };
+        let awkward = Frame {
+            positions: vec![
+                [0.1 + 0.2, 1.0 / 3.0, -2.0f64.sqrt()],
+                [1e-300, 5e-324, 7.0],
+            ],
+            radii: vec![0.49999999999999994, std::f64::consts::PI],
+            pbc: [true, true, true],
+            ..frame.clone()
+        };
+        XyzWriter::create(&exact, prov)
+            .unwrap()
+            .exact()
+            .write(&awkward)
+            .unwrap();
+        let back = read_frames(&exact).unwrap();
+        assert_eq!(back[0].positions, awkward.positions);
+        assert_eq!(back[0].radii, awkward.radii);
+        assert_eq!(back[0].pbc, [true, true, true]);
     }
 
     #[test]

@@ -22,7 +22,9 @@ fn packs_writes_and_analyses() {
             "--seed",
             "2",
             "--max-pressure",
-            "1e7",
+            "1e9",
+            "--tol",
+            "1e-7",
             "-o",
         ])
         .arg(&xyz)
@@ -50,7 +52,7 @@ fn packs_writes_and_analyses() {
         .split(',')
         .map(|v| v.parse().unwrap())
         .collect();
-    assert!(last[3] > 1e7, "final pressure {}", last[3]);
+    assert!(last[3] > 1e9, "final pressure {}", last[3]);
     let pov = std::fs::read_to_string(dir.path().join("out/packing.pov")).unwrap();
     assert!(pov.contains("sphere"));
     // analyse reads it back: same φ as the summary printed
@@ -63,6 +65,28 @@ fn packs_writes_and_analyses() {
         .unwrap();
     let a = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{a}");
+    // read back from the file (exact numbers, periodic box from pbc="T T T"),
+    // the contacts at a gap of 1e-7 are those of the packing in memory
+    let out = mote()
+        .args(["pack", "analyse", "--tol", "1e-7"])
+        .arg(&xyz)
+        .output()
+        .unwrap();
+    let tight = String::from_utf8_lossy(&out.stdout);
+    let z_summary = text.split("backbone mean contact number ").nth(1).unwrap()[..6].to_string();
+    let rattlers = text
+        .split("1e-7: ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .to_string();
+    assert!(
+        tight.contains(&format!("{rattlers} rattlers"))
+            && tight.contains(&format!("backbone mean {z_summary}")),
+        "{tight}\n{text}"
+    );
     let phi_summary = text.split("phi = ").nth(1).unwrap()[..6].to_string();
     assert!(
         a.contains(&format!("packing fraction      {phi_summary}")),

@@ -107,8 +107,8 @@ struct AnalyseArgs {
     #[arg(value_name = "FILE")]
     file: PathBuf,
     /// Relative gap tolerance: i and j touch if |r_ij| < (1 + TOL)(r_i + r_j).
-    /// Extended XYZ keeps radii to 7 digits, so tolerances below ~1e-6 see
-    /// the rounding.
+    /// `mote pack` writes every number exactly, so any tolerance works on
+    /// its files; other writers' rounding (e.g. 7 digits) sets a floor.
     #[arg(long, default_value_t = 1e-5)]
     tol: f64,
     /// Bonds for Q6: |r_ij| < BOND·(r_i + r_j).
@@ -338,7 +338,7 @@ fn pack_dim<const D: usize>(
     let frame = mote_edmd::scene::frame(sys);
     if let Some(s) = &stem {
         let path = a.output.clone().unwrap_or_else(|| s.with_extension("xyz"));
-        let mut w = mote_io::xyz::XyzWriter::create(&path, provenance.clone())?;
+        let mut w = mote_io::xyz::XyzWriter::create(&path, provenance.clone())?.exact();
         w.write(&frame)?;
         write_pov(&frame, &s.with_extension("pov"))?;
     }
