@@ -184,6 +184,37 @@ impl Stepper {
         sys.carried_angular_acceleration = alpha;
     }
 
+    /// Evaluates the forces leap-frog will start from, if none are carried,
+    /// and carries them. The first step would evaluate exactly these, so the
+    /// trajectory does not change; what does is that the virial and the
+    /// dipoles that observables read before the first step are those of the
+    /// initial state, not of no evaluation at all (P(0) = ρkT, U_dd(0) = 0).
+    /// Other schemes evaluate inside each step and are left alone.
+    pub fn prime(&mut self, sys: &mut System, ff: &mut ForceField) {
+        if self.scheme != Integrator::LeapFrog
+            || sys.carried_acceleration.len() == sys.particles.len()
+        {
+            return;
+        }
+        let t = sys.time;
+        let mut acc = std::mem::take(&mut sys.carried_acceleration);
+        if ff.exerts_torques() {
+            let mut alpha = std::mem::take(&mut sys.carried_angular_acceleration);
+            Self::eval_rotating(ff, sys, t, &mut acc, &mut alpha);
+            sys.carried_angular_acceleration = alpha;
+        } else {
+            Self::eval(
+                ff,
+                sys,
+                &sys.particles.position,
+                &sys.particles.velocity,
+                t,
+                &mut acc,
+            );
+        }
+        sys.carried_acceleration = acc;
+    }
+
     /// Advances the system by one step h.
     pub fn step(&mut self, sys: &mut System, ff: &mut ForceField, h: f64) {
         let t = sys.time;

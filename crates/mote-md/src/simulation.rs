@@ -102,6 +102,9 @@ impl Simulation {
         let start = Instant::now();
         let steps = length.steps_from(self.system.time, self.dt);
         let first_step = self.system.step;
+        if self.brownian.is_none() {
+            self.stepper.prime(&mut self.system, &mut self.forces);
+        }
         let initial = Observables::measure(&self.system, &mut self.forces);
         let e0 = initial.total_energy();
         let mut max_err: f64 = 0.0;

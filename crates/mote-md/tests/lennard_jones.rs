@@ -152,3 +152,165 @@ fn lj_nve_drift_over_1e5_steps() {
     );
     assert!(swing < 5e-4, "fluctuation {swing:.2e}");
 }
+
+/// Forces, energy and virial of LJ by brute force: every pair and every
+/// periodic image within the cut-off (so boxes shorter than 2 r_c count the
+/// same particle several times, as the ghost list must).
+fn lj_brute(
+    pos: &[DVec3],
+    b: &Boundary,
+    lj: &mote_md::force::LennardJones,
+) -> (Vec<DVec3>, f64, f64) {
+    let l = b.hi - b.lo;
+    let reach = |axis: usize| {
+        if b.periodic[axis] {
+            (lj.cutoff / l[axis]).ceil() as i32 + 1
+        } else {
+            0
+        }
+    };
+    let (nx, ny, nz) = (reach(0), reach(1), reach(2));
+    let (s2, e) = (lj.sigma * lj.sigma, lj.epsilon);
+    let mut force = vec![DVec3::ZERO; pos.len()];
+    let (mut energy, mut virial) = (0.0, 0.0);
+    for i in 0..pos.len() {
+        for j in 0..pos.len() {
+            for a in -nx..=nx {
+                for c in -ny..=ny {
+                    for d in -nz..=nz {
+                        let shift = DVec3::new(a as f64, c as f64, d as f64) * l;
+                        if i == j && shift == DVec3::ZERO {
+                            continue;
+                        }
+                        let r = pos[i] - pos[j] - shift;
+                        let r2 = r.length_squared();
+                        if r2 >= lj.cutoff * lj.cutoff {
+                            continue;
+                        }
+                        let s6 = (s2 / r2).powi(3);
+                        let f_over_r = 24.0 * e * (2.0 * s6 * s6 - s6) / r2;
+                        force[i] += r * f_over_r;
+                        // Each pair is met from both ends: halve.
+                        energy += 0.5 * (4.0 * e * (s6 * s6 - s6) - lj.shift());
+                        virial += 0.5 * f_over_r * r2;
+                    }
+                }
+            }
+        }
+    }
+    (force, energy, virial)
+}
+
+/// A simple-cubic lattice of `n³` sites filling `l`, each site moved by up
+/// to ±0.1 of the spacing per axis (no two particles closer than 0.8 of it).
+fn jittered(n: usize, l: DVec3, rng: &mut Xoshiro256PlusPlus) -> Vec<DVec3> {
+    let a = l / n as f64;
+    let mut pos = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let u = DVec3::new(rng.gen(), rng.gen(), rng.gen()) - 0.5;
+                pos.push((DVec3::new(i as f64, j as f64, k as f64) + 0.5 + 0.2 * u) * a);
+            }
+        }
+    }
+    pos
+}
+
+fn lj_through_list(lj: &mut mote_md::force::LennardJones, pos: &[DVec3]) -> (Vec<DVec3>, f64, f64) {
+    use mote_md::{Interaction, State};
+    let zero = vec![DVec3::ZERO; pos.len()];
+    let mass = vec![1.0; pos.len()];
+    let state = State {
+        position: pos,
+        velocity: &zero,
+        mass: &mass,
+        time: 0.0,
+    };
+    let mut force = vec![DVec3::ZERO; pos.len()];
+    lj.add_forces(&state, &mut force);
+    let virial = lj.virial();
+    let energy = lj.potential_energy(&state);
+    (force, energy, virial)
+}
+
+/// The ghost-list LJ gives the forces, energy and virial of the brute-force
+/// sum over images: periodic, walled on one axis, open, and a box shorter
+/// than two cut-offs (several images of one particle in reach).
+#[test]
+fn lj_forces_match_brute_force_over_images() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(17);
+    let cases = [
+        (DVec3::splat(7.0), [true, true, true], 6usize),
+        (DVec3::new(7.0, 8.0, 6.5), [true, false, true], 6),
+        (DVec3::splat(6.0), [false, false, false], 5),
+        (DVec3::new(3.2, 4.0, 3.6), [true, true, true], 3),
+    ];
+    for (l, periodic, n) in cases {
+        let b = Boundary {
+            lo: DVec3::new(-1.0, 0.5, 2.0),
+            hi: DVec3::new(-1.0, 0.5, 2.0) + l,
+            periodic,
+        };
+        let pos: Vec<DVec3> = jittered(n, l, &mut rng).iter().map(|p| *p + b.lo).collect();
+        for shifted in [true, false] {
+            let mut lj = mote_md::force::LennardJones::new(1.0, 1.0, 2.5, shifted, 0.3, b);
+            let (f, u, w) = lj_through_list(&mut lj, &pos);
+            let (fb, ub, wb) = lj_brute(&pos, &b, &lj);
+            let scale = fb.iter().fold(0.0f64, |a, f| a.max(f.length()));
+            for i in 0..pos.len() {
+                let err = (f[i] - fb[i]).length() / scale;
+                assert!(
+                    err < 1e-12,
+                    "{periodic:?} L = {l}: particle {i}: {} vs {}",
+                    f[i],
+                    fb[i]
+                );
+            }
+            assert!(
+                (u - ub).abs() < 1e-11 * ub.abs().max(1.0),
+                "energy {u} vs {ub}"
+            );
+            assert!(
+                (w - wb).abs() < 1e-11 * wb.abs().max(1.0),
+                "virial {w} vs {wb}"
+            );
+        }
+    }
+}
+
+/// The AVX-512 rows (where the CPU has them) agree with the portable ones
+/// to round-off, and two threads give the bits of one.
+#[test]
+fn lj_rows_agree_across_kernels_and_threads() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+    let l = DVec3::splat(9.0);
+    let b = Boundary {
+        lo: DVec3::ZERO,
+        hi: l,
+        periodic: [true; 3],
+    };
+    let pos = jittered(9, l, &mut rng);
+    let run = |simd: bool, threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut lj = mote_md::force::LennardJones::new(1.0, 1.0, 2.5, true, 0.3, b);
+            lj.set_simd(simd);
+            lj_through_list(&mut lj, &pos)
+        })
+    };
+    let (f1, u1, w1) = run(true, 1);
+    let (f2, u2, w2) = run(true, 2);
+    assert_eq!(f1, f2, "forces differ between 1 and 2 threads");
+    assert_eq!((u1.to_bits(), w1.to_bits()), (u2.to_bits(), w2.to_bits()));
+    let (fp, up, wp) = run(false, 1);
+    let scale = fp.iter().fold(0.0f64, |a, f| a.max(f.length()));
+    for i in 0..pos.len() {
+        assert!((f1[i] - fp[i]).length() < 1e-13 * scale, "particle {i}");
+    }
+    assert!((u1 - up).abs() < 1e-12 * up.abs());
+    assert!((w1 - wp).abs() < 1e-12 * wp.abs());
+}

@@ -12,6 +12,9 @@ use rayon::prelude::*;
 
 use crate::boundary::Boundary;
 
+mod ghosts;
+pub use ghosts::{Copy4, GhostList};
+
 /// A Verlet neighbour list in compressed rows.
 #[derive(Debug, Clone, Default)]
 pub struct VerletList {
@@ -205,20 +208,26 @@ impl CellGrid {
     /// Calls `f(j)` for every particle in the cells around position r.
     pub fn for_each_candidate(&self, r: DVec3, mut f: impl FnMut(usize)) {
         let c = self.coords(r);
-        let range = |k: usize| -> Vec<isize> {
+        // The (at most three) distinct cells along each axis, without
+        // allocating: a periodic axis of one cell visits it once.
+        let range = |k: usize| -> ([isize; 3], usize) {
             let d = self.dims[k] as isize;
             if d == 1 {
-                vec![0]
+                ([0, 0, 0], 1)
             } else if self.periodic[k] {
-                vec![(c[k] - 1).rem_euclid(d), c[k], (c[k] + 1).rem_euclid(d)]
+                (
+                    [(c[k] - 1).rem_euclid(d), c[k], (c[k] + 1).rem_euclid(d)],
+                    3,
+                )
             } else {
-                ((c[k] - 1).max(0)..=(c[k] + 1).min(d - 1)).collect()
+                let (a, b) = ((c[k] - 1).max(0), (c[k] + 1).min(d - 1));
+                ([a, a + 1, a + 2], (b - a + 1) as usize)
             }
         };
         let (xs, ys, zs) = (range(0), range(1), range(2));
-        for &z in &zs {
-            for &y in &ys {
-                for &x in &xs {
+        for &z in &zs.0[..zs.1] {
+            for &y in &ys.0[..ys.1] {
+                for &x in &xs.0[..xs.1] {
                     let cell = self.cell_index([x, y, z]);
                     for &j in &self.order[self.first[cell]..self.first[cell + 1]] {
                         f(j);

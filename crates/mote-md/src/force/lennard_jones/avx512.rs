@@ -1,0 +1,99 @@
+//! One row of the Lennard-Jones pair loop, eight neighbours at a time:
+//! eight 32-byte records loaded and transposed, 1/r² from `vrcp14pd` refined by two
+//! Newton–Raphson steps y ← y (2 − r² y) (14 → 28 → 56 bits), lanes beyond
+//! r_c masked to zero. The portable loop in `mod.rs` is the reference.
+
+use std::arch::x86_64::*;
+
+use glam::DVec3;
+
+use super::{Coefficients, RowSum};
+use crate::neighbor::Copy4;
+
+/// The sums of row `row` of particle copy `k` (see [`super::row_portable`]).
+///
+/// # Safety
+/// The CPU must have AVX-512F; `k` and every entry of `row` must index
+/// `position`.
+#[target_feature(enable = "avx512f")]
+pub(super) unsafe fn row(
+    k: usize,
+    row: &[u32],
+    position: &[Copy4],
+    c: &Coefficients,
+    energy: bool,
+) -> RowSum {
+    let [xi, yi, zi, _] = position[k].0;
+    let (xi, yi, zi) = (_mm512_set1_pd(xi), _mm512_set1_pd(yi), _mm512_set1_pd(zi));
+    let base = position.as_ptr() as *const f64;
+    // Lane order of the transpose below: records 0..8 to lanes 0..8.
+    let low = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
+    let high = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
+    let cutoff2 = _mm512_set1_pd(c.cutoff2);
+    let sigma2 = _mm512_set1_pd(c.sigma2);
+    let eps48 = _mm512_set1_pd(c.eps48);
+    let eps24 = _mm512_set1_pd(c.eps24);
+    let eps4 = _mm512_set1_pd(c.eps4);
+    let shift = _mm512_set1_pd(c.shift);
+    let one = _mm512_set1_pd(1.0);
+    let two = _mm512_set1_pd(2.0);
+    let zero = _mm512_setzero_pd();
+    let (mut fx, mut fy, mut fz, mut w, mut u) = (zero, zero, zero, zero, zero);
+
+    let mut lanes = |index: &[u32; 8], valid: __mmask8| {
+        // Eight 32-byte records (x, y, z, 0), two to a register, then
+        // transposed: a_k = (r_k | r_{k+4}); unpacking pairs them per
+        // 128-bit lane, and two-source permutes gather each coordinate.
+        // SAFETY: the caller guarantees every index is in bounds.
+        let record = |m: usize| unsafe { _mm256_load_pd(base.add(4 * index[m] as usize)) };
+        let pair =
+            |m: usize| _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(record(m)), record(m + 4));
+        let (a0, a1, a2, a3) = (pair(0), pair(1), pair(2), pair(3));
+        let (xz01, yw01) = (_mm512_unpacklo_pd(a0, a1), _mm512_unpackhi_pd(a0, a1));
+        let (xz23, yw23) = (_mm512_unpacklo_pd(a2, a3), _mm512_unpackhi_pd(a2, a3));
+        let xj = _mm512_permutex2var_pd(xz01, low, xz23);
+        let zj = _mm512_permutex2var_pd(xz01, high, xz23);
+        let yj = _mm512_permutex2var_pd(yw01, low, yw23);
+        let dx = _mm512_sub_pd(xi, xj);
+        let dy = _mm512_sub_pd(yi, yj);
+        let dz = _mm512_sub_pd(zi, zj);
+        let r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
+        let inside = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(valid, r2, cutoff2);
+        let r2s = _mm512_mask_blend_pd(inside, one, r2);
+        let mut inv = _mm512_rcp14_pd(r2s);
+        inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(r2s, inv, two));
+        inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(r2s, inv, two));
+        let s2 = _mm512_mul_pd(sigma2, inv);
+        let s6 = _mm512_mul_pd(_mm512_mul_pd(s2, s2), s2);
+        let f = _mm512_mul_pd(_mm512_mul_pd(inv, s6), _mm512_fmsub_pd(eps48, s6, eps24));
+        let f = _mm512_maskz_mov_pd(inside, f);
+        fx = _mm512_fmadd_pd(f, dx, fx);
+        fy = _mm512_fmadd_pd(f, dy, fy);
+        fz = _mm512_fmadd_pd(f, dz, fz);
+        w = _mm512_fmadd_pd(f, r2, w);
+        if energy {
+            let e = _mm512_fmsub_pd(_mm512_fmsub_pd(eps4, s6, eps4), s6, shift);
+            u = _mm512_mask_add_pd(u, inside, u, e);
+        }
+    };
+
+    let chunks = row.chunks_exact(8);
+    let tail = chunks.remainder();
+    for chunk in chunks {
+        lanes(chunk.try_into().expect("eight"), 0xff);
+    }
+    if !tail.is_empty() {
+        let mut padded = [k as u32; 8];
+        padded[..tail.len()].copy_from_slice(tail);
+        lanes(&padded, ((1u32 << tail.len()) - 1) as __mmask8);
+    }
+    RowSum {
+        force: DVec3::new(
+            _mm512_reduce_add_pd(fx),
+            _mm512_reduce_add_pd(fy),
+            _mm512_reduce_add_pd(fz),
+        ),
+        virial: _mm512_reduce_add_pd(w),
+        energy: _mm512_reduce_add_pd(u),
+    }
+}

@@ -1,0 +1,574 @@
+//! A full neighbour list over a cell-sorted copy of the particles, with their
+//! periodic images appended as ghosts: the list that SIMD pair kernels read.
+//!
+//! Building wraps every particle into the box and sorts the particles by
+//! cell, so particles that are neighbours in space are neighbours in memory.
+//! Each periodic axis then adds an image x ± L of every copy within
+//! r_c + skin of a face; the axes are swept one after the other, so the
+//! images of images cover the edges and corners. A pair is then a plain
+//! difference x_i − x_j: the pair loop does no minimum image. Each
+//! particle's row lists every copy within r_c + skin (both members of a
+//! pair see each other), so a kernel sums the force on i alone and writes
+//! nothing else: rows run in parallel with no reductions.
+//!
+//! Between builds, [`GhostList::update`] moves every copy by the
+//! displacement of its particle since the build, taken as a minimum image,
+//! so the integrator may wrap positions freely. The list is rebuilt when a
+//! particle has moved more than half the skin (no pair can then have come
+//! within r_c unseen) or after a fixed number of updates if one is set.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::boundary::Boundary;
+
+/// Particles per parallel block of a build or refresh.
+const BLOCK: usize = 512;
+
+/// A copy's coordinates (x, y, z, 0), aligned to 32 bytes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[repr(C, align(32))]
+pub struct Copy4(pub [f64; 4]);
+
+/// A full Verlet list over sorted copies and periodic ghosts.
+#[derive(Debug, Clone, Default)]
+pub struct GhostList {
+    /// Interaction cut-off r_c.
+    pub cutoff: f64,
+    /// Skin: the list holds pairs within r_c + skin.
+    pub skin: f64,
+    /// Rebuild at least every this many updates (0: only on displacement).
+    pub every: u64,
+    /// The particle of each copy (particles and ghosts, in cell order).
+    pub particle: Vec<u32>,
+    /// The copies that are particles themselves, one per row, in cell order.
+    pub owner: Vec<u32>,
+    /// The row of each particle.
+    pub slot: Vec<u32>,
+    /// Current coordinates of the copies, (x, y, z, 0): one aligned
+    /// 32-byte record each, so a kernel loads a neighbour in one go.
+    pub position: Vec<Copy4>,
+    /// `neighbors[start[r]..start[r + 1]]` are the copies near row r.
+    pub start: Vec<u32>,
+    pub neighbors: Vec<u32>,
+    /// Coordinates of the copies at the build (ghost shifts included).
+    base: [Vec<f64>; 3],
+    /// Wrapped positions of the particles at the build.
+    reference: Vec<DVec3>,
+    displacement: Vec<DVec3>,
+    since_build: u64,
+    /// Number of builds so far.
+    pub builds: u64,
+}
+
+impl GhostList {
+    pub fn new(cutoff: f64, skin: f64) -> Self {
+        Self {
+            cutoff,
+            skin,
+            ..Self::default()
+        }
+    }
+
+    /// Number of particles (rows).
+    pub fn len(&self) -> usize {
+        self.slot.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.slot.is_empty()
+    }
+
+    /// Number of ghost copies.
+    pub fn ghosts(&self) -> usize {
+        self.particle.len() - self.slot.len()
+    }
+
+    /// Current position of copy k.
+    #[inline]
+    pub fn at(&self, k: usize) -> DVec3 {
+        let [x, y, z, _] = self.position[k].0;
+        DVec3::new(x, y, z)
+    }
+
+    /// The copies near the particle of row r.
+    #[inline]
+    pub fn row(&self, r: usize) -> &[u32] {
+        &self.neighbors[self.start[r] as usize..self.start[r + 1] as usize]
+    }
+
+    /// Counts one step: rebuilds the list if it is due or stale, else moves
+    /// the copies to `pos`. Returns whether it rebuilt.
+    pub fn update(&mut self, pos: &[DVec3], boundary: &Boundary) -> bool {
+        self.since_build += 1;
+        let due = self.every > 0 && self.since_build >= self.every;
+        self.follow(pos, boundary, due)
+    }
+
+    /// Moves the copies to `pos` (rebuilding if a particle has gone too far)
+    /// without counting a step: for energies between steps.
+    pub fn refresh(&mut self, pos: &[DVec3], boundary: &Boundary) -> bool {
+        self.follow(pos, boundary, false)
+    }
+
+    fn follow(&mut self, pos: &[DVec3], boundary: &Boundary, due: bool) -> bool {
+        if due || self.reference.len() != pos.len() {
+            self.build(pos, boundary);
+            return true;
+        }
+        let limit = 0.25 * self.skin * self.skin;
+        let reference = &self.reference;
+        let farthest = self
+            .displacement
+            .par_iter_mut()
+            .with_min_len(BLOCK)
+            .enumerate()
+            .map(|(i, d)| {
+                *d = boundary.minimum_image(pos[i] - reference[i]);
+                d.length_squared()
+            })
+            .reduce(|| 0.0, f64::max);
+        if farthest > limit {
+            self.build(pos, boundary);
+            return true;
+        }
+        let (particle, displacement) = (&self.particle, &self.displacement);
+        let [bx, by, bz] = &self.base;
+        self.position
+            .par_chunks_mut(BLOCK)
+            .enumerate()
+            .for_each(|(b, chunk)| {
+                for (c, p) in chunk.iter_mut().enumerate() {
+                    let k = b * BLOCK + c;
+                    let d = displacement[particle[k] as usize];
+                    *p = Copy4([bx[k] + d.x, by[k] + d.y, bz[k] + d.z, 0.0]);
+                }
+            });
+        false
+    }
+
+    /// What a checkpoint must hold for a resumed run to sum forces in the
+    /// same order as the uninterrupted one: [updates since the build, then
+    /// the wrapped positions of the build, x y z per particle]. Empty before
+    /// the first build.
+    pub fn carried_state(&self) -> Vec<f64> {
+        if self.reference.is_empty() {
+            return Vec::new();
+        }
+        let mut out = Vec::with_capacity(1 + 3 * self.reference.len());
+        out.push(self.since_build as f64);
+        out.extend(self.reference.iter().flat_map(|r| r.to_array()));
+        out
+    }
+
+    /// Rebuilds the list [`GhostList::carried_state`] describes. Wrapping is
+    /// idempotent, so the build at the stored positions is the one the
+    /// uninterrupted run made, row order and all.
+    pub fn restore(&mut self, state: &[f64], boundary: &Boundary) -> Result<(), String> {
+        let Some((&since, xyz)) = state.split_first() else {
+            return Ok(());
+        };
+        if xyz.len() % 3 != 0 || !(since >= 0.0 && since.fract() == 0.0) {
+            return Err("neighbour list: a step count and x y z triples expected".into());
+        }
+        let reference: Vec<DVec3> = xyz.chunks(3).map(DVec3::from_slice).collect();
+        self.build(&reference, boundary);
+        self.since_build = since as u64;
+        Ok(())
+    }
+
+    /// Builds the list from scratch at positions `pos`.
+    pub fn build(&mut self, pos: &[DVec3], boundary: &Boundary) {
+        let n = pos.len();
+        assert!(
+            n < u32::MAX as usize / 2,
+            "too many particles for u32 lists"
+        );
+        let reach = self.cutoff + self.skin;
+        let wrapped: Vec<DVec3> = pos.par_iter().map(|r| boundary.wrap(*r)).collect();
+        let grid = Grid::new(&wrapped, boundary, reach);
+
+        // The particles, then their images within reach of the box.
+        let mut copies: Vec<(u32, DVec3)> = (0..n as u32).map(|i| (i, DVec3::ZERO)).collect();
+        for k in 0..3 {
+            if !boundary.periodic[k] {
+                continue;
+            }
+            let l = boundary.hi[k] - boundary.lo[k];
+            let images = (reach / l).ceil() as i32;
+            let (lo, hi) = (boundary.lo[k] - reach, boundary.hi[k] + reach);
+            for c in 0..copies.len() {
+                let (i, shift) = copies[c];
+                let r = wrapped[i as usize][k] + shift[k];
+                for m in (-images..=images).filter(|&m| m != 0) {
+                    let image = r + m as f64 * l;
+                    if image >= lo && image < hi {
+                        let mut s = shift;
+                        s[k] += m as f64 * l;
+                        copies.push((i, s));
+                    }
+                }
+            }
+        }
+        // All copies in cell order: a cell, and a run of cells along x, is
+        // a contiguous range of the coordinate arrays.
+        let at = |&(i, s): &(u32, DVec3)| wrapped[i as usize] + s;
+        let unsorted_cells: Vec<u32> = copies.par_iter().map(|c| grid.cell(at(c))).collect();
+        let order = grid.counting_sort(&unsorted_cells);
+        let first = grid.first(&unsorted_cells);
+        let copies: Vec<(u32, DVec3)> = order.iter().map(|&c| copies[c as usize]).collect();
+        let cell: Vec<u32> = order.iter().map(|&c| unsorted_cells[c as usize]).collect();
+        self.particle = copies.iter().map(|c| c.0).collect();
+        self.owner.clear();
+        self.slot = vec![0; n];
+        for (k, c) in copies.iter().enumerate() {
+            if c.1 == DVec3::ZERO {
+                self.slot[c.0 as usize] = self.owner.len() as u32;
+                self.owner.push(k as u32);
+            }
+        }
+        for axis in 0..3 {
+            self.base[axis] = copies.par_iter().map(|c| at(c)[axis]).collect();
+        }
+        let [bx, by, bz] = &self.base;
+        self.position = (0..copies.len())
+            .map(|k| Copy4([bx[k], by[k], bz[k], 0.0]))
+            .collect();
+
+        // Each particle's row from the 3 × 3 runs of three cells around it,
+        // without branches on the distance.
+        let (x, y, z, owner) = (bx, by, bz, &self.owner);
+        let reach2 = reach * reach;
+        let rows: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let mut near: Vec<u32> = Vec::new();
+                let mut len = Vec::with_capacity(BLOCK);
+                for r in b * BLOCK..((b + 1) * BLOCK).min(n) {
+                    let k = owner[r] as usize;
+                    let before = near.len();
+                    let (xk, yk, zk) = (x[k], y[k], z[k]);
+                    grid.for_each_run_around(cell[k], |lo, hi| {
+                        let (lo, hi) = (first[lo] as usize, first[hi + 1] as usize);
+                        let count = near.len();
+                        near.resize(count + hi - lo + 8, 0);
+                        let kept = within(
+                            (xk, yk, zk),
+                            reach2,
+                            (&x[lo..hi], &y[lo..hi], &z[lo..hi]),
+                            lo,
+                            k,
+                            &mut near[count..],
+                        );
+                        near.truncate(count + kept);
+                    });
+                    len.push((near.len() - before) as u32);
+                }
+                (near, len)
+            })
+            .collect();
+        self.start.clear();
+        self.neighbors.clear();
+        self.start.push(0);
+        for (near, len) in &rows {
+            self.neighbors.extend_from_slice(near);
+            for &l in len {
+                let last = *self.start.last().unwrap();
+                self.start.push(last + l);
+            }
+        }
+        self.reference = wrapped;
+        self.displacement = vec![DVec3::ZERO; n];
+        self.since_build = 0;
+        self.builds += 1;
+    }
+}
+
+/// Writes to the front of `out` the indices `first + m` of the points
+/// (x[m], y[m], z[m]) closer than √reach2 to `at`, except `exclude`, and
+/// returns how many. `out` must have eight entries to spare beyond
+/// `x.len()`. Branch-free: AVX-512 compresses eight indices at a time where
+/// the CPU has it; else an index is written, then kept or not.
+#[inline]
+fn within(
+    at: (f64, f64, f64),
+    reach2: f64,
+    (x, y, z): (&[f64], &[f64], &[f64]),
+    first: usize,
+    exclude: usize,
+    out: &mut [u32],
+) -> usize {
+    assert!(out.len() >= x.len() + 8 && y.len() == x.len() && z.len() == x.len());
+    #[cfg(target_arch = "x86_64")]
+    if compress_available() {
+        // SAFETY: AVX-512F and VL are present; the slices were checked above.
+        return unsafe { within_avx512(at, reach2, (x, y, z), first, exclude, out) };
+    }
+    let mut kept = 0;
+    for (m, ((&xj, &yj), &zj)) in x.iter().zip(y).zip(z).enumerate() {
+        let (dx, dy, dz) = (at.0 - xj, at.1 - yj, at.2 - zj);
+        let j = first + m;
+        // SAFETY: kept ≤ m < x.len() ≤ out.len().
+        unsafe { *out.get_unchecked_mut(kept) = j as u32 };
+        kept += usize::from((dx * dx + dy * dy + dz * dz < reach2) & (j != exclude));
+    }
+    kept
+}
+
+#[cfg(target_arch = "x86_64")]
+fn compress_available() -> bool {
+    use std::sync::OnceLock;
+    static AVAILABLE: OnceLock<bool> = OnceLock::new();
+    *AVAILABLE.get_or_init(|| {
+        std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+    })
+}
+
+/// [`within`] eight points at a time: contiguous loads, one compare, the
+/// kept indices compressed into a register and stored whole (the eight
+/// spare entries of `out` take the overhang).
+///
+/// # Safety
+/// AVX-512F and AVX-512VL; `y`, `z` as long as `x`; `out` at least
+/// `x.len() + 8` long.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl")]
+unsafe fn within_avx512(
+    at: (f64, f64, f64),
+    reach2: f64,
+    (x, y, z): (&[f64], &[f64], &[f64]),
+    first: usize,
+    exclude: usize,
+    out: &mut [u32],
+) -> usize {
+    use std::arch::x86_64::*;
+    let (ax, ay, az) = (
+        _mm512_set1_pd(at.0),
+        _mm512_set1_pd(at.1),
+        _mm512_set1_pd(at.2),
+    );
+    let limit = _mm512_set1_pd(reach2);
+    let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let n = x.len();
+    let mut kept = 0;
+    let mut m = 0;
+    while m < n {
+        let valid: __mmask8 = if n - m >= 8 {
+            0xff
+        } else {
+            ((1u32 << (n - m)) - 1) as u8
+        };
+        // SAFETY: lanes outside `valid` are not read.
+        let (xj, yj, zj) = unsafe {
+            (
+                _mm512_maskz_loadu_pd(valid, x.as_ptr().add(m)),
+                _mm512_maskz_loadu_pd(valid, y.as_ptr().add(m)),
+                _mm512_maskz_loadu_pd(valid, z.as_ptr().add(m)),
+            )
+        };
+        let (dx, dy, dz) = (
+            _mm512_sub_pd(ax, xj),
+            _mm512_sub_pd(ay, yj),
+            _mm512_sub_pd(az, zj),
+        );
+        let r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
+        let mut near = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(valid, r2, limit);
+        let j0 = first + m;
+        if exclude >= j0 && exclude < j0 + 8 {
+            near &= !(1u8 << (exclude - j0));
+        }
+        let index = _mm256_add_epi32(lanes, _mm256_set1_epi32(j0 as i32));
+        let packed = _mm256_maskz_compress_epi32(near, index);
+        // SAFETY: kept ≤ m and out.len() ≥ n + 8 ≥ kept + 8.
+        unsafe { _mm256_storeu_si256(out.as_mut_ptr().add(kept) as *mut __m256i, packed) };
+        kept += near.count_ones() as usize;
+        m += 8;
+    }
+    kept
+}
+
+/// Cells of edge ≥ r_c + skin over the box and its ghost shell (periodic
+/// axes) or over the particles' extent (open axes).
+struct Grid {
+    lo: DVec3,
+    inverse_edge: DVec3,
+    dims: [u32; 3],
+}
+
+impl Grid {
+    fn new(wrapped: &[DVec3], boundary: &Boundary, reach: f64) -> Self {
+        let mut lo = DVec3::ZERO;
+        let mut inverse_edge = DVec3::ZERO;
+        let mut dims = [1u32; 3];
+        for k in 0..3 {
+            let (a, b) = if boundary.periodic[k] {
+                (boundary.lo[k] - reach, boundary.hi[k] + reach)
+            } else {
+                let a = wrapped.iter().map(|r| r[k]).fold(f64::INFINITY, f64::min);
+                let b = wrapped
+                    .iter()
+                    .map(|r| r[k])
+                    .fold(f64::NEG_INFINITY, f64::max);
+                if a.is_finite() {
+                    (a, b)
+                } else {
+                    (0.0, 1.0)
+                }
+            };
+            let len = (b - a).max(reach);
+            dims[k] = ((len / reach).floor() as u32).clamp(1, 1 << 10);
+            lo[k] = a;
+            inverse_edge[k] = dims[k] as f64 / len;
+        }
+        Self {
+            lo,
+            inverse_edge,
+            dims,
+        }
+    }
+
+    fn count(&self) -> usize {
+        (self.dims[0] * self.dims[1] * self.dims[2]) as usize
+    }
+
+    fn coords(&self, r: DVec3) -> [u32; 3] {
+        let mut c = [0; 3];
+        for k in 0..3 {
+            let x = ((r[k] - self.lo[k]) * self.inverse_edge[k]).floor();
+            c[k] = x.clamp(0.0, (self.dims[k] - 1) as f64) as u32;
+        }
+        c
+    }
+
+    fn cell(&self, r: DVec3) -> u32 {
+        let [x, y, z] = self.coords(r);
+        x + self.dims[0] * (y + self.dims[1] * z)
+    }
+
+    /// Start of each cell's members in [`Grid::counting_sort`]'s order.
+    fn first(&self, cells: &[u32]) -> Vec<u32> {
+        let mut first = vec![0u32; self.count() + 1];
+        for &c in cells {
+            first[c as usize + 1] += 1;
+        }
+        for c in 0..self.count() {
+            first[c + 1] += first[c];
+        }
+        first
+    }
+
+    /// Indices sorted by cell, stable within a cell.
+    fn counting_sort(&self, cells: &[u32]) -> Vec<u32> {
+        let mut fill = self.first(cells);
+        let mut order = vec![0u32; cells.len()];
+        for (i, &c) in cells.iter().enumerate() {
+            order[fill[c as usize] as usize] = i as u32;
+            fill[c as usize] += 1;
+        }
+        order
+    }
+
+    /// Calls `f(first, last)` for the nine runs of cells along x around
+    /// cell `c` (itself included), clipped to the grid: the ghost shell
+    /// stands in for periodic neighbours.
+    fn for_each_run_around(&self, c: u32, mut f: impl FnMut(usize, usize)) {
+        let [dx, dy] = [self.dims[0], self.dims[1]];
+        let (x, y, z) = (c % dx, (c / dx) % dy, c / (dx * dy));
+        let span = |v: u32, d: u32| v.saturating_sub(1)..=(v + 1).min(d - 1);
+        let (x0, x1) = (x.saturating_sub(1), (x + 1).min(dx - 1));
+        for cz in span(z, self.dims[2]) {
+            for cy in span(y, dy) {
+                let row = dx * (cy + dy * cz);
+                f((row + x0) as usize, (row + x1) as usize);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scatter(n: usize, l: DVec3, seed: u64) -> Vec<DVec3> {
+        let mut s = seed;
+        let mut u = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|_| DVec3::new(u() * l.x, u() * l.y, u() * l.z))
+            .collect()
+    }
+
+    /// Every pair within r_c + skin (minimum image) is in both rows, once,
+    /// and nothing else; periodic, mixed and open boundaries.
+    #[test]
+    fn rows_hold_exactly_the_pairs_in_reach() {
+        let l = DVec3::new(7.0, 8.0, 9.0);
+        for periodic in [[true; 3], [true, false, true], [false; 3]] {
+            let b = Boundary {
+                lo: DVec3::ZERO,
+                hi: l,
+                periodic,
+            };
+            let pos = scatter(600, l, 7);
+            let mut list = GhostList::new(1.1, 0.4);
+            list.build(&pos, &b);
+            let reach2 = 1.5f64 * 1.5;
+            for i in 0..pos.len() {
+                let r = list.slot[i] as usize;
+                let k = list.owner[r] as usize;
+                let mut seen: Vec<usize> = list
+                    .row(r)
+                    .iter()
+                    .map(|&j| list.particle[j as usize] as usize)
+                    .collect();
+                seen.sort_unstable();
+                let expect: Vec<usize> = (0..pos.len())
+                    .filter(|&j| {
+                        j != i && b.minimum_image(pos[j] - pos[i]).length_squared() < reach2
+                    })
+                    .collect();
+                assert_eq!(seen, expect, "particle {i}, periodic {periodic:?}");
+                for &j in list.row(r) {
+                    let j = j as usize;
+                    let d = list.at(k) - list.at(j);
+                    let i2 = list.particle[j] as usize;
+                    let m = b.minimum_image(pos[i] - pos[i2]);
+                    assert!((d - m).length() < 1e-12);
+                }
+            }
+        }
+    }
+
+    /// Copies follow wrapped particles between builds.
+    #[test]
+    fn copies_follow_wrapped_particles() {
+        let l = DVec3::splat(6.0);
+        let b = Boundary {
+            lo: DVec3::ZERO,
+            hi: l,
+            periodic: [true; 3],
+        };
+        let mut pos = scatter(300, l, 3);
+        let mut list = GhostList::new(1.0, 0.6);
+        list.update(&pos, &b);
+        for r in pos.iter_mut() {
+            *r = b.wrap(*r + DVec3::new(0.2, -0.1, 0.15));
+        }
+        assert!(!list.update(&pos, &b));
+        for i in 0..pos.len() {
+            let r = list.slot[i] as usize;
+            let k = list.owner[r] as usize;
+            for &j in list.row(r) {
+                let j = j as usize;
+                let d = list.at(k) - list.at(j);
+                let m = b.minimum_image(pos[i] - pos[list.particle[j] as usize]);
+                assert!((d - m).length() < 1e-12);
+            }
+        }
+    }
+}
