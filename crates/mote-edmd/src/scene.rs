@@ -64,6 +64,8 @@ impl Default for BoundarySpec {
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
+    /// One line saying what the scene shows (listed by `mote examples`).
+    pub title: Option<String>,
     /// 2 (disks) or 3 (spheres). Default 3.
     #[serde(default = "default_dim")]
     pub dimension: usize,
@@ -536,12 +538,17 @@ pub struct Run {
     pub speeds: Vec<f64>,
     /// Final velocities (3 components, z = 0 for disks), kept for N ≤ 1000.
     pub final_velocities: Vec<[f64; 3]>,
+    /// The state at the end (for a picture of it).
+    pub final_frame: Option<mote_io::xyz::Frame>,
     pub outputs: Vec<PathBuf>,
 }
 
 /// Output destinations and provenance.
 pub struct Outputs {
+    /// Folder the output files go to.
     pub base: PathBuf,
+    /// Folder the scene's own relative paths (`file = ...`) resolve against.
+    pub scene_dir: PathBuf,
     pub provenance: mote_io::Provenance,
 }
 
@@ -553,7 +560,7 @@ pub fn run_scene<const D: usize>(
     out: &Outputs,
     mut progress: impl FnMut(f64),
 ) -> Result<Run, EdmdError> {
-    let mut sys = scene.build::<D>(seed, &out.base)?;
+    let mut sys = scene.build::<D>(seed, &out.scene_dir)?;
     let n = sys.len();
     let e0 = sys.kinetic_energy();
     let p0 = sys.momentum();
@@ -744,6 +751,7 @@ pub fn run_scene<const D: usize>(
         result.outputs.push(w.path().to_path_buf());
     }
     result.speeds = speeds;
+    result.final_frame = Some(frame(&sys));
     if n <= 1000 {
         result.final_velocities = sys.velocities().iter().map(to3).collect();
     }

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use mote_md::rigid::scene::{is_rigid_scene, run_rigid_scene, RigidScene};
+use mote_md::rigid::scene::{is_rigid_scene, run_rigid_scene, RigidRun, RigidScene};
 
 fn example(name: &str) -> String {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -44,7 +44,16 @@ fn examples_build() {
 fn magnet_example_runs() {
     let text = example("magnet-in-field.toml");
     let dir = tempfile::tempdir().unwrap();
-    let r = run_rigid_scene(&text, "magnet-in-field.toml", None, Some(dir.path()), true).unwrap();
+    let r = run_rigid_scene(
+        &text,
+        "magnet-in-field.toml",
+        &RigidRun {
+            out_dir: Some(dir.path().to_path_buf()),
+            ..RigidRun::default()
+        },
+        |_, _, _| {},
+    )
+    .unwrap();
     assert_eq!(r.steps, 20000);
     assert!((r.time - 200.0).abs() < 1e-9);
     let table = mote_io::csv::read_table(&dir.path().join("observables.csv")).unwrap();
@@ -102,8 +111,16 @@ fn run_scene_file() {
     };
     let text = std::fs::read_to_string(&path).unwrap();
     let out = std::env::var("MOTE_RIGID_OUT").ok();
-    let r = run_rigid_scene(&text, &path, None, out.as_deref().map(Path::new), true)
-        .unwrap_or_else(|e| panic!("{e}"));
+    let r = run_rigid_scene(
+        &text,
+        &path,
+        &RigidRun {
+            out_dir: out.as_deref().map(std::path::PathBuf::from),
+            ..RigidRun::default()
+        },
+        |_, _, _| {},
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     println!(
         "{} bodies, {} spheres, {} steps, t = {}, {:.3} s wall, {:.4} µs per body-step\nKE {:e} PE {:e} P {} L {}",
         r.bodies,

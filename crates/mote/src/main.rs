@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
-mod examples;
+mod progress;
 
 /// mote — many-particle simulation toolkit.
 #[derive(Parser, Debug)]
@@ -48,7 +48,7 @@ enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
-    /// Event-driven hard spheres and disks; see `mote edmd --help`.
+    /// Event-driven hard spheres and disks (an alias of `mote run` kept for one release); see `mote edmd --help`.
     #[command(disable_help_flag = true, disable_version_flag = true)]
     Edmd {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]

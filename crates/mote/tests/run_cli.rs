@@ -66,6 +66,9 @@ fn until_overrides_the_scene() {
     assert_eq!(*table.column("time").unwrap().last().unwrap(), 10.0);
 }
 
+/// `mote examples` lists every engine's examples under a heading each,
+/// and every example, written out, runs through `mote run` (a few steps,
+/// or a short time for the event-driven ones).
 #[test]
 fn examples_are_listed_and_written_and_each_one_runs() {
     let dir = tempfile::tempdir().unwrap();
@@ -84,19 +87,48 @@ fn examples_are_listed_and_written_and_each_one_runs() {
         "rotating-drum",
         "plummer",
         "ferrofluid",
+        "magnet-in-field",
+        "clumps-settling",
+        "chains-rotating-field",
+        "cube",
+        "cradle-heavy",
+        "maxwell2d",
+        "eos",
     ] {
         assert!(list.contains(name), "{name} missing from {list}");
     }
+    for heading in [
+        "point particles",
+        "rigid clumps of spheres",
+        "hard spheres and disks",
+    ] {
+        assert!(list.contains(heading), "{heading} missing from {list}");
+    }
     let o = mote(&["examples", "--write", "scenes"], dir.path());
     assert!(o.status.success());
+    let mut engines = std::collections::HashSet::new();
     for entry in std::fs::read_dir(dir.path().join("scenes")).unwrap() {
         let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let engine = mote_front::Engine::of_scene(&text);
+        engines.insert(format!("{engine:?}"));
+        let length = match engine {
+            mote_front::Engine::EventDriven => {
+                let table: toml::Table = text.parse().unwrap();
+                let equilibrate = table
+                    .get("equilibrate")
+                    .and_then(|v| v.as_float())
+                    .unwrap_or(0.0);
+                ["--until".to_string(), format!("{}", equilibrate + 0.05)]
+            }
+            _ => ["--steps".to_string(), "3".to_string()],
+        };
         let o = mote(
             &[
                 "run",
                 path.to_str().unwrap(),
-                "--steps",
-                "3",
+                &length[0],
+                &length[1],
                 "-q",
                 "-o",
                 "o",
@@ -105,6 +137,138 @@ fn examples_are_listed_and_written_and_each_one_runs() {
         );
         assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
     }
+    assert_eq!(engines.len(), 3, "{engines:?}");
+}
+
+/// An event-driven scene run by `mote run` writes the same files, byte for
+/// byte, as by the old `mote edmd` (same seed, same simulated time).
+#[test]
+fn event_driven_scene_runs_through_mote_run_as_through_mote_edmd() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &[
+            "run",
+            "example:maxwell2d",
+            "--until",
+            "3",
+            "--seed",
+            "99",
+            "-o",
+            "run",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary = String::from_utf8_lossy(&o.stdout);
+    assert!(summary.contains("250 disks"), "{summary}");
+    let o = mote(
+        &[
+            "edmd",
+            "example:maxwell2d",
+            "--time",
+            "3",
+            "--seed",
+            "99",
+            "--out-dir",
+            "edmd",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    for file in ["maxwell2d.xyz", "maxwell2d.csv", "maxwell2d-speeds.csv"] {
+        let a = std::fs::read(dir.path().join("run").join(file)).unwrap();
+        let b = std::fs::read(dir.path().join("edmd").join(file)).unwrap();
+        assert!(a.len() > 100, "{file} is nearly empty");
+        assert_eq!(a, b, "{file} differs between mote run and mote edmd");
+    }
+}
+
+/// Options an engine does not have are refused, each named with the
+/// reason, and nothing runs; none is silently ignored.
+#[test]
+fn options_an_engine_lacks_are_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &["run", "example:cradle", "--dt", "0.1", "--steps", "4"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(
+        err.contains("--dt (event-driven dynamics jumps from collision to collision")
+            && err.contains("--steps ("),
+        "{err}"
+    );
+    let o = mote(
+        &["run", "example:magnet-in-field", "--checkpoint-every", "10"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(
+        err.contains("--checkpoint-every (rigid runs do not write checkpoints yet)"),
+        "{err}"
+    );
+    let o = mote(
+        &[
+            "run",
+            "example:sun-earth",
+            "--system",
+            "springs",
+            "--steps",
+            "2",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--system chooses the model of an MPPphys particle file"));
+    assert!(
+        !dir.path().join("out").exists(),
+        "a refused run wrote files"
+    );
+}
+
+/// A rigid run honours --dt, --steps, --seed, -o and --picture, and a
+/// scene without a seed gets one chosen and printed.
+#[test]
+fn rigid_run_takes_the_common_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/rigid/magnet-in-field.toml"
+    ))
+    .unwrap()
+    .replace("seed = 1\n", "");
+    std::fs::write(dir.path().join("m.toml"), scene).unwrap();
+    let o = mote(
+        &[
+            "run",
+            "m.toml",
+            "--dt",
+            "0.002",
+            "--steps",
+            "7",
+            "-o",
+            "m",
+            "--picture",
+            "m.png",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("(chosen)") && err.contains("dt = 0.002"),
+        "{err}"
+    );
+    let summary = String::from_utf8_lossy(&o.stdout);
+    assert!(summary.contains("7 steps to t = 1.400000e-2"), "{summary}");
+    let t = mote_io::csv::read_table(&dir.path().join("m/observables.csv")).unwrap();
+    let time = t.column("time").unwrap();
+    let last = *time.last().unwrap();
+    assert!((last - 7.0 * 0.002).abs() < 1e-15, "last row at t = {last}");
+    let png = std::fs::read(dir.path().join("m.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
 }
 
 #[test]

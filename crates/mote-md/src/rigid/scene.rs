@@ -71,7 +71,7 @@
 //! trajectory_every = 1000
 //! ```
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -361,6 +361,10 @@ pub struct Report {
     /// The force on each wall at the last step.
     pub wall_forces: Vec<(String, DVec3)>,
     pub files: Vec<PathBuf>,
+    pub seed: u64,
+    pub dt: f64,
+    /// The spheres at the end (for a picture).
+    pub final_frame: Frame,
 }
 
 fn line_of(text: &str, offset: usize) -> usize {
@@ -856,21 +860,86 @@ fn random_sites(
     Ok(taken[first..].iter().map(|(x, _)| *x).collect())
 }
 
+/// What a caller changes about a rigid scene's run; `None` keeps the scene's.
+#[derive(Debug, Clone, Default)]
+pub struct RigidRun {
+    /// Replaces the scene's seed (the scene's, else 1, when absent).
+    pub seed: Option<u64>,
+    /// Replaces `[output] dir`.
+    pub out_dir: Option<PathBuf>,
+    /// Replaces `[run] dt`.
+    pub dt: Option<f64>,
+    /// Replaces the run length by a number of steps.
+    pub steps: Option<u64>,
+    /// Replaces the run length by an end time (steps = round(t/dt)).
+    pub until: Option<f64>,
+}
+
+/// The spheres of every body as an extended-XYZ frame: world positions,
+/// velocities v + ω × (c − x), radii; species `B<kind>`.
+pub fn sphere_frame(b: &RigidBodies) -> Frame {
+    let mut world = super::interaction::WorldFrame::default();
+    world.update(b);
+    let positions: Vec<[f64; 3]> = world.sphere_centre.iter().map(|c| c.to_array()).collect();
+    let velocities: Vec<[f64; 3]> = world
+        .sphere_centre
+        .iter()
+        .zip(&world.sphere_body)
+        .map(|(c, &k)| {
+            let k = k as usize;
+            (b.velocity[k] + b.omega[k].cross(*c - b.position[k])).to_array()
+        })
+        .collect();
+    let (cell, origin) = Frame::bounding_cell(&positions, &world.sphere_radius, 1.0);
+    Frame {
+        time: b.time,
+        cell,
+        origin,
+        pbc: [false; 3],
+        species: world
+            .sphere_body
+            .iter()
+            .map(|k| format!("B{}", b.kind[*k as usize]))
+            .collect(),
+        positions,
+        velocities,
+        radii: world.sphere_radius.clone(),
+    }
+}
+
 /// Runs a rigid scene: `text` is the TOML, `file_label` locates errors and
-/// goes into the provenance headers, `seed_override` replaces the scene's
-/// seed, `out_dir` replaces `[output] dir`. Writes `observables.csv` and,
-/// with `trajectory_every` > 0, `trajectory.xyz` (the spheres).
+/// goes into the provenance headers, `options` replace the scene's seed,
+/// output folder, time step or run length. Writes `observables.csv` and,
+/// with `trajectory_every` > 0, `trajectory.xyz` (the spheres). Calls
+/// `progress(step, steps, time)` after every step.
 pub fn run_rigid_scene(
     text: &str,
     file_label: &str,
-    seed_override: Option<u64>,
-    out_dir: Option<&Path>,
-    quiet: bool,
+    options: &RigidRun,
+    mut progress: impl FnMut(u64, u64, f64),
 ) -> Result<Report, MdError> {
     let scene = RigidScene::parse(text, file_label)?;
-    let mut built = scene.build(text, file_label, seed_override)?;
-    let dir = out_dir
-        .map(Path::to_path_buf)
+    let mut built = scene.build(text, file_label, options.seed)?;
+    if let Some(dt) = options.dt {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(
+                ParseError::new(file_label, 0, format!("time step {dt}: must be > 0")).into(),
+            );
+        }
+        built.steps = match scene.run.get_ref().until {
+            Some(t) => (t / dt).round() as u64,
+            None => built.steps,
+        };
+        built.dt = dt;
+    }
+    if let Some(n) = options.steps {
+        built.steps = n;
+    } else if let Some(t) = options.until {
+        built.steps = (t / built.dt).round() as u64;
+    }
+    let dir = options
+        .out_dir
+        .clone()
         .unwrap_or_else(|| PathBuf::from(&scene.output.dir));
     std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
     let provenance = Provenance {
@@ -943,35 +1012,7 @@ pub fn run_rigid_scene(
             Ok((o.kinetic_energy(), e.potential))
         };
     let frame = |b: &RigidBodies, xyz: &mut XyzWriter| -> Result<(), MdError> {
-        let mut world = super::interaction::WorldFrame::default();
-        world.update(b);
-        let positions: Vec<[f64; 3]> = world.sphere_centre.iter().map(|c| c.to_array()).collect();
-        let velocities: Vec<[f64; 3]> = world
-            .sphere_centre
-            .iter()
-            .zip(&world.sphere_body)
-            .map(|(c, &k)| {
-                let k = k as usize;
-                (b.velocity[k] + b.omega[k].cross(*c - b.position[k])).to_array()
-            })
-            .collect();
-        let (cell, origin) = Frame::bounding_cell(&positions, &world.sphere_radius, 1.0);
-        let fr = Frame {
-            time: b.time,
-            cell,
-            origin,
-            pbc: [false; 3],
-            species: world
-                .sphere_body
-                .iter()
-                .map(|k| format!("B{}", b.kind[*k as usize]))
-                .collect(),
-            positions,
-            velocities,
-            radii: world.sphere_radius.clone(),
-        };
-        xyz.write(&fr)?;
-        Ok(())
+        Ok(xyz.write(&sphere_frame(b))?)
     };
     let start = Instant::now();
     sample(b, f, &mut csv)?;
@@ -993,18 +1034,13 @@ pub fn run_rigid_scene(
                     what: "a non-finite velocity".into(),
                 });
             }
-            if !quiet {
-                eprintln!(
-                    "step {step}/{} t = {:.6e} KE = {ke:.6e}",
-                    built.steps, b.time
-                );
-            }
         }
         if let Some(x) = xyz.as_mut() {
             if traj_every > 0 && step % traj_every == 0 {
                 frame(b, x)?;
             }
         }
+        progress(step, built.steps, b.time);
     }
     let wall_seconds = start.elapsed().as_secs_f64();
     let e = f.energies(b);
@@ -1021,5 +1057,8 @@ pub fn run_rigid_scene(
         angular_momentum: o.angular_momentum,
         wall_forces: contacts.map(|c| c.wall_forces()).unwrap_or_default(),
         files,
+        seed: built.seed,
+        dt: built.dt,
+        final_frame: sphere_frame(b),
     })
 }

@@ -1,11 +1,11 @@
-//! `mote examples`: list the built-in examples or write them out to edit.
+//! `mote examples`: list the built-in examples of every engine, grouped, or
+//! write their scene files out to edit.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-
-use crate::examples;
+use mote_front::{examples, Engine};
 
 #[derive(clap::Args, Debug)]
 pub struct ExamplesArgs {
@@ -30,10 +30,13 @@ pub fn run(global: &super::GlobalOpts, args: ExamplesArgs) -> anyhow::Result<Exi
         return Ok(ExitCode::SUCCESS);
     }
     let width = all.iter().map(|e| e.name.len()).max().unwrap_or(0);
-    for e in &all {
-        println!("{:width$}  {}", e.name, examples::title(&e.text));
+    for engine in [Engine::Particles, Engine::Rigid, Engine::EventDriven] {
+        println!("{}:", engine.title());
+        for e in all.iter().filter(|e| e.engine == engine) {
+            println!("  {:width$}  {}", e.name, e.description);
+        }
+        println!();
     }
-    println!("\nrun one with `mote run example:NAME`; copy them with `mote examples --write DIR`");
-    println!("event-driven hard-sphere examples: `mote edmd --list`");
+    println!("run one with `mote run example:NAME`; copy them with `mote examples --write DIR`");
     Ok(ExitCode::SUCCESS)
 }

@@ -1,0 +1,90 @@
+//! Which engine a scene describes.
+
+/// The engines `mote run` drives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Engine {
+    /// Point particles with fixed-step integrators or Brownian dynamics
+    /// (gravity, springs, Lennard-Jones, granular contacts, dipoles).
+    Particles,
+    /// Rigid clumps of overlapping spheres moved by the FRBI (`[rigid]`).
+    Rigid,
+    /// Event-driven hard spheres and disks (mote-edmd).
+    EventDriven,
+}
+
+/// Top-level keys only an event-driven scene has.
+const EVENT_DRIVEN_KEYS: &[&str] = &[
+    "event_driven",
+    "dimension",
+    "n",
+    "packing_fraction",
+    "placement",
+    "output_interval",
+    "time",
+    "equilibrate",
+    "histogram",
+    "trajectory",
+    "observables",
+    "check_overlaps",
+    "speed",
+    "temperature",
+    "large_fraction",
+    "size_ratio",
+    "particles",
+];
+
+impl Engine {
+    /// The engine of a TOML scene: `[rigid]` means rigid bodies; the keys
+    /// of an event-driven scene (or a `box` given as a list of lengths)
+    /// mean hard spheres; anything else is a point-particle scene. A text
+    /// that is not TOML is left to the point-particle parser, whose error
+    /// names the line.
+    pub fn of_scene(text: &str) -> Engine {
+        let Ok(table) = text.parse::<toml::Table>() else {
+            return Engine::Particles;
+        };
+        if table.contains_key("rigid") {
+            Engine::Rigid
+        } else if EVENT_DRIVEN_KEYS.iter().any(|k| table.contains_key(*k))
+            || table.get("box").is_some_and(|b| b.is_array())
+        {
+            Engine::EventDriven
+        } else {
+            Engine::Particles
+        }
+    }
+
+    /// The heading `mote examples` groups this engine's examples under.
+    pub fn title(self) -> &'static str {
+        match self {
+            Engine::Particles => "point particles (fixed-step integrators, Brownian dynamics)",
+            Engine::Rigid => "rigid clumps of spheres (Fast Rigid Bodies Integrator)",
+            Engine::EventDriven => "hard spheres and disks (event-driven)",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn engines_of_the_built_in_examples() {
+        for e in crate::examples::all() {
+            assert_eq!(Engine::of_scene(&e.text), e.engine, "example {}", e.name);
+        }
+    }
+
+    #[test]
+    fn a_list_box_is_event_driven_a_table_box_is_not() {
+        assert_eq!(
+            Engine::of_scene("box = [1.0, 1.0, 1.0]\n"),
+            Engine::EventDriven
+        );
+        assert_eq!(
+            Engine::of_scene("[box]\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, 1.0]\n"),
+            Engine::Particles
+        );
+        assert_eq!(Engine::of_scene("[rigid]\n"), Engine::Rigid);
+    }
+}

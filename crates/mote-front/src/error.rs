@@ -1,0 +1,35 @@
+//! Errors of the front: the engines' own, and bad requests.
+
+use mote_io::{IoError, ParseError};
+
+#[derive(Debug, thiserror::Error)]
+pub enum FrontError {
+    #[error(transparent)]
+    Parse(#[from] ParseError),
+    #[error(transparent)]
+    Io(#[from] IoError),
+    #[error(transparent)]
+    Md(#[from] mote_md::MdError),
+    #[error(transparent)]
+    Edmd(#[from] mote_edmd::EdmdError),
+    #[error(transparent)]
+    Render(#[from] mote_render::RenderError),
+    /// A request that cannot be served (an unknown example, an option the
+    /// scene's engine does not have, a missing run length), said in words.
+    #[error("{0}")]
+    Request(String),
+}
+
+impl FrontError {
+    pub fn request(message: impl Into<String>) -> Self {
+        FrontError::Request(message.into())
+    }
+}
+
+/// `return Err(FrontError::Request(format!(...)))`.
+macro_rules! refuse {
+    ($($arg:tt)*) => {
+        return Err($crate::error::FrontError::Request(format!($($arg)*)))
+    };
+}
+pub(crate) use refuse;

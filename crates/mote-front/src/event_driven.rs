@@ -1,0 +1,210 @@
+//! Event-driven hard spheres and disks (`mote_edmd::scene::run_scene`).
+
+use std::path::{Path, PathBuf};
+
+use mote_edmd::scene::{run_scene, Outputs};
+use mote_edmd::Scene;
+
+use crate::error::{refuse, FrontError};
+use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
+
+/// The words of the old `mote edmd` command, kept as an alias for one
+/// release: `--time` is the measured time after `equilibrate` (where
+/// `--until` is the end time), and `--no-output` writes no files.
+#[derive(Debug, Clone, Default)]
+pub struct EdmdWords {
+    pub time: Option<f64>,
+    pub no_output: bool,
+}
+
+pub(crate) fn run(
+    input: &Input,
+    options: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    run_with(input, options, &EdmdWords::default(), monitor)
+}
+
+/// Runs an event-driven scene; `words` are the old command's options.
+pub fn run_with(
+    input: &Input,
+    options: &RunOptions,
+    words: &EdmdWords,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    const WHY_NO_STEP: &str =
+        "event-driven dynamics jumps from collision to collision, with no time step";
+    options.refuse(
+        "event-driven hard spheres",
+        &[
+            (options.dt.is_some(), "--dt", WHY_NO_STEP),
+            (options.steps.is_some(), "--steps", WHY_NO_STEP),
+            (
+                options.checkpoint_every.is_some(),
+                "--checkpoint-every",
+                "event-driven runs do not write checkpoints yet",
+            ),
+            (
+                options.solver.is_some(),
+                "--solver",
+                "collisions are predicted exactly; there is no integrator to choose",
+            ),
+            (
+                options.system.is_some(),
+                "--system",
+                "it chooses the model of an MPPphys particle file",
+            ),
+        ],
+    )?;
+    let mut scene = Scene::parse(&input.text, &input.label)?;
+    if let Some(t) = options.until {
+        if !(t.is_finite() && t > scene.equilibrate) {
+            refuse!(
+                "--until {t}: must be a time after the scene's equilibration ({})",
+                scene.equilibrate
+            );
+        }
+        scene.time = t - scene.equilibrate;
+    }
+    if let Some(t) = words.time {
+        if !(t >= 0.0 && t.is_finite()) {
+            refuse!("--time {t}: must be a non-negative number");
+        }
+        scene.time = t;
+    }
+    if words.no_output {
+        scene.trajectory = None;
+        scene.observables = None;
+        scene.histogram = None;
+    }
+    let dir = options
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
+    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
+    let scene_dir = if input.label.starts_with("example:") {
+        PathBuf::from(".")
+    } else {
+        Path::new(&input.label)
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."))
+    };
+    let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
+    monitor.start(&format!(
+        "mote run {}: event-driven hard {}, simulated time {} after {} of equilibration, {}",
+        input.label,
+        if scene.dimension == 2 {
+            "disks"
+        } else {
+            "spheres"
+        },
+        scene.time,
+        scene.equilibrate,
+        crate::seed_phrase(seed, chosen),
+    ));
+    let out = Outputs {
+        base: dir.clone(),
+        scene_dir,
+        provenance: crate::provenance(&input.label, seed),
+    };
+    let cpu0 = crate::cpu::cpu_seconds();
+    let progress = |f: f64| monitor.progress((f * 1000.0) as u64, 1000, "");
+    let r = match scene.dimension {
+        2 => run_scene::<2>(&scene, seed, &out, progress),
+        _ => run_scene::<3>(&scene, seed, &out, progress),
+    };
+    let r = r.map_err(|e| FrontError::request(format!("{}: run stopped: {e}", input.label)))?;
+    let cpu = crate::cpu::cpu_seconds() - cpu0;
+    let mut outcome = Outcome {
+        engine: Engine::EventDriven,
+        seed,
+        dir,
+        summary: summary(&r, &scene, cpu),
+        ending: Ending::Finished,
+    };
+    if let (Some(png), Some(frame)) = (&options.picture, &r.final_frame) {
+        mote_render::frame::picture(frame, png, 1920, 1080)?;
+        outcome
+            .summary
+            .push(format!("Picture of the final state: {}.", png.display()));
+    }
+    Ok(outcome)
+}
+
+/// The paragraph that ends an event-driven run, then the final speeds of
+/// small systems (Newton's cradles) and the files written.
+fn summary(r: &mote_edmd::Run, scene: &Scene, cpu: f64) -> Vec<String> {
+    let rate = if cpu > 0.05 {
+        format!("{:.3e}", r.collisions as f64 / cpu)
+    } else {
+        "(too short to time)".to_string()
+    };
+    let mut s = format!(
+        "{} {} (packing fraction {:.4}, seed {}): simulated t = {} after {} of equilibration with {} pair collisions and {} wall collisions \
+         ({} events in all) in {:.3} s CPU / {:.3} s wall, {} collisions per CPU-second. ",
+        r.n,
+        if r.dimension == 2 { "disks" } else { "spheres" },
+        r.packing_fraction,
+        r.seed,
+        r.simulated_time,
+        scene.equilibrate,
+        r.collisions,
+        r.wall_hits,
+        r.events,
+        cpu,
+        r.wall_seconds,
+        rate
+    );
+    if r.z.is_finite() {
+        s += &format!(
+            "Compressibility factor Z = {:.4} ({} {:.4}, {:+.2} %). ",
+            r.z,
+            if r.dimension == 2 {
+                "Henderson"
+            } else {
+                "Carnahan-Starling"
+            },
+            r.z_reference,
+            100.0 * (r.z - r.z_reference) / r.z_reference
+        );
+    }
+    if r.wall_pressure.is_finite() {
+        s += &format!("Wall pressure {:.4e}. ", r.wall_pressure);
+    }
+    if r.collisions > 0 {
+        s += &format!(
+            "Collision rate {:.4} per particle per unit time (mean free time {:.4e}). ",
+            r.collision_rate, r.mean_free_time
+        );
+    }
+    s += &format!(
+        "kT = {:.6}; energy drift {:.1e}",
+        r.temperature, r.energy_drift
+    );
+    if r.momentum_drift.is_finite() {
+        s += &format!(", momentum drift {:.1e}", r.momentum_drift);
+    }
+    s += &format!(
+        "; speeds vs Maxwell-Boltzmann: KS D = {:.4}, p = {:.3}.",
+        r.ks.0, r.ks.1
+    );
+    let mut lines = vec![s];
+    if r.n <= 10 {
+        let v: Vec<String> = r.speeds.iter().map(|x| format!("{x:.12}")).collect();
+        lines.push(format!("final speeds: {}", v.join(" ")));
+        if !r.final_velocities.is_empty() {
+            let v: Vec<String> = r
+                .final_velocities
+                .iter()
+                .map(|v| format!("{:+.12}", v[0]))
+                .collect();
+            lines.push(format!("final x-velocities: {}", v.join(" ")));
+        }
+    }
+    for p in &r.outputs {
+        lines.push(format!("wrote {}", p.display()));
+    }
+    lines
+}

@@ -1,0 +1,74 @@
+//! What `mote run` was given: a scene file, an MPPphys particle file, a
+//! built-in example, or a scene text handed over by the Python API.
+
+use std::path::Path;
+
+use crate::engine::Engine;
+use crate::error::{refuse, FrontError};
+use crate::examples;
+
+/// The input text and the names it goes by.
+#[derive(Debug, Clone)]
+pub struct Input {
+    /// Short name: the file stem or the example's name (`out/NAME`).
+    pub name: String,
+    /// How messages and output headers name it: the path or `example:NAME`.
+    pub label: String,
+    pub text: String,
+    /// An MPPphys particle file rather than a TOML scene.
+    pub plist: bool,
+}
+
+impl Input {
+    /// Reads `spec`: `example:NAME`, a `.toml` scene file, or any other file
+    /// as an MPPphys particle file.
+    pub fn read(spec: &str) -> Result<Input, FrontError> {
+        if let Some(name) = spec.strip_prefix("example:") {
+            let Some(e) = examples::find(name) else {
+                let names: Vec<String> = examples::all().into_iter().map(|e| e.name).collect();
+                refuse!(
+                    "no example called '{name}'; the examples are: {}",
+                    names.join(", ")
+                );
+            };
+            return Ok(Input {
+                name: name.to_string(),
+                label: spec.to_string(),
+                text: e.text,
+                plist: false,
+            });
+        }
+        let path = Path::new(spec);
+        let text = std::fs::read_to_string(path).map_err(|e| mote_io::IoError::os(path, e))?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "run".into());
+        let plist = path.extension().and_then(|e| e.to_str()) != Some("toml");
+        Ok(Input {
+            name,
+            label: spec.to_string(),
+            text,
+            plist,
+        })
+    }
+
+    /// A scene given as text (`label` names it in messages).
+    pub fn scene(name: &str, label: &str, text: &str) -> Input {
+        Input {
+            name: name.to_string(),
+            label: label.to_string(),
+            text: text.to_string(),
+            plist: false,
+        }
+    }
+
+    /// The engine that runs this input.
+    pub fn engine(&self) -> Engine {
+        if self.plist {
+            Engine::Particles
+        } else {
+            Engine::of_scene(&self.text)
+        }
+    }
+}

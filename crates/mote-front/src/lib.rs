@@ -1,0 +1,163 @@
+//! mote's one scene front: it reads what a run was given (scene file,
+//! MPPphys particle file, `example:NAME`), picks the engine the scene
+//! describes, applies the common run options to it, runs it and says what
+//! happened. The binary `mote`, the Python API and the viewer all go
+//! through [`run`]; they only parse their own arguments and report.
+//!
+//! Every common option either works for the scene's engine or is refused
+//! with a message that says why ([`RunOptions`]); none is silently ignored.
+
+mod cpu;
+pub mod engine;
+pub mod error;
+pub mod event_driven;
+pub mod examples;
+pub mod input;
+mod particles;
+mod rigid;
+pub mod seed;
+
+use std::path::PathBuf;
+
+pub use engine::Engine;
+pub use error::FrontError;
+pub use input::Input;
+
+/// The options of `mote run`, common to every engine.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Scene file, particle file or `example:NAME` (absent with `resume`).
+    pub input: Option<String>,
+    /// Continue from this checkpoint.
+    pub resume: Option<PathBuf>,
+    /// Write a checkpoint every this many steps and at the end.
+    pub checkpoint_every: Option<u64>,
+    /// Run until this simulated time.
+    pub until: Option<f64>,
+    /// Run this many steps.
+    pub steps: Option<u64>,
+    /// Time step.
+    pub dt: Option<f64>,
+    /// Model of an MPPphys particle file: `nbody` or `springs` (default nbody).
+    pub system: Option<String>,
+    /// Integrator of a point-particle run.
+    pub solver: Option<String>,
+    /// Output folder.
+    pub output: Option<PathBuf>,
+    /// Ray-trace the final state into this PNG.
+    pub picture: Option<PathBuf>,
+    /// Seed (default: the scene's, else chosen and printed).
+    pub seed: Option<u64>,
+    /// Worker threads the caller set up (recorded in the opening line).
+    pub threads: Option<usize>,
+}
+
+impl RunOptions {
+    /// Refuses the options an engine does not have, naming each and why.
+    fn refuse(&self, engine: &str, refused: &[(bool, &str, &str)]) -> Result<(), FrontError> {
+        let named: Vec<String> = refused
+            .iter()
+            .filter(|(given, _, _)| *given)
+            .map(|(_, option, why)| format!("{option} ({why})"))
+            .collect();
+        if named.is_empty() {
+            Ok(())
+        } else {
+            Err(FrontError::request(format!(
+                "{}: option{} not available for {engine}: {}",
+                self.input.as_deref().unwrap_or("the scene"),
+                if named.len() == 1 { "" } else { "s" },
+                named.join("; ")
+            )))
+        }
+    }
+}
+
+/// What a caller shows while a run goes: the opening line and progress.
+pub trait Monitor {
+    /// The line that opens a run: what it is, its size, its seed.
+    fn start(&mut self, line: &str);
+    /// `done` of `total` units (steps, or thousandths of the simulated
+    /// time), with a short note such as the current time.
+    fn progress(&mut self, done: u64, total: u64, note: &str);
+    /// The run has ended (successfully or not).
+    fn finish(&mut self) {}
+}
+
+/// A monitor that shows nothing.
+pub struct Silent;
+
+impl Monitor for Silent {
+    fn start(&mut self, _line: &str) {}
+    fn progress(&mut self, _done: u64, _total: u64, _note: &str) {}
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ending {
+    /// It ran to the end.
+    Finished,
+    /// It went unstable (a non-finite number); the message names the step
+    /// and the particle, and the files written so far are kept.
+    Unstable(String),
+}
+
+/// What a run did: the summary lines to print, where the files went, how
+/// it ended.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub engine: Engine,
+    pub seed: u64,
+    pub dir: PathBuf,
+    pub summary: Vec<String>,
+    pub ending: Ending,
+}
+
+/// Runs what `options` describe with the engine its scene asks for.
+pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, FrontError> {
+    if options.resume.is_some() {
+        // Only time-stepped point-particle runs write checkpoints, so a
+        // checkpoint is always theirs.
+        return particles::run(None, options, monitor);
+    }
+    let Some(spec) = options.input.as_deref() else {
+        error::refuse!("no input: give a scene file, a particle file or example:NAME");
+    };
+    let input = Input::read(spec)?;
+    run_input(&input, options, monitor)
+}
+
+/// Runs an input already read (a scene text from Python, say).
+pub fn run_input(
+    input: &Input,
+    options: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    let result = match input.engine() {
+        Engine::Particles => particles::run(Some(input.clone()), options, monitor),
+        Engine::Rigid => rigid::run(input, options, monitor),
+        Engine::EventDriven => event_driven::run(input, options, monitor),
+    };
+    monitor.finish();
+    result
+}
+
+/// "1 thread" / "2 threads".
+fn threads_phrase() -> String {
+    let n = rayon::current_num_threads();
+    format!("{n} thread{}", if n == 1 { "" } else { "s" })
+}
+
+/// ", seed 7" or ", seed 7 (chosen)".
+fn seed_phrase(seed: u64, chosen: bool) -> String {
+    format!("seed {seed}{}", if chosen { " (chosen)" } else { "" })
+}
+
+/// The provenance every output file of this run starts with.
+fn provenance(label: &str, seed: u64) -> mote_io::Provenance {
+    mote_io::Provenance {
+        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
+        scene: label.to_string(),
+        seed,
+    }
+}

@@ -1,0 +1,443 @@
+//! Point-particle runs: fixed-step integrators and Brownian dynamics
+//! (`mote_md::Simulation`), from a scene, a particle file or a checkpoint.
+
+use std::path::{Path, PathBuf};
+
+use mote_io::checkpoint::{self, Checkpoint};
+use mote_io::{IoError, Provenance};
+use mote_md::output::{ObservablesCsv, TrajectoryXyz};
+use mote_md::scene::{PlistSystem, Scene};
+use mote_md::{MdError, Observables, Observer, RunLength, RunReport, System};
+
+use crate::error::{refuse, FrontError};
+use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
+
+/// Writes DIR/checkpoint.mote on its schedule: the run's input and options
+/// (`template`) with the current state.
+struct CheckpointWriter {
+    path: PathBuf,
+    every: u64,
+    template: Checkpoint,
+    /// The interactions' carried state, taken just before `observe`.
+    carried: Vec<(usize, Vec<f64>)>,
+}
+
+impl Observer for CheckpointWriter {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe_forces(&mut self, forces: &mote_md::ForceField) {
+        self.carried = forces
+            .interactions
+            .iter()
+            .enumerate()
+            .map(|(k, i)| (k, i.carried_state()))
+            .filter(|(_, v)| !v.is_empty())
+            .collect();
+    }
+
+    fn observe(&mut self, sys: &System, _obs: &Observables) -> Result<(), MdError> {
+        let p = &sys.particles;
+        let rotating = !sys.carried_angular_acceleration.is_empty();
+        let cp = Checkpoint {
+            angular: if rotating {
+                p.angular_velocity
+                    .iter()
+                    .zip(&sys.carried_angular_acceleration)
+                    .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            carried: self.carried.clone(),
+            time: sys.time,
+            step: sys.step,
+            positions: p.position.iter().map(|r| r.to_array()).collect(),
+            velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
+            accelerations: sys
+                .carried_acceleration
+                .iter()
+                .map(|a| a.to_array())
+                .collect(),
+            ..self.template.clone()
+        };
+        Ok(checkpoint::write(&self.path, &cp)?)
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.path.display().to_string()]
+    }
+}
+
+fn hex(x: f64) -> String {
+    format!("{:016x}", x.to_bits())
+}
+
+fn unhex(s: &str) -> Result<f64, FrontError> {
+    u64::from_str_radix(s, 16)
+        .map(f64::from_bits)
+        .map_err(|_| FrontError::request("a checkpoint option is not a hexadecimal f64"))
+}
+
+fn number<T: std::str::FromStr>(key: &str, v: String) -> Result<T, FrontError> {
+    v.parse().map_err(|_| {
+        FrontError::request(format!("checkpoint option {key} = '{v}' is not a number"))
+    })
+}
+
+/// Drops what an interrupted run wrote after its last checkpoint (rows past
+/// `step`, frames past `time`), so the resumed run continues the files.
+fn trim_outputs(
+    dir: &Path,
+    step: u64,
+    time: f64,
+    provenance: &Provenance,
+) -> Result<(), FrontError> {
+    let csv = dir.join("observables.csv");
+    if let Ok(text) = std::fs::read_to_string(&csv) {
+        let mut column = None;
+        let mut kept = String::new();
+        for line in text.lines() {
+            let keep = if line.starts_with('#') {
+                true
+            } else if let Some(k) = column {
+                line.split(',')
+                    .nth(k)
+                    .and_then(|v| v.trim().parse::<f64>().ok())
+                    .is_some_and(|s| s <= step as f64)
+            } else {
+                column = line.split(',').position(|c| c.trim() == "step");
+                true
+            };
+            if keep {
+                kept.push_str(line);
+                kept.push('\n');
+            }
+        }
+        std::fs::write(&csv, kept).map_err(|e| IoError::os(&csv, e))?;
+    }
+    let xyz = dir.join("trajectory.xyz");
+    if xyz.exists() {
+        let frames = mote_io::xyz::read_frames(&xyz)?;
+        let mut w = mote_io::xyz::XyzWriter::create(&xyz, provenance.clone())?;
+        for f in frames.iter().filter(|f| f.time <= time) {
+            w.write(f)?;
+        }
+    }
+    Ok(())
+}
+
+/// The input and the options of the run a checkpoint came from.
+fn restore(cp: &Checkpoint, given: &RunOptions) -> Result<(Input, RunOptions), FrontError> {
+    let get = |k: &str| cp.option(k).map(str::to_string);
+    let plist = get("plist").as_deref() == Some("true");
+    let input = Input {
+        name: get("name").unwrap_or_else(|| "run".into()),
+        label: cp.input_label.clone(),
+        text: cp.input_text.clone(),
+        plist,
+    };
+    let options = RunOptions {
+        input: None,
+        resume: given.resume.clone(),
+        checkpoint_every: get("checkpoint-every")
+            .map(|v| number("checkpoint-every", v))
+            .transpose()?,
+        until: None,
+        steps: get("total-steps")
+            .map(|v| number("total-steps", v))
+            .transpose()?,
+        dt: get("dt").map(|v| unhex(&v)).transpose()?,
+        system: get("system").filter(|_| plist),
+        solver: get("solver"),
+        output: get("output").map(PathBuf::from),
+        picture: given.picture.clone(),
+        seed: Some(cp.seed),
+        threads: given.threads,
+    };
+    Ok((input, options))
+}
+
+/// Puts the checkpoint's state into the freshly built simulation.
+fn resume_state(
+    cp: &Checkpoint,
+    sim: &mut mote_md::Simulation,
+    label: &str,
+) -> Result<(), FrontError> {
+    let sys = &mut sim.system;
+    if cp.positions.len() != sys.particles.len() {
+        refuse!(
+            "{label}: the checkpoint has {} particles, its scene makes {}",
+            cp.positions.len(),
+            sys.particles.len()
+        );
+    }
+    sys.time = cp.time;
+    sys.step = cp.step;
+    for (i, (r, v)) in cp.positions.iter().zip(&cp.velocities).enumerate() {
+        sys.particles.position[i] = mote_md::DVec3::from(*r);
+        sys.particles.velocity[i] = mote_md::DVec3::from(*v);
+    }
+    sys.carried_acceleration = cp
+        .accelerations
+        .iter()
+        .map(|a| mote_md::DVec3::from(*a))
+        .collect();
+    if !cp.angular.is_empty() {
+        if cp.angular.len() != sys.particles.len() {
+            refuse!("{label}: the checkpoint's angular table has the wrong length");
+        }
+        sys.carried_angular_acceleration.clear();
+        for (i, a) in cp.angular.iter().enumerate() {
+            sys.particles.angular_velocity[i] = mote_md::DVec3::new(a[0], a[1], a[2]);
+            sys.carried_angular_acceleration
+                .push(mote_md::DVec3::new(a[3], a[4], a[5]));
+        }
+    }
+    let forces = &mut sim.forces;
+    let count = forces.interactions.len();
+    for (k, values) in &cp.carried {
+        let Some(interaction) = forces.interactions.get_mut(*k) else {
+            refuse!(
+                "{label}: the checkpoint carries state for interaction {k}, the scene has {count}"
+            );
+        };
+        interaction
+            .restore_carried_state(values)
+            .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
+    }
+    sim.sample_at_start = false;
+    Ok(())
+}
+
+/// Runs a point-particle input, or resumes `options.resume` when `input` is None.
+pub(crate) fn run(
+    input: Option<Input>,
+    options: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    let resumed = match &options.resume {
+        Some(path) => Some(checkpoint::read(path)?),
+        None => None,
+    };
+    let (input, args) = match (&resumed, input) {
+        (Some(cp), _) => restore(cp, options)?,
+        (None, Some(input)) => (input, options.clone()),
+        (None, None) => refuse!("no input to run"),
+    };
+    let scene = if input.plist {
+        let system = match args.system.as_deref().unwrap_or("nbody") {
+            "nbody" => PlistSystem::Nbody,
+            "springs" => PlistSystem::Springs,
+            other => refuse!("unknown --system '{other}': expected nbody or springs"),
+        };
+        let pf = mote_io::plist::parse(&input.text, &input.label)?;
+        let solver = args.solver.clone().unwrap_or_else(|| "leapfrog".into());
+        Scene::from_plist(&pf, system, &solver, &input.label)?
+    } else {
+        if args.system.is_some() {
+            refuse!(
+                "{}: --system chooses the model of an MPPphys particle file; a scene names its forces itself",
+                input.label
+            );
+        }
+        let mut scene = Scene::parse(&input.text, &input.label)?;
+        if let Some(s) = &args.solver {
+            scene.run.integrator = toml::Spanned::new(0..0, s.clone());
+        }
+        scene
+    };
+    let mut scene = scene;
+    if let Some(dt) = args.dt {
+        scene.run.dt = Some(toml::Spanned::new(0..0, dt));
+    }
+    if scene.run.dt.is_none() {
+        refuse!(
+            "{}: no time step: give one with --dt (a particle file sets it with a 'dt' line)",
+            input.label
+        );
+    }
+    let (seed, chosen) = crate::seed::resolve(args.seed, scene.seed);
+    let mut built = scene.build(&input.text, &input.label, seed)?;
+    let length = match (args.steps, args.until, built.length) {
+        (Some(n), _, _) => RunLength::Steps(n),
+        (None, Some(t), _) => RunLength::Until(t),
+        (None, None, Some(l)) => l,
+        (None, None, None) => refuse!(
+            "{}: no run length: give --until T or --steps N",
+            input.label
+        ),
+    };
+
+    let dir = args
+        .output
+        .clone()
+        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
+    std::fs::create_dir_all(&dir).map_err(|e| IoError::os(&dir, e))?;
+    let total_steps = length.steps_from(built.simulation.system.time, built.simulation.dt);
+    let append = resumed.is_some();
+    if let Some(cp) = &resumed {
+        resume_state(cp, &mut built.simulation, &input.label)?;
+    }
+    let length =
+        RunLength::Steps(total_steps - resumed.as_ref().map_or(0, |cp| cp.step.min(total_steps)));
+    let provenance = crate::provenance(&input.label, seed);
+    if let Some(cp) = &resumed {
+        trim_outputs(&dir, cp.step, cp.time, &provenance)?;
+    }
+    let out = &scene.output;
+    let sim = &mut built.simulation;
+    if out.observables_every > 0 {
+        sim.observers.push(Box::new(ObservablesCsv::create(
+            &dir.join("observables.csv"),
+            &provenance,
+            scene.units,
+            out.observables_every,
+            built.probes.clone(),
+            sim.system.boundary.periodic.iter().all(|p| *p),
+            &sim.forces
+                .interactions
+                .iter()
+                .flat_map(|i| i.wall_forces())
+                .map(|w| w.0)
+                .collect::<Vec<_>>(),
+            sim.system
+                .particles
+                .dipole
+                .iter()
+                .any(|m| *m != mote_md::DVec3::ZERO),
+            append,
+        )?));
+    }
+    if out.trajectory_every > 0 {
+        sim.observers.push(Box::new(TrajectoryXyz::create(
+            &dir.join("trajectory.xyz"),
+            provenance.clone(),
+            out.trajectory_every,
+            append,
+        )?));
+    }
+    if let Some(every) = args.checkpoint_every {
+        let mut options = vec![
+            ("name".to_string(), input.name.clone()),
+            ("plist".to_string(), input.plist.to_string()),
+            (
+                "system".to_string(),
+                args.system.clone().unwrap_or_else(|| "nbody".into()),
+            ),
+            ("total-steps".to_string(), total_steps.to_string()),
+            ("checkpoint-every".to_string(), every.to_string()),
+            ("dt".to_string(), hex(sim.dt)),
+            ("output".to_string(), dir.display().to_string()),
+        ];
+        if let Some(s) = &args.solver {
+            options.push(("solver".to_string(), s.clone()));
+        }
+        sim.observers.push(Box::new(CheckpointWriter {
+            path: dir.join("checkpoint.mote"),
+            every: every.max(1),
+            template: Checkpoint {
+                program: provenance.program.clone(),
+                seed,
+                options,
+                input_label: input.label.clone(),
+                input_text: input.text.clone(),
+                ..Checkpoint::default()
+            },
+            carried: Vec::new(),
+        }));
+    }
+
+    let steps = length.steps_from(sim.system.time, sim.dt);
+    let propagator = if sim.brownian.is_some() {
+        "Brownian dynamics".to_string()
+    } else {
+        sim.stepper.scheme.name().to_string()
+    };
+    monitor.start(&format!(
+        "mote run {}: {} particles, {} with dt = {}, {} steps, {}, {}",
+        input.label,
+        sim.system.particles.len(),
+        propagator,
+        sim.dt,
+        steps,
+        crate::seed_phrase(seed, chosen),
+        crate::threads_phrase(),
+    ));
+    let result = sim.run(length, |sys| {
+        if sys.step % 16 == 0 {
+            monitor.progress(sys.step, steps, &format!("t = {:.6e}", sys.time));
+        }
+    });
+    let mut outcome = Outcome {
+        engine: Engine::Particles,
+        seed,
+        dir: dir.clone(),
+        summary: Vec::new(),
+        ending: Ending::Finished,
+    };
+    match result {
+        Ok(report) => {
+            outcome
+                .summary
+                .push(summary(&report, &scene, &dir, sim.brownian.is_some()));
+            if let Some(png) = &args.picture {
+                let frame = mote_md::output::frame_of(&sim.system);
+                mote_render::frame::picture(&frame, png, 1920, 1080)?;
+                outcome
+                    .summary
+                    .push(format!("Picture of the final state: {}.", png.display()));
+            }
+        }
+        Err(e @ MdError::Unstable { .. }) => outcome.ending = Ending::Unstable(e.to_string()),
+        Err(e) => return Err(e.into()),
+    }
+    Ok(outcome)
+}
+
+/// The paragraph that ends a run. Overdamped (Brownian) runs have no
+/// conserved energy, so they report the energies, not a drift.
+fn summary(report: &RunReport, scene: &Scene, dir: &Path, brownian: bool) -> String {
+    let secs = report.wall.as_secs_f64();
+    let [_, t_unit, _, e_unit] = scene.units.labels();
+    let files = if report.files.is_empty() {
+        "no files (output switched off)".to_string()
+    } else {
+        report.files.join(", ")
+    };
+    let energy = if brownian {
+        format!(
+            "Overdamped dynamics conserve no energy: potential energy went from {:.9e} to {:.9e} {}.",
+            report.initial.potential, report.last.potential, e_unit
+        )
+    } else {
+        format!(
+            "Total energy went from {:.9e} to {:.9e} {}: relative drift {:.3e} at the end, {:.3e} at most over the sampled instants.",
+            report.initial.total_energy(),
+            report.last.total_energy(),
+            e_unit,
+            rel(report.last.total_energy(), report.initial.total_energy()),
+            report.max_energy_error,
+        )
+    };
+    format!(
+        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). {energy} Output in {}: {}.",
+        report.steps,
+        report.last.time,
+        t_unit,
+        secs,
+        report.steps as f64 / secs.max(1e-9),
+        dir.display(),
+        files
+    )
+}
+
+fn rel(e: f64, e0: f64) -> f64 {
+    if e0 != 0.0 {
+        (e - e0).abs() / e0.abs()
+    } else {
+        (e - e0).abs()
+    }
+}

@@ -1,0 +1,108 @@
+//! Rigid clumps of spheres moved by the FRBI (`mote_md::rigid::scene`).
+
+use mote_md::rigid::scene::{run_rigid_scene, RigidRun, RigidScene};
+use mote_md::MdError;
+
+use crate::error::FrontError;
+use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
+
+pub(crate) fn run(
+    input: &Input,
+    options: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    options.refuse(
+        "rigid bodies",
+        &[
+            (
+                options.checkpoint_every.is_some(),
+                "--checkpoint-every",
+                "rigid runs do not write checkpoints yet",
+            ),
+            (
+                options.solver.is_some(),
+                "--solver",
+                "rigid bodies are moved by the FRBI only",
+            ),
+            (
+                options.system.is_some(),
+                "--system",
+                "it chooses the model of an MPPphys particle file",
+            ),
+        ],
+    )?;
+    let scene = RigidScene::parse(&input.text, &input.label)?;
+    let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
+    let dir = options
+        .output
+        .clone()
+        .unwrap_or_else(|| std::path::PathBuf::from(&scene.output.dir));
+    let run = RigidRun {
+        seed: Some(seed),
+        out_dir: Some(dir.clone()),
+        dt: options.dt,
+        steps: options.steps,
+        until: options.until,
+    };
+    monitor.start(&format!(
+        "mote run {}: rigid clumps (FRBI) with dt = {}, {}, {}",
+        input.label,
+        options.dt.unwrap_or(scene.run.get_ref().dt),
+        crate::seed_phrase(seed, chosen),
+        crate::threads_phrase(),
+    ));
+    let result = run_rigid_scene(&input.text, &input.label, &run, |step, steps, time| {
+        if step % 16 == 0 || step == steps {
+            monitor.progress(step, steps, &format!("t = {time:.6e}"));
+        }
+    });
+    let mut outcome = Outcome {
+        engine: Engine::Rigid,
+        seed,
+        dir,
+        summary: Vec::new(),
+        ending: Ending::Finished,
+    };
+    let report = match result {
+        Ok(r) => r,
+        Err(e @ MdError::Unstable { .. }) => {
+            outcome.ending = Ending::Unstable(e.to_string());
+            return Ok(outcome);
+        }
+        Err(e) => return Err(e.into()),
+    };
+    outcome.summary.push(format!(
+        "mote run {}: {} rigid bodies ({} spheres), FRBI with dt = {}, {} steps to t = {:.6e} in {:.3} s of wall time, {}. \
+         Final kinetic energy {:.6e}, potential {:.6e}; momentum {}, angular momentum {}.",
+        input.label,
+        report.bodies,
+        report.spheres,
+        report.dt,
+        report.steps,
+        report.time,
+        report.wall_seconds,
+        crate::seed_phrase(seed, chosen),
+        report.kinetic_energy,
+        report.potential_energy,
+        report.linear_momentum,
+        report.angular_momentum,
+    ));
+    for (name, f) in &report.wall_forces {
+        outcome.summary.push(format!("  force on wall {name}: {f}"));
+    }
+    let files: Vec<String> = report
+        .files
+        .iter()
+        .map(|f| f.display().to_string())
+        .collect();
+    outcome
+        .summary
+        .push(format!("Output: {}", files.join(", ")));
+    if let Some(png) = &options.picture {
+        mote_render::frame::picture(&report.final_frame, png, 1920, 1080)?;
+        outcome
+            .summary
+            .push(format!("Picture of the final state: {}.", png.display()));
+    }
+    Ok(outcome)
+}
