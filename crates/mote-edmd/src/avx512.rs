@@ -31,7 +31,7 @@ pub(crate) struct Probe<const D: usize> {
 
 /// Whether this CPU can run [`earliest`].
 pub(crate) fn available() -> bool {
-    is_x86_feature_detected!("avx512f")
+    mote_geom::simd::has_avx512()
 }
 
 /// Transposes eight rows of eight doubles.

@@ -87,27 +87,8 @@ pub fn maxwell3d_cdf(v: f64, b2: f64) -> f64 {
     erf(x) - 2.0 / PI.sqrt() * x * (-x * x).exp()
 }
 
-/// erf(x) to ~1e-7 (Abramowitz & Stegun 7.1.26 is too coarse; this is the
-/// Numerical Recipes erfc Chebyshev fit, relative error < 1.2e-7).
-pub fn erf(x: f64) -> f64 {
-    let z = x.abs();
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t
-        * (-z * z - 1.26551223
-            + t * (1.00002368
-                + t * (0.37409196
-                    + t * (0.09678418
-                        + t * (-0.18628806
-                            + t * (0.27886807
-                                + t * (-1.13520398
-                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-            .exp();
-    if x >= 0.0 {
-        1.0 - r
-    } else {
-        r - 1.0
-    }
-}
+/// erf of musl/fdlibm (below 1 ulp), the one erf of the workspace.
+pub use libm::erf;
 
 /// Histogram of `values` on `[0, max)` with `bins` bins, normalised as a
 /// probability density (counts / (n · width)).

@@ -7,7 +7,7 @@
 //! Every common option either works for the scene's engine or is refused
 //! with a message that says why ([`RunOptions`]); none is silently ignored.
 
-mod cpu;
+pub mod cpu;
 pub mod engine;
 pub mod error;
 pub mod event_driven;

@@ -29,6 +29,7 @@ mod objects;
 mod placement;
 mod rotation;
 mod series;
+pub mod simd;
 mod velocity;
 
 pub use glam::{DMat3, DVec3};

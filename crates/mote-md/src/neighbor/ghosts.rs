@@ -317,12 +317,7 @@ fn within(
 
 #[cfg(target_arch = "x86_64")]
 fn compress_available() -> bool {
-    use std::sync::OnceLock;
-    static AVAILABLE: OnceLock<bool> = OnceLock::new();
-    *AVAILABLE.get_or_init(|| {
-        std::arch::is_x86_feature_detected!("avx512f")
-            && std::arch::is_x86_feature_detected!("avx512vl")
-    })
+    mote_geom::simd::has_avx512()
 }
 
 /// [`within`] eight points at a time: contiguous loads, one compare, the

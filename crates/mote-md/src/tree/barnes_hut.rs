@@ -20,6 +20,7 @@
 //! count.
 
 use glam::DVec3;
+use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
 #[cfg(target_arch = "x86_64")]
@@ -319,24 +320,6 @@ struct Walker<'a> {
     strength: &'a [f64],
     eps2: f64,
     isa: Isa,
-}
-
-/// The widest kernel this CPU runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Isa {
-    Portable,
-    #[cfg(target_arch = "x86_64")]
-    Avx512,
-}
-
-fn isa() -> Isa {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            return Isa::Avx512;
-        }
-    }
-    Isa::Portable
 }
 
 impl Walker<'_> {

@@ -51,18 +51,9 @@ struct Args {
 }
 
 pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let args = match Args::try_parse_from(
-        std::iter::once("mote edmd".to_string()).chain(args.iter().cloned()),
-    ) {
+    let args = match super::parse_words::<Args>("mote edmd", args) {
         Ok(a) => a,
-        Err(e) => {
-            let _ = e.print();
-            return Ok(if e.use_stderr() {
-                ExitCode::from(2)
-            } else {
-                ExitCode::SUCCESS
-            });
-        }
+        Err(code) => return Ok(code),
     };
     let global = global.merged(&super::GlobalOpts {
         quiet: args.quiet,

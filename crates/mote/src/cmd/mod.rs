@@ -1,5 +1,7 @@
 //! One module per subcommand.
 
+use std::process::ExitCode;
+
 pub mod edmd;
 pub mod examples;
 pub mod pack;
@@ -7,6 +9,20 @@ pub mod plot;
 pub mod rcp;
 pub mod render;
 pub mod run;
+
+/// Parses a subcommand's own words with clap (`name` heads its usage). On
+/// `--help`, `--version` or a usage error it prints clap's message and
+/// gives the exit status: 0 for help and version, 2 for a usage error.
+pub fn parse_words<T: clap::Parser>(name: &str, args: &[String]) -> Result<T, ExitCode> {
+    T::try_parse_from(std::iter::once(name.to_string()).chain(args.iter().cloned())).map_err(|e| {
+        let _ = e.print();
+        if e.use_stderr() {
+            ExitCode::from(2)
+        } else {
+            ExitCode::SUCCESS
+        }
+    })
+}
 
 /// Options every subcommand understands.
 #[derive(clap::Args, Debug, Clone)]

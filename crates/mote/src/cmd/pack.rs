@@ -125,29 +125,18 @@ struct AnalyseArgs {
     quiet: bool,
 }
 
-fn parse<T: Parser>(name: &str, args: &[String]) -> Result<T, ExitCode> {
-    T::try_parse_from(std::iter::once(name.to_string()).chain(args.iter().cloned())).map_err(|e| {
-        let _ = e.print();
-        if e.use_stderr() {
-            ExitCode::from(2)
-        } else {
-            ExitCode::SUCCESS
-        }
-    })
-}
-
 pub fn run(global: &GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
     if matches!(
         args.first().map(String::as_str),
         Some("analyse") | Some("analyze")
     ) {
-        let a = match parse::<AnalyseArgs>("mote pack analyse", &args[1..]) {
+        let a = match super::parse_words::<AnalyseArgs>("mote pack analyse", &args[1..]) {
             Ok(a) => a,
             Err(code) => return Ok(code),
         };
         return analyse_cmd(global, &a);
     }
-    let a = match parse::<Args>("mote pack", args) {
+    let a = match super::parse_words::<Args>("mote pack", args) {
         Ok(a) => a,
         Err(code) => return Ok(code),
     };
@@ -215,13 +204,7 @@ fn pack_cmd(global: &GlobalOpts, a: &Args) -> anyhow::Result<ExitCode> {
             "--tol {t}: must be a non-negative number"
         );
     }
-    let seed = a.seed.or(global.seed).unwrap_or_else(|| {
-        let t = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.as_nanos() as u64)
-            .unwrap_or(0);
-        t ^ (std::process::id() as u64).rotate_left(32)
-    });
+    let (seed, chosen) = mote_front::seed::resolve(a.seed.or(global.seed), None);
     let settings = PackSettings {
         n: a.n,
         sizes,
@@ -250,7 +233,10 @@ fn pack_cmd(global: &GlobalOpts, a: &Args) -> anyhow::Result<ExitCode> {
         if a.no_jam { " --no-jam" } else { "" }
     );
     if !quiet {
-        eprintln!("mote pack: {label}, seed {seed}");
+        eprintln!(
+            "mote pack: {label}, seed {seed}{}",
+            if chosen { " (chosen)" } else { "" }
+        );
     }
     let provenance = mote_io::Provenance {
         program: format!("mote {}", env!("CARGO_PKG_VERSION")),
@@ -303,7 +289,7 @@ fn pack_dim<const D: usize>(
         b
     };
     let t0 = std::time::Instant::now();
-    let cpu0 = cpu_seconds();
+    let cpu0 = mote_front::cpu::cpu_seconds();
     let mut csv_err = None;
     let result = packer.run(|s| {
         if let Some(w) = csv.as_mut() {
@@ -329,7 +315,7 @@ fn pack_dim<const D: usize>(
     if let Some(e) = csv_err {
         return Err(e.into());
     }
-    let cpu = cpu_seconds() - cpu0;
+    let cpu = mote_front::cpu::cpu_seconds() - cpu0;
     let sys = packer.system();
     let simbox = *sys.simbox();
     let pos = sys.positions();
@@ -545,21 +531,4 @@ fn analyse_dim<const D: usize>(
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// CPU seconds (user + system) of this process, from /proc (NaN elsewhere).
-fn cpu_seconds() -> f64 {
-    let Ok(s) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let Some(rest) = s.rfind(')').map(|k| &s[k + 2..]) else {
-        return f64::NAN;
-    };
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |k: usize| {
-        f.get(k)
-            .and_then(|x| x.parse::<f64>().ok())
-            .unwrap_or(f64::NAN)
-    };
-    (ticks(11) + ticks(12)) / 100.0
 }

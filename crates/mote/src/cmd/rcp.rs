@@ -683,10 +683,9 @@ fn search_from(vary: &[String], max_evals: usize) -> anyhow::Result<design::Sear
 }
 
 fn optimize(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let argv = std::iter::once("mote rcp optimize".to_string()).chain(args.iter().cloned());
-    let a = match OptimizeArgs::try_parse_from(argv) {
+    let a = match super::parse_words::<OptimizeArgs>("mote rcp optimize", args) {
         Ok(a) => a,
-        Err(e) => return clap_exit(e),
+        Err(code) => return Ok(code),
     };
     let pops = a.input.populations()?;
     let est = a.input.estimator()?;
@@ -754,10 +753,9 @@ struct ScanArgs {
 }
 
 fn scan(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let argv = std::iter::once("mote rcp scan".to_string()).chain(args.iter().cloned());
-    let a = match ScanArgs::try_parse_from(argv) {
+    let a = match super::parse_words::<ScanArgs>("mote rcp scan", args) {
         Ok(a) => a,
-        Err(e) => return clap_exit(e),
+        Err(code) => return Ok(code),
     };
     global.init_threads()?;
     let x: Axis = a.x.parse().context("--x")?;
@@ -828,11 +826,4 @@ fn scan(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode>
         );
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Prints a clap message (help, version or usage error) and gives its exit status.
-fn clap_exit(e: clap::Error) -> anyhow::Result<ExitCode> {
-    let code = if e.use_stderr() { 2 } else { 0 };
-    e.print()?;
-    Ok(ExitCode::from(code))
 }

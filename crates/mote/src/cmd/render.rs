@@ -84,14 +84,9 @@ struct RenderArgs {
 }
 
 pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let words = std::iter::once("mote render".to_string()).chain(args.iter().cloned());
-    let a = match RenderArgs::try_parse_from(words) {
+    let a = match super::parse_words::<RenderArgs>("mote render", args) {
         Ok(a) => a,
-        Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
-            let _ = e.print();
-            return Ok(ExitCode::from(code));
-        }
+        Err(code) => return Ok(code),
     };
     // Global options may also come after the subcommand.
     let global = &global.merged(&a.global);

@@ -5,19 +5,9 @@
 use std::arch::x86_64::*;
 
 use glam::DVec3;
+use mote_geom::simd::avx512::rsqrt;
 
 use super::Soa;
-
-/// 1/√r² to full double precision (r² > 0 and finite).
-#[inline]
-#[target_feature(enable = "avx512f")]
-fn rsqrt(r2: __m512d) -> __m512d {
-    let three_halves = _mm512_set1_pd(1.5);
-    let h = _mm512_mul_pd(_mm512_set1_pd(0.5), r2);
-    let mut y = _mm512_rsqrt14_pd(r2);
-    y = _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(h, y), y, three_halves));
-    _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(h, y), y, three_halves))
-}
 
 /// Separations d = r_j − r_i of the 8 particles from j, their masses, and
 /// r² = |d|² + ε².

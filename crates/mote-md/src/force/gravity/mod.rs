@@ -22,6 +22,7 @@ mod avx512;
 mod portable;
 
 use glam::DVec3;
+use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
 use super::{Interaction, State};
@@ -55,24 +56,6 @@ struct TileRow {
     rx: Vec<f64>,
     ry: Vec<f64>,
     rz: Vec<f64>,
-}
-
-/// The widest kernel this CPU runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Isa {
-    Portable,
-    #[cfg(target_arch = "x86_64")]
-    Avx512,
-}
-
-fn isa() -> Isa {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            return Isa::Avx512;
-        }
-    }
-    Isa::Portable
 }
 
 /// The particles as structure-of-arrays slices (length a multiple of 8).

@@ -179,14 +179,7 @@ impl LennardJones {
 }
 
 fn simd_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx512f")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    mote_geom::simd::has_avx512()
 }
 
 /// The sums of row r, by the AVX-512 kernel or the portable one.
