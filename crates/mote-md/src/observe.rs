@@ -92,9 +92,14 @@ impl Observables {
     }
 
     /// Column names of [`Observables::values`].
-    pub const COLUMNS: [&'static str; 13] = [
+    /// The columns of observables.csv, the same words as the rigid
+    /// engine's: kinetic energy whole, then its translational and
+    /// rotational parts (LAMMPS's `ke` is the translational one).
+    pub const COLUMNS: [&'static str; 15] = [
         "time",
         "kinetic_energy",
+        "translational_energy",
+        "rotational_energy",
         "potential_energy",
         "total_energy",
         "px",
@@ -108,10 +113,12 @@ impl Observables {
         "pressure",
     ];
 
-    pub fn values(&self, step: u64) -> [f64; 13] {
+    pub fn values(&self, step: u64) -> [f64; 15] {
         [
             self.time,
             self.kinetic,
+            self.kinetic - self.rotational,
+            self.rotational,
             self.potential,
             self.total_energy(),
             self.momentum.x,

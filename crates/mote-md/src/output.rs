@@ -48,6 +48,8 @@ impl ObservablesCsv {
             e.into(),
             e.into(),
             e.into(),
+            e.into(),
+            e.into(),
             p.clone(),
             p.clone(),
             p,

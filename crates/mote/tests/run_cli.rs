@@ -488,3 +488,47 @@ fn rigid_scene_runs_through_mote_run() {
         .iter()
         .all(|p| (p - px[0]).abs() <= 1e-12 * px[0].abs().max(1.0)));
 }
+
+/// A granular run's observables give the kinetic energy whole and split
+/// into its translational part (what LAMMPS's `ke` reports) and its
+/// rotational part, with the units in the header, as rigid runs do.
+#[test]
+fn granular_observables_split_translation_and_rotation() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &[
+            "run",
+            "example:rotating-drum",
+            "--steps",
+            "2500",
+            "-q",
+            "-o",
+            "drum",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = mote_io::csv::read_table(&dir.path().join("drum/observables.csv")).unwrap();
+    let k = t.column("kinetic_energy").unwrap();
+    let kt = t.column("translational_energy").unwrap();
+    let kr = t.column("rotational_energy").unwrap();
+    assert!(k.len() >= 2);
+    for i in 0..k.len() {
+        assert!(
+            (kt[i] + kr[i] - k[i]).abs() <= 1e-12 * k[i].abs().max(1e-300),
+            "row {i}: {} + {} ≠ {}",
+            kt[i],
+            kr[i],
+            k[i]
+        );
+        assert!(kr[i] >= 0.0 && kt[i] >= 0.0);
+    }
+    let last = k.len() - 1;
+    assert!(
+        kr[last] > 0.0,
+        "the grains roll: rotational energy {}",
+        kr[last]
+    );
+    let header = std::fs::read_to_string(dir.path().join("drum/observables.csv")).unwrap();
+    assert!(header.contains("translational_energy"));
+}
