@@ -11,6 +11,7 @@ pub mod header;
 pub mod lammps_data;
 pub mod lammps_dump;
 pub mod plist;
+pub mod png;
 pub mod vtu;
 pub mod xyz;
 

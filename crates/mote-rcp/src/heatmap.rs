@@ -61,13 +61,8 @@ impl Image {
     }
 
     /// Encodes the image as PNG.
-    pub fn write_png(&self, w: impl Write) -> Result<(), png::EncodingError> {
-        let mut enc = png::Encoder::new(w, self.width as u32, self.height as u32);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header()?;
-        writer.write_image_data(&self.pixels)?;
-        writer.finish()
+    pub fn write_png(&self, w: impl Write) -> Result<(), mote_io::png::EncodingError> {
+        mote_io::png::encode_rgb(w, self.width as u32, self.height as u32, &self.pixels)
     }
 }
 

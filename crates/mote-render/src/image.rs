@@ -41,15 +41,7 @@ impl Image {
     /// Writes the picture as an 8-bit RGB PNG.
     pub fn write_png(&self, path: &Path) -> Result<(), RenderError> {
         let file = File::create(path).map_err(|e| RenderError::io(path, e))?;
-        let mut enc = png::Encoder::new(BufWriter::new(file), self.width, self.height);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut w = enc
-            .write_header()
-            .map_err(|e| RenderError::Png(path.display().to_string(), e.to_string()))?;
-        w.write_image_data(&self.rgb)
-            .map_err(|e| RenderError::Png(path.display().to_string(), e.to_string()))?;
-        w.finish()
+        mote_io::png::encode_rgb(BufWriter::new(file), self.width, self.height, &self.rgb)
             .map_err(|e| RenderError::Png(path.display().to_string(), e.to_string()))
     }
 
