@@ -48,7 +48,8 @@ pub struct RunOptions {
     pub picture: Option<PathBuf>,
     /// Seed (default: the scene's, else chosen and printed).
     pub seed: Option<u64>,
-    /// Worker threads the caller set up (recorded in the opening line).
+    /// Worker threads the caller asked for. The caller sets up the rayon
+    /// pool; the opening line reports the pool's actual size.
     pub threads: Option<usize>,
 }
 
