@@ -34,6 +34,57 @@ impl fmt::Display for ParseError {
     }
 }
 
+/// An input text and its name: turns byte spans (as TOML and other parsers
+/// report them) into `file:line` errors. The one place a byte offset becomes
+/// a line number.
+#[derive(Debug, Clone, Copy)]
+pub struct Source<'a> {
+    /// The file (or pseudo-name) in messages.
+    pub file: &'a str,
+    /// The whole text.
+    pub text: &'a str,
+}
+
+impl<'a> Source<'a> {
+    pub fn new(file: &'a str, text: &'a str) -> Self {
+        Self { file, text }
+    }
+
+    /// One-based line of a byte offset (offsets past the end give the last line).
+    pub fn line_of(&self, offset: usize) -> usize {
+        let end = offset.min(self.text.len());
+        self.text.as_bytes()[..end]
+            .iter()
+            .filter(|b| **b == b'\n')
+            .count()
+            + 1
+    }
+
+    /// `file:line: message` at the start of `span`; an empty span at offset 0
+    /// (a default value, not written in the file) gives the whole file
+    /// (`file: message`).
+    pub fn error(&self, span: std::ops::Range<usize>, message: impl Into<String>) -> ParseError {
+        let line = if span.start == 0 && span.end == 0 {
+            0
+        } else {
+            self.line_of(span.start)
+        };
+        ParseError::new(self.file, line, message)
+    }
+
+    /// `file: message`, about the file as a whole.
+    pub fn whole(&self, message: impl Into<String>) -> ParseError {
+        ParseError::new(self.file, 0, message)
+    }
+
+    /// The error of a parser that reports an optional span (a TOML syntax or
+    /// type error) with its message trimmed.
+    pub fn parser_error(&self, span: Option<std::ops::Range<usize>>, message: &str) -> ParseError {
+        let line = span.map_or(0, |s| self.line_of(s.start));
+        ParseError::new(self.file, line, message.trim())
+    }
+}
+
 /// Errors of mote-io: a parse error or an operating-system error on a named file.
 #[derive(Debug, thiserror::Error)]
 pub enum IoError {
@@ -54,5 +105,29 @@ impl IoError {
             path: path.into(),
             cause: source,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spans_become_lines() {
+        let src = Source::new("scene.toml", "a = 1\n\n[b]\nc = 2\n");
+        assert_eq!(src.line_of(0), 1);
+        assert_eq!(src.line_of(6), 2);
+        assert_eq!(src.line_of(7), 3);
+        assert_eq!(src.line_of(1000), 5);
+        assert_eq!(src.error(7..10, "bad").to_string(), "scene.toml:3: bad");
+        assert_eq!(
+            src.error(0..0, "missing").to_string(),
+            "scene.toml: missing"
+        );
+        assert_eq!(src.error(0..1, "first").to_string(), "scene.toml:1: first");
+        assert_eq!(
+            src.parser_error(Some(11..12), " wrong\n").to_string(),
+            "scene.toml:4: wrong"
+        );
     }
 }

@@ -15,5 +15,5 @@ pub mod png;
 pub mod vtu;
 pub mod xyz;
 
-pub use error::{IoError, ParseError};
+pub use error::{IoError, ParseError, Source};
 pub use header::Provenance;

@@ -43,6 +43,17 @@ impl UnitSystem {
         }
     }
 
+    /// Coulomb's constant k = 1/(4πε₀): 8.987 551 7923e9 N m² C⁻² in SI
+    /// (CODATA 2018), 1 in reduced units (charges q* = q/√(4πε₀σε)); none
+    /// in astronomical units, where a scene must give it.
+    pub fn coulomb_constant(self) -> Option<f64> {
+        match self {
+            UnitSystem::Si => Some(8.987_551_792_3e9),
+            UnitSystem::Lj => Some(1.0),
+            UnitSystem::Astro => None,
+        }
+    }
+
     /// Unit labels for (length, time, mass, energy).
     pub fn labels(self) -> [&'static str; 4] {
         match self {

@@ -5,6 +5,7 @@
 
 mod damping;
 pub mod dipolar;
+mod electric;
 pub mod ewald;
 pub mod granular;
 mod gravity;
@@ -13,6 +14,7 @@ mod springs;
 mod uniform;
 
 pub use damping::GlobalDamping;
+pub use electric::{DirectCoulomb, ElectricField};
 pub use gravity::DirectGravity;
 pub use lennard_jones::LennardJones;
 pub use springs::{Spring, SpringNetwork};

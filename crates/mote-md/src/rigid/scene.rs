@@ -79,7 +79,7 @@ use glam::DVec3;
 use mote_geom::{from_axis_angle, DE, E};
 use mote_io::csv::CsvWriter;
 use mote_io::xyz::{Frame, XyzWriter};
-use mote_io::{ParseError, Provenance};
+use mote_io::{ParseError, Provenance, Source};
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use serde::Deserialize;
@@ -367,14 +367,6 @@ pub struct Report {
     pub final_frame: Frame,
 }
 
-fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())]
-        .bytes()
-        .filter(|b| *b == b'\n')
-        .count()
-        + 1
-}
-
 /// Whether a scene text is a rigid-body scene (has a `[rigid]` table).
 pub fn is_rigid_scene(text: &str) -> bool {
     text.parse::<toml::Table>()
@@ -385,10 +377,8 @@ pub fn is_rigid_scene(text: &str) -> bool {
 impl RigidScene {
     /// Parses a scene; errors are `file:line: message`.
     pub fn parse(text: &str, file: &str) -> Result<Self, ParseError> {
-        toml::from_str::<RigidScene>(text).map_err(|e| {
-            let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(0);
-            ParseError::new(file, line, e.message().trim().to_string())
-        })
+        toml::from_str::<RigidScene>(text)
+            .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
     }
 
     /// Builds bodies and integrator; `seed` overrides the scene's.
@@ -398,9 +388,8 @@ impl RigidScene {
         file: &str,
         seed: Option<u64>,
     ) -> Result<BuiltRigid, ParseError> {
-        let err = |span: std::ops::Range<usize>, msg: String| {
-            ParseError::new(file, line_of(text, span.start), msg)
-        };
+        let src = Source::new(file, text);
+        let err = |span: std::ops::Range<usize>, msg: String| src.error(span, msg);
         let seed = seed.or(self.seed).unwrap_or(1);
         let rigid = self.rigid.get_ref();
         let mut frbi = Frbi::new();
@@ -524,9 +513,8 @@ impl RigidScene {
             }
         }
         if bodies.is_empty() {
-            return Err(ParseError::new(
-                file,
-                line_of(text, self.rigid.span().start),
+            return Err(src.error(
+                self.rigid.span(),
                 "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]] or [[rigid.random]]",
             ));
         }

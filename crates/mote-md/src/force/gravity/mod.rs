@@ -79,13 +79,19 @@ impl DirectGravity {
     /// Copies the state into the structure-of-arrays scratch, padded to a
     /// multiple of the lane count with massless particles far away.
     fn load(&mut self, state: &State) {
-        let n = state.position.len();
+        self.load_strengths(state.position, state.mass);
+    }
+
+    /// Copies positions and source strengths (masses, or charges for
+    /// Coulomb's law) into the structure-of-arrays scratch.
+    fn load_strengths(&mut self, position: &[DVec3], strength: &[f64]) {
+        let n = position.len();
         let padded = n.div_ceil(LANES) * LANES;
         self.x.clear();
         self.y.clear();
         self.z.clear();
         self.m.clear();
-        for (r, m) in state.position.iter().zip(state.mass) {
+        for (r, m) in position.iter().zip(strength) {
             self.x.push(r.x);
             self.y.push(r.y);
             self.z.push(r.z);
@@ -118,6 +124,46 @@ impl DirectGravity {
     /// Accelerations divided by G of the first `out.len()` particles.
     fn field(&mut self, out: &mut [DVec3]) {
         self.field_with(out, isa());
+    }
+
+    /// The inverse-square field Σ_{j≠i} s_j (r_j − r_i) / (|r_j − r_i|² + ε²)^{3/2}
+    /// of sources of strength s (any sign) at every particle, by the same
+    /// tiled pair kernel as gravity.
+    pub(crate) fn inverse_square_field(
+        &mut self,
+        position: &[DVec3],
+        strength: &[f64],
+        out: &mut [DVec3],
+    ) {
+        self.load_strengths(position, strength);
+        self.field(out);
+    }
+
+    /// Σ_i s_i Σ_{j≠i} s_j / (|r_j − r_i|² + ε²)^{1/2} (each pair twice), in a fixed order.
+    pub(crate) fn pair_potential_sum(&mut self, position: &[DVec3], strength: &[f64]) -> f64 {
+        self.load_strengths(position, strength);
+        self.potential_sum(position.len())
+    }
+
+    /// Σ_i m_i Σ_{j≠i} m_j / r_ij over the first `n` (unpadded) particles.
+    fn potential_sum(&self, n: usize) -> f64 {
+        let eps2 = self.softening * self.softening;
+        let soa = self.soa();
+        let isa = isa();
+        let per_i: Vec<f64> = (0..n)
+            .into_par_iter()
+            .with_min_len(64)
+            .map(|i| {
+                soa.m[i]
+                    * match isa {
+                        // SAFETY: the CPU supports AVX-512F (`isa`); slices are padded to 8.
+                        #[cfg(target_arch = "x86_64")]
+                        Isa::Avx512 => unsafe { avx512::potential_at(i, soa, eps2) },
+                        Isa::Portable => portable::potential_at(i, soa, eps2),
+                    }
+            })
+            .collect();
+        per_i.iter().sum::<f64>()
     }
 
     fn field_with(&mut self, out: &mut [DVec3], isa: Isa) {
@@ -230,23 +276,7 @@ impl Interaction for DirectGravity {
     /// U = −(G/2) Σ_i m_i Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2}, summed in a fixed order.
     fn potential_energy(&mut self, state: &State) -> f64 {
         self.load(state);
-        let eps2 = self.softening * self.softening;
-        let soa = self.soa();
-        let isa = isa();
-        let per_i: Vec<f64> = (0..state.position.len())
-            .into_par_iter()
-            .with_min_len(64)
-            .map(|i| {
-                soa.m[i]
-                    * match isa {
-                        // SAFETY: the CPU supports AVX-512F (`isa`); slices are padded to 8.
-                        #[cfg(target_arch = "x86_64")]
-                        Isa::Avx512 => unsafe { avx512::potential_at(i, soa, eps2) },
-                        Isa::Portable => portable::potential_at(i, soa, eps2),
-                    }
-            })
-            .collect();
-        -0.5 * self.g * per_i.iter().sum::<f64>()
+        -0.5 * self.g * self.potential_sum(state.position.len())
     }
 }
 

@@ -1,0 +1,204 @@
+//! `[coulomb]`: forces between the particles' charges, by direct summation
+//! or a Barnes–Hut tree in open space, or by Ewald summation in a cubic
+//! periodic box; `[electric_field]`: a uniform field E(t) = E₀ cos(ωt + φ).
+
+use std::ops::Range;
+
+use glam::DVec3;
+use serde::Deserialize;
+
+use mote_io::{ParseError, Source};
+
+use super::gravity::direct;
+use super::{Build, Scene, Section};
+use crate::boundary::Boundary;
+use crate::force::ewald::EwaldCoulomb;
+use crate::force::{DirectCoulomb, ElectricField};
+use crate::tree::TreeCoulomb;
+
+/// `[coulomb]`: Coulomb's law between every pair of charged particles.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoulombSettings {
+    /// Coulomb's constant 1/(4πε₀); default: the unit system's (1 in LJ units).
+    pub k: Option<f64>,
+    /// `direct` (default: every pair, open space), `tree` (Barnes–Hut with
+    /// multipoles to quadrupole, open space) or `ewald` (cubic periodic box,
+    /// tin-foil boundaries).
+    #[serde(default = "direct")]
+    pub method: String,
+    /// Softening length ε of `direct` and `tree` (default 0).
+    pub softening: Option<f64>,
+    /// Opening angle θ of the tree (default 0.5).
+    pub theta: Option<f64>,
+    /// Ewald's real-space cut-off (default half the box side).
+    pub cutoff: Option<f64>,
+    /// Ewald: the RMS force error aimed at, in force units (Kolafa & Perram
+    /// 1992 choose α and the k-vectors from it).
+    pub accuracy: Option<f64>,
+}
+
+impl Section for CoulombSettings {
+    fn add_to(&self, span: Range<usize>, scene: &Scene, b: &mut Build) -> Result<(), ParseError> {
+        let src = b.src;
+        let err = |msg: String| src.error(span.clone(), msg);
+        let k = match self.k.or(scene.units.coulomb_constant()) {
+            Some(k) => positive(src, span.clone(), "[coulomb] k", k)?,
+            None => return Err(err("[coulomb] needs k = 1/(4πε₀) in these units".into())),
+        };
+        let charge = b.particles.charge.clone();
+        if charge.iter().all(|q| *q == 0.0) {
+            return Err(err(
+                "[coulomb] no particle has a charge: give the particles `charge = ...`".into(),
+            ));
+        }
+        if let Some(q) = charge.iter().find(|q| !q.is_finite()) {
+            return Err(err(format!(
+                "[coulomb] every charge must be finite, found {q}"
+            )));
+        }
+        let open = |method: &str| {
+            if b.boundary.periodic.iter().any(|p| *p) {
+                Err(err(format!(
+                    "[coulomb] method = \"{method}\" sums over open space: a periodic box needs method = \"ewald\""
+                )))
+            } else {
+                Ok(())
+            }
+        };
+        let refuse = |key: &str, given: bool, method: &str| {
+            if given {
+                Err(err(format!(
+                    "[coulomb] {key} does not apply to method = \"{method}\""
+                )))
+            } else {
+                Ok(())
+            }
+        };
+        let softening = self.softening.unwrap_or(0.0);
+        if softening.is_nan() || softening < 0.0 {
+            return Err(err(format!(
+                "[coulomb] softening must not be negative, found {softening}"
+            )));
+        }
+        match self.method.as_str() {
+            "direct" => {
+                open("direct")?;
+                refuse("theta", self.theta.is_some(), "direct")?;
+                refuse("cutoff", self.cutoff.is_some(), "direct")?;
+                refuse("accuracy", self.accuracy.is_some(), "direct")?;
+                b.forces.push(DirectCoulomb::new(k, charge, softening));
+            }
+            "tree" => {
+                open("tree")?;
+                refuse("cutoff", self.cutoff.is_some(), "tree")?;
+                refuse("accuracy", self.accuracy.is_some(), "tree")?;
+                let theta = self.theta.unwrap_or(0.5);
+                if !(0.0..1.2).contains(&theta) {
+                    return Err(err(format!(
+                        "[coulomb] theta must be in [0, 1.2), found {theta}"
+                    )));
+                }
+                b.forces.push(TreeCoulomb::new(k, charge, softening, theta));
+            }
+            "ewald" => {
+                refuse("softening", self.softening.is_some(), "ewald")?;
+                refuse("theta", self.theta.is_some(), "ewald")?;
+                let l = ewald_box(src, span.clone(), b.boundary, "coulomb")?;
+                let rc = positive(
+                    src,
+                    span.clone(),
+                    "[coulomb] cutoff",
+                    self.cutoff.unwrap_or(0.5 * l),
+                )?;
+                if rc > 0.5 * l {
+                    return Err(err(format!(
+                        "[coulomb] the Ewald cut-off {rc} must be at most half the box side {l}"
+                    )));
+                }
+                let accuracy = self.accuracy.ok_or_else(|| {
+                    err("[coulomb] method = \"ewald\" needs accuracy = the RMS force error aimed at (force units)".into())
+                })?;
+                positive(src, span.clone(), "[coulomb] accuracy", accuracy)?;
+                b.forces.push(EwaldCoulomb::new(k, charge, l, rc, accuracy));
+            }
+            other => {
+                return Err(err(format!(
+                    "[coulomb] unknown method '{other}': expected direct, tree or ewald"
+                )))
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `[electric_field]`: E(t) = e cos(ωt + φ) on every charge (constant by default).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElectricFieldSettings {
+    /// The field E₀ (force per charge).
+    pub e: [f64; 3],
+    /// Angular frequency ω in rad per time (default 0: constant).
+    #[serde(default)]
+    pub angular_frequency: f64,
+    /// Phase φ (default 0).
+    #[serde(default)]
+    pub phase: f64,
+}
+
+impl Section for ElectricFieldSettings {
+    fn add_to(&self, span: Range<usize>, _: &Scene, b: &mut Build) -> Result<(), ParseError> {
+        if self
+            .e
+            .iter()
+            .chain([&self.angular_frequency, &self.phase])
+            .any(|x| !x.is_finite())
+        {
+            return Err(b.src.error(
+                span,
+                "[electric_field] e, angular_frequency and phase must be finite",
+            ));
+        }
+        let has_potential = (0..3).all(|a| !(b.boundary.periodic[a] && self.e[a] != 0.0));
+        b.forces.push(ElectricField {
+            amplitude: DVec3::from(self.e),
+            angular_frequency: self.angular_frequency,
+            phase: self.phase,
+            charge: b.particles.charge.clone(),
+            has_potential,
+        });
+        Ok(())
+    }
+}
+
+/// The side L of the cubic periodic box Ewald sums need, or why there is none.
+pub(crate) fn ewald_box(
+    src: Source,
+    span: Range<usize>,
+    boundary: Boundary,
+    table: &str,
+) -> Result<f64, ParseError> {
+    let l = boundary.lengths();
+    let cubic = (l.x - l.y).abs() <= 1e-12 * l.x && (l.x - l.z).abs() <= 1e-12 * l.x;
+    if boundary.periodic != [true; 3] || !cubic || !(l.x > 0.0 && l.x.is_finite()) {
+        return Err(src.error(
+            span,
+            format!("[{table}] method = \"ewald\" needs a cubic [box] periodic on every axis"),
+        ));
+    }
+    Ok(l.x)
+}
+
+/// `value` if it is positive and finite, else `file:line: what must be positive`.
+pub(crate) fn positive(
+    src: Source,
+    span: Range<usize>,
+    what: &str,
+    value: f64,
+) -> Result<f64, ParseError> {
+    if value > 0.0 && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(src.error(span, format!("{what} must be positive, found {value}")))
+    }
+}

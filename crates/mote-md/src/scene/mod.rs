@@ -1,0 +1,237 @@
+//! Scene files (TOML) and MPPphys particle files, turned into a [`Simulation`].
+//!
+//! Every key is documented in docs/scene-format.md. Each table of a scene is
+//! a settings type in its own file here that checks itself and builds its
+//! own part (lumol's `FromToml` per settings type is the model):
+//!
+//! - [`particles`]: the particle tables and generators, `[[spring]]`;
+//! - one file per force law: [`gravity`] (`[gravity]`, `[field]`),
+//!   [`lennard_jones`], [`granular`] (`[granular]`, `[[wall]]`), [`dipolar`]
+//!   (`[dipolar]`, `[magnetic_field]`), [`electric`] (`[coulomb]`,
+//!   `[electric_field]`), [`bath`] (`[damping]`, `[thermostat]`, `[brownian]`);
+//! - [`run`]: `[run]`, `[output]`, `[box]`; [`plist`]: MPPphys particle files.
+//!
+//! A new force law is a settings type implementing [`Section`] in a file of
+//! its own, a field of [`Scene`], and one line in [`Scene::build`] where the
+//! interactions are listed in the order their forces are summed.
+//!
+//! Particles are numbered in this order: `[[particle]]` tables, then
+//! `[[lattice]]`, `[[ring]]`, `[[annulus]]`, `[[random_box]]`, `[[fcc]]`,
+//! `[[cloud]]` and `[[plummer]]` generators, then `[[lammps_data]]` files,
+//! each in file order.
+
+pub mod bath;
+pub mod dipolar;
+pub mod electric;
+pub mod granular;
+pub mod gravity;
+pub mod lennard_jones;
+pub mod particles;
+pub mod plist;
+pub mod run;
+
+use std::ops::Range;
+
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Deserialize;
+use toml::Spanned;
+
+use mote_io::{ParseError, Source};
+
+use crate::boundary::Boundary;
+use crate::force::{ForceField, SpringNetwork};
+use crate::integrate::Stepper;
+use crate::observe::Probe;
+use crate::particles::{Particles, System};
+use crate::simulation::{RunLength, Simulation};
+use crate::units::UnitSystem;
+
+pub use bath::{BrownianSettings, DampingSettings, ThermostatSettings};
+pub use dipolar::{DipolarSettings, MagneticFieldSettings, WcaSettings};
+pub use electric::{CoulombSettings, ElectricFieldSettings};
+pub use granular::{GranularSettings, WallSpec};
+pub use gravity::{FieldSettings, GravitySettings};
+pub use lennard_jones::LennardJonesSettings;
+pub use particles::{
+    AnnulusSpec, CloudSpec, DataSpec, FccSpec, LatticeSpec, LatticeSprings, ModeSpec, ParticleSpec,
+    PlummerSpec, Properties, RandomBoxSpec, RingSpec, SpeedSpec, SpringSpec,
+};
+pub use plist::PlistSystem;
+pub use run::{BoxSettings, OutputSettings, RunSettings};
+
+/// A whole scene file.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// One line saying what the scene is.
+    #[serde(default)]
+    pub title: String,
+    /// `si` (default), `lj` or `astro`.
+    #[serde(default)]
+    pub units: UnitSystem,
+    /// Seed of the random generators; chosen and printed when absent.
+    pub seed: Option<u64>,
+    #[serde(default)]
+    pub run: RunSettings,
+    pub gravity: Option<Spanned<GravitySettings>>,
+    pub field: Option<Spanned<FieldSettings>>,
+    pub damping: Option<Spanned<DampingSettings>>,
+    pub lennard_jones: Option<Spanned<LennardJonesSettings>>,
+    pub thermostat: Option<Spanned<ThermostatSettings>>,
+    pub granular: Option<Spanned<GranularSettings>>,
+    pub dipolar: Option<Spanned<DipolarSettings>>,
+    pub magnetic_field: Option<Spanned<MagneticFieldSettings>>,
+    pub coulomb: Option<Spanned<CoulombSettings>>,
+    pub electric_field: Option<Spanned<ElectricFieldSettings>>,
+    pub brownian: Option<Spanned<BrownianSettings>>,
+    #[serde(default)]
+    pub plummer: Vec<Spanned<PlummerSpec>>,
+    #[serde(default)]
+    pub wall: Vec<Spanned<WallSpec>>,
+    #[serde(rename = "box")]
+    pub bounds: Option<Spanned<BoxSettings>>,
+    #[serde(default)]
+    pub particle: Vec<Spanned<ParticleSpec>>,
+    #[serde(default)]
+    pub lattice: Vec<Spanned<LatticeSpec>>,
+    #[serde(default)]
+    pub ring: Vec<Spanned<RingSpec>>,
+    #[serde(default)]
+    pub annulus: Vec<Spanned<AnnulusSpec>>,
+    #[serde(default)]
+    pub random_box: Vec<Spanned<RandomBoxSpec>>,
+    #[serde(default)]
+    pub fcc: Vec<Spanned<FccSpec>>,
+    #[serde(default)]
+    pub cloud: Vec<Spanned<CloudSpec>>,
+    #[serde(default)]
+    pub lammps_data: Vec<Spanned<DataSpec>>,
+    #[serde(default)]
+    pub spring: Vec<Spanned<SpringSpec>>,
+    #[serde(default)]
+    pub output: OutputSettings,
+}
+
+/// A scene turned into its parts, ready to run.
+pub struct Built {
+    pub simulation: Simulation,
+    pub length: Option<RunLength>,
+    pub probes: Vec<Probe>,
+    pub seed: u64,
+}
+
+/// What the sections build together: the particles, the box, the
+/// interactions in the order their forces are summed, and the run's random
+/// generator (drawn from in table order, so a seed gives one run).
+pub struct Build<'a> {
+    /// Locates errors: `file:line: message`.
+    pub src: Source<'a>,
+    pub units: UnitSystem,
+    pub rng: Xoshiro256PlusPlus,
+    pub particles: Particles,
+    pub boundary: Boundary,
+    pub forces: ForceField,
+}
+
+/// A table of the scene that adds interactions to the run.
+pub trait Section {
+    /// Checks the table and pushes its interactions onto `b.forces`; `span`
+    /// locates the table in errors, `scene` gives the other tables.
+    fn add_to(&self, span: Range<usize>, scene: &Scene, b: &mut Build) -> Result<(), ParseError>;
+}
+
+/// Adds an optional table's interactions.
+fn add<T: Section>(
+    table: &Option<Spanned<T>>,
+    scene: &Scene,
+    b: &mut Build,
+) -> Result<(), ParseError> {
+    match table {
+        Some(t) => t.get_ref().add_to(t.span(), scene, b),
+        None => Ok(()),
+    }
+}
+
+impl Scene {
+    /// Parses a scene; errors are `file:line: message`.
+    pub fn parse(text: &str, file: &str) -> Result<Scene, ParseError> {
+        toml::from_str::<Scene>(text)
+            .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
+    }
+
+    /// Builds the simulation. `text` and `file` locate errors; `seed` overrides the scene's.
+    pub fn build(&self, text: &str, file: &str, seed: u64) -> Result<Built, ParseError> {
+        let src = Source::new(file, text);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let made = particles::make(self, src, &mut rng)?;
+        let boundary = run::boundary(&self.bounds, made.fcc_box, src)?;
+        let mut b = Build {
+            src,
+            units: self.units,
+            rng,
+            particles: made.particles,
+            boundary,
+            forces: ForceField::new(),
+        };
+        // The interactions, in the order their forces are summed.
+        add(&self.gravity, self, &mut b)?;
+        if !made.springs.is_empty() {
+            b.forces.push(SpringNetwork {
+                springs: made.springs,
+            });
+        }
+        add(&self.field, self, &mut b)?;
+        add(&self.damping, self, &mut b)?;
+        add(&self.lennard_jones, self, &mut b)?;
+        add(&self.granular, self, &mut b)?;
+        granular::refuse_walls_without_contacts(self, src)?;
+        add(&self.dipolar, self, &mut b)?;
+        add(&self.magnetic_field, self, &mut b)?;
+        add(&self.coulomb, self, &mut b)?;
+        add(&self.electric_field, self, &mut b)?;
+
+        let brownian = bath::brownian(&self.brownian, &b)?;
+        let thermostat = bath::thermostat(&self.thermostat, src)?;
+        let (integrator, dt, length) = self.run.schedule(src)?;
+        let probes = self.output.probes(src, b.particles.len())?;
+        let mut system = System::new(b.particles);
+        system.boundary = b.boundary;
+        system.wrap_positions();
+        if self.run.centre_of_mass {
+            system.to_centre_of_mass_frame();
+        }
+        Ok(Built {
+            simulation: Simulation {
+                system,
+                forces: b.forces,
+                stepper: Stepper::new(integrator),
+                dt,
+                observers: Vec::new(),
+                thermostat,
+                seed,
+                sample_at_start: true,
+                brownian,
+            },
+            length,
+            probes,
+            seed,
+        })
+    }
+}
+
+pub(crate) fn one() -> f64 {
+    1.0
+}
+pub(crate) fn yes() -> bool {
+    true
+}
+pub(crate) fn white() -> [f64; 3] {
+    [1.0, 1.0, 1.0]
+}
+pub(crate) fn z_axis() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+pub(crate) fn all_free() -> [bool; 3] {
+    [true; 3]
+}

@@ -1,0 +1,622 @@
+//! The particles of a scene: `[[particle]]` tables, the generators
+//! (`[[lattice]]`, `[[ring]]`, `[[annulus]]`, `[[random_box]]`, `[[fcc]]`,
+//! `[[cloud]]`, `[[plummer]]`), `[[lammps_data]]` files and `[[spring]]`s
+//! between them (002 Eq. 4).
+
+use glam::DVec3;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Deserialize;
+
+use mote_io::{ParseError, Source};
+
+use super::{all_free, one, white, z_axis, Scene};
+use crate::boundary::Boundary;
+use crate::force::Spring;
+use crate::init::{self, Anchor};
+use crate::particles::{ParticleInit, Particles};
+
+/// Properties shared by the particles a table makes.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Properties {
+    #[serde(default = "one")]
+    pub mass: f64,
+    #[serde(default)]
+    pub charge: f64,
+    #[serde(default)]
+    pub radius: f64,
+    /// Mass density ρ: when given, the mass is ρ (4/3)π r³ (solid spheres).
+    pub density: Option<f64>,
+    /// Magnetic dipole moment m (a vector).
+    #[serde(default)]
+    pub dipole: [f64; 3],
+
+    #[serde(default = "white")]
+    pub color: [f64; 3],
+    /// Per axis: may the particle move? (MPPphys `vfix` 1 1 1 = all free.)
+    #[serde(default = "all_free")]
+    pub free: [bool; 3],
+}
+
+impl Default for Properties {
+    fn default() -> Self {
+        Self {
+            mass: 1.0,
+            charge: 0.0,
+            radius: 0.0,
+            density: None,
+            dipole: [0.0; 3],
+            color: white(),
+            free: all_free(),
+        }
+    }
+}
+
+impl Properties {
+    fn template(&self) -> ParticleInit {
+        ParticleInit {
+            mass: self
+                .density
+                .map_or(self.mass, |rho| sphere_mass(rho, self.radius)),
+            charge: self.charge,
+            radius: self.radius,
+            color: self.color,
+            free: self.free,
+            dipole: DVec3::from(self.dipole),
+            ..ParticleInit::default()
+        }
+    }
+}
+
+/// The mass ρ (4/3)π r³ of a solid sphere.
+fn sphere_mass(density: f64, radius: f64) -> f64 {
+    density * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3)
+}
+
+/// `[[particle]]`: one particle.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    pub position: [f64; 3],
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Displacement applied after spring rest lengths are taken (MPPphys `dis`).
+    #[serde(default)]
+    pub displacement: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[lattice]]`: a rectangular lattice, optionally joined by springs.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatticeSpec {
+    pub n: [usize; 3],
+    pub spacing: [f64; 3],
+    #[serde(default)]
+    pub origin: [f64; 3],
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// `none` (default), `boundary` or `first-column`.
+    #[serde(default)]
+    pub anchor: Option<String>,
+    pub springs: Option<LatticeSprings>,
+    /// Displacement of mode (r, s): u = amplitude · sin(rπx/a) sin(sπy/b) over the lattice (002 Eq. 20).
+    pub mode: Option<ModeSpec>,
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatticeSprings {
+    pub stiffness: f64,
+    #[serde(default)]
+    pub damping: f64,
+    #[serde(default)]
+    pub diagonals: bool,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModeSpec {
+    pub r: u32,
+    pub s: u32,
+    pub amplitude: [f64; 3],
+}
+
+/// The speed of ring bodies: a number or a rule.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum SpeedSpec {
+    Value(f64),
+    Rule(String),
+}
+
+/// `[[ring]]`: N equal bodies on a circle.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RingSpec {
+    pub n: usize,
+    /// Radius R of the circle (the bodies' own size is `radius`).
+    pub orbit_radius: f64,
+    #[serde(default)]
+    pub centre: [f64; 3],
+    #[serde(default = "z_axis")]
+    pub normal: [f64; 3],
+    /// `"choreography"` (002 Eq. 16), `"kepler"` (about `central_mass`) or a number.
+    pub speed: SpeedSpec,
+    #[serde(default)]
+    pub central_mass: f64,
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[annulus]]`: ring particles on Kepler orbits about a central mass.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnnulusSpec {
+    pub n: usize,
+    pub inner: f64,
+    pub outer: f64,
+    pub central_mass: f64,
+    #[serde(default)]
+    pub centre: [f64; 3],
+    #[serde(default = "z_axis")]
+    pub normal: [f64; 3],
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[random_box]]`: N particles uniformly at random in a box.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomBoxSpec {
+    pub n: usize,
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    /// Standard deviation of each velocity component.
+    #[serde(default)]
+    pub velocity_sigma: f64,
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[spring]]`: springs between listed particle pairs (002 Eq. 4).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    pub pairs: Vec<[usize; 2]>,
+    pub stiffness: f64,
+    #[serde(default)]
+    pub damping: f64,
+    /// Default: the distance of the pair before displacements.
+    pub rest_length: Option<f64>,
+}
+
+/// `[[cloud]]`: n non-overlapping spheres placed at random in [min, max]
+/// (random sequential addition), radii uniform in radius·(1 ± spread).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudSpec {
+    pub n: usize,
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    #[serde(default)]
+    pub spread: f64,
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[lammps_data]]`: spheres from a LAMMPS data file (`atom_style sphere`:
+/// id type diameter density x y z), path relative to the scene file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DataSpec {
+    pub file: String,
+    #[serde(default = "white")]
+    pub color: [f64; 3],
+}
+
+/// `[[fcc]]`: a face-centred cubic crystal at a number density, with
+/// Maxwell–Boltzmann velocities at temperature kT (zero total momentum,
+/// rescaled to exactly kT); sets a periodic `[box]` when the scene has none.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FccSpec {
+    pub cells: [usize; 3],
+    pub density: f64,
+    #[serde(default)]
+    pub kt: f64,
+    #[serde(default)]
+    pub origin: [f64; 3],
+    #[serde(flatten)]
+    pub props: Properties,
+}
+
+/// `[[plummer]]`: a Plummer sphere (Aarseth, Hénon & Wielen 1974) of `n`
+/// particles, total mass `total_mass`, scale radius `scale_radius`, in
+/// virial equilibrium, truncated at `max_radius` (default 20 scale radii).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlummerSpec {
+    pub n: usize,
+    #[serde(default = "one")]
+    pub total_mass: f64,
+    #[serde(default = "one")]
+    pub scale_radius: f64,
+    pub max_radius: Option<f64>,
+    #[serde(default = "white")]
+    pub color: [f64; 3],
+}
+
+/// The particles of a scene, the springs between them, and the periodic box
+/// an `[[fcc]]` crystal sets.
+pub struct Made {
+    pub particles: Particles,
+    pub springs: Vec<Spring>,
+    pub fcc_box: Option<Boundary>,
+}
+
+/// Makes every particle of the scene, in the order of the module's doc,
+/// drawing from `rng` in that order.
+pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<Made, ParseError> {
+    let file = src.file;
+    let err = |span: std::ops::Range<usize>, msg: String| src.error(span, msg);
+    let g_const = scene
+        .gravity
+        .as_ref()
+        .and_then(|g| g.get_ref().g)
+        .unwrap_or(scene.units.gravitational_constant());
+    let mut inits: Vec<ParticleInit> = Vec::new();
+    let mut displacements: Vec<DVec3> = Vec::new();
+    let mut springs: Vec<Spring> = Vec::new();
+
+    let check_props = |p: &Properties, span: std::ops::Range<usize>| -> Result<(), ParseError> {
+        if !p.mass.is_finite() || p.mass <= 0.0 {
+            return Err(err(
+                span,
+                format!("mass must be positive, found {}", p.mass),
+            ));
+        }
+        if let Some(rho) = p.density {
+            if !rho.is_finite() || rho <= 0.0 || p.radius <= 0.0 {
+                return Err(err(
+                    span,
+                    format!("density must be positive and needs a radius, found density {rho}"),
+                ));
+            }
+        }
+        if p.radius < 0.0 {
+            return Err(err(
+                span,
+                format!("radius must not be negative, found {}", p.radius),
+            ));
+        }
+        Ok(())
+    };
+
+    for spec in &scene.particle {
+        let s = spec.get_ref();
+        check_props(&s.props, spec.span())?;
+        let mut p = s.props.template();
+        p.position = DVec3::from(s.position);
+        p.velocity = DVec3::from(s.velocity);
+        inits.push(p);
+        displacements.push(DVec3::from(s.displacement));
+    }
+    for spec in &scene.lattice {
+        let s = spec.get_ref();
+        check_props(&s.props, spec.span())?;
+        if s.n.contains(&0) {
+            return Err(err(
+                spec.span(),
+                "lattice n needs at least one site per axis".into(),
+            ));
+        }
+        let anchor = match s.anchor.as_deref() {
+            None | Some("none") => Anchor::None,
+            Some("boundary") => Anchor::Boundary,
+            Some("first-column") => Anchor::FirstColumn,
+            Some(other) => {
+                return Err(err(
+                    spec.span(),
+                    format!("unknown anchor '{other}': expected none, boundary or first-column"),
+                ))
+            }
+        };
+        let mut t = s.props.template();
+        t.velocity = DVec3::from(s.velocity);
+        let lat = init::lattice(
+            s.n,
+            DVec3::from(s.origin),
+            DVec3::from(s.spacing),
+            &t,
+            anchor,
+            s.springs
+                .as_ref()
+                .map(|sp| (sp.stiffness, sp.damping, sp.diagonals)),
+        );
+        let offset = inits.len();
+        let [nx, ny, _] = s.n;
+        for (k, site) in lat.sites.into_iter().enumerate() {
+            let mut d = DVec3::ZERO;
+            if let Some(m) = &s.mode {
+                let (i, j) = (k % nx, (k / nx) % ny);
+                let fx = if nx > 1 {
+                    i as f64 / (nx - 1) as f64
+                } else {
+                    0.5
+                };
+                let fy = if ny > 1 {
+                    j as f64 / (ny - 1) as f64
+                } else {
+                    0.5
+                };
+                let pi = std::f64::consts::PI;
+                d = DVec3::from(m.amplitude)
+                    * ((m.r as f64 * pi * fx).sin() * (m.s as f64 * pi * fy).sin());
+            }
+            inits.push(site);
+            displacements.push(d);
+        }
+        springs.extend(lat.springs.into_iter().map(|sp| Spring {
+            i: sp.i + offset,
+            j: sp.j + offset,
+            ..sp
+        }));
+    }
+    for spec in &scene.ring {
+        let s = spec.get_ref();
+        check_props(&s.props, spec.span())?;
+        if s.n == 0 || !s.orbit_radius.is_finite() || s.orbit_radius <= 0.0 {
+            return Err(err(
+                spec.span(),
+                "a ring needs n ≥ 1 and orbit_radius > 0".into(),
+            ));
+        }
+        let speed = match &s.speed {
+            SpeedSpec::Value(v) => *v,
+            SpeedSpec::Rule(r) if r == "choreography" => {
+                init::choreography_speed(s.n, g_const * s.props.mass, s.orbit_radius)
+            }
+            SpeedSpec::Rule(r) if r == "kepler" => {
+                (g_const * s.central_mass / s.orbit_radius).sqrt()
+            }
+            SpeedSpec::Rule(r) => {
+                return Err(err(
+                    spec.span(),
+                    format!(
+                        "unknown speed '{r}': expected \"choreography\", \"kepler\" or a number"
+                    ),
+                ))
+            }
+        };
+        let mut t = s.props.template();
+        t.velocity = DVec3::from(s.velocity);
+        for p in init::ring(
+            s.n,
+            DVec3::from(s.centre),
+            s.orbit_radius,
+            DVec3::from(s.normal),
+            speed,
+            &t,
+        ) {
+            inits.push(p);
+            displacements.push(DVec3::ZERO);
+        }
+    }
+    for spec in &scene.annulus {
+        let s = spec.get_ref();
+        check_props(&s.props, spec.span())?;
+        if s.inner.is_nan() || s.inner <= 0.0 || s.outer.is_nan() || s.outer < s.inner {
+            return Err(err(
+                spec.span(),
+                "an annulus needs 0 < inner ≤ outer".into(),
+            ));
+        }
+        let mut t = s.props.template();
+        t.velocity = DVec3::from(s.velocity);
+        for p in init::annulus(
+            s.n,
+            DVec3::from(s.centre),
+            s.inner,
+            s.outer,
+            DVec3::from(s.normal),
+            g_const * s.central_mass,
+            &t,
+            rng,
+        ) {
+            inits.push(p);
+            displacements.push(DVec3::ZERO);
+        }
+    }
+    for spec in &scene.random_box {
+        let s = spec.get_ref();
+        check_props(&s.props, spec.span())?;
+        if (0..3).any(|d| s.max[d] < s.min[d]) {
+            return Err(err(
+                spec.span(),
+                "random_box needs min ≤ max on every axis".into(),
+            ));
+        }
+        let t = s.props.template();
+        for p in init::random_box(
+            s.n,
+            DVec3::from(s.min),
+            DVec3::from(s.max),
+            s.velocity_sigma,
+            &t,
+            rng,
+        ) {
+            inits.push(p);
+            displacements.push(DVec3::ZERO);
+        }
+    }
+    let mut fcc_box: Option<crate::boundary::Boundary> = None;
+    for spec in &scene.fcc {
+        let s = spec.get_ref();
+        check_props(&s.props, spec.span())?;
+        if s.cells.contains(&0) || s.density.is_nan() || s.density <= 0.0 || s.kt < 0.0 {
+            return Err(err(
+                spec.span(),
+                "fcc needs cells ≥ 1 on every axis, density > 0 and kt ≥ 0".into(),
+            ));
+        }
+        let lat = init::fcc(
+            s.cells,
+            s.density,
+            DVec3::from(s.origin),
+            s.kt,
+            &s.props.template(),
+            rng,
+        );
+        fcc_box = Some(lat.1);
+        for p in lat.0 {
+            inits.push(p);
+            displacements.push(DVec3::ZERO);
+        }
+    }
+    for spec in &scene.cloud {
+        let s = spec.get_ref();
+        check_props(&s.props, spec.span())?;
+        if s.props.radius <= 0.0 || !(0.0..1.0).contains(&s.spread) {
+            return Err(err(
+                spec.span(),
+                "a cloud needs radius > 0 and 0 ≤ spread < 1".into(),
+            ));
+        }
+        let made = init::cloud(
+            s.n,
+            DVec3::from(s.min),
+            DVec3::from(s.max),
+            s.props.radius,
+            s.spread,
+            &s.props.template(),
+            rng,
+        );
+        if made.len() < s.n {
+            return Err(err(
+                spec.span(),
+                format!(
+                    "only {} of {} spheres fit in the cloud's box without overlap: enlarge it or lower n",
+                    made.len(),
+                    s.n
+                ),
+            ));
+        }
+        for mut p in made {
+            if let Some(rho) = s.props.density {
+                p.mass = sphere_mass(rho, p.radius);
+            }
+            inits.push(p);
+            displacements.push(DVec3::ZERO);
+        }
+    }
+    for spec in &scene.plummer {
+        let s = spec.get_ref();
+        if s.n == 0
+            || s.total_mass.is_nan()
+            || s.total_mass <= 0.0
+            || s.scale_radius.is_nan()
+            || s.scale_radius <= 0.0
+        {
+            return Err(err(
+                spec.span(),
+                "a plummer sphere needs n ≥ 1, total_mass > 0 and scale_radius > 0".into(),
+            ));
+        }
+        let sphere = crate::tree::PlummerSphere {
+            n: s.n,
+            mass: s.total_mass,
+            radius: s.scale_radius,
+            g: g_const,
+            max_radius: Some(s.max_radius.unwrap_or(20.0 * s.scale_radius)),
+        };
+        let template = ParticleInit {
+            mass: s.total_mass / s.n as f64,
+            color: s.color,
+            ..ParticleInit::default()
+        };
+        for p in sphere.particles(&template, rng) {
+            inits.push(p);
+            displacements.push(DVec3::ZERO);
+        }
+    }
+    for spec in &scene.lammps_data {
+        let s = spec.get_ref();
+        let path = std::path::Path::new(file)
+            .parent()
+            .unwrap_or(std::path::Path::new("."))
+            .join(&s.file);
+        let data = mote_io::lammps_data::read(&path).map_err(|e| {
+            if e.line == 0 && e.message.starts_with("cannot read") {
+                err(spec.span(), format!("{}: {}", path.display(), e.message))
+            } else {
+                e
+            }
+        })?;
+        for a in &data.atoms {
+            let radius = 0.5 * a.diameter;
+            inits.push(ParticleInit {
+                position: DVec3::from(a.position),
+                velocity: DVec3::from(a.velocity),
+                angular_velocity: DVec3::from(a.angular_velocity),
+                mass: sphere_mass(a.density, radius),
+                radius,
+                color: s.color,
+                ..ParticleInit::default()
+            });
+            displacements.push(DVec3::ZERO);
+        }
+    }
+    let n = inits.len();
+    if n == 0 {
+        return Err(src.whole("the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]], [[fcc]], [[cloud]], [[plummer]]) or [[lammps_data]]"));
+    }
+    for spec in &scene.spring {
+        let s = spec.get_ref();
+        if s.stiffness < 0.0 || s.damping < 0.0 {
+            return Err(err(
+                spec.span(),
+                "spring stiffness and damping must not be negative".into(),
+            ));
+        }
+        for &[i, j] in &s.pairs {
+            if i >= n || j >= n || i == j {
+                return Err(err(
+                    spec.span(),
+                    format!(
+                        "spring pair [{i}, {j}] must name two different particles 0..{}",
+                        n - 1
+                    ),
+                ));
+            }
+            springs.push(Spring {
+                i,
+                j,
+                stiffness: s.stiffness,
+                damping: s.damping,
+                rest_length: s
+                    .rest_length
+                    .unwrap_or_else(|| (inits[i].position - inits[j].position).length()),
+            });
+        }
+    }
+    // Displacements come after rest lengths were taken (MPPphys `dis`).
+    let mut particles = Particles::default();
+    for (mut p, d) in inits.into_iter().zip(displacements) {
+        p.position += d;
+        particles.push(p);
+    }
+
+    Ok(Made {
+        particles,
+        springs,
+        fcc_box,
+    })
+}

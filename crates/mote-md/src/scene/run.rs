@@ -1,0 +1,167 @@
+//! `[run]` (integrator, time step, length), `[output]` (files and their
+//! intervals) and `[box]` (the simulation box).
+
+use glam::DVec3;
+use serde::Deserialize;
+use toml::Spanned;
+
+use mote_io::{ParseError, Source};
+
+use super::all_free;
+use crate::boundary::Boundary;
+use crate::integrate::Integrator;
+use crate::observe::Probe;
+use crate::simulation::RunLength;
+
+/// `[run]`: integrator, time step and length.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSettings {
+    /// Default: leapfrog.
+    #[serde(default = "default_integrator")]
+    pub integrator: Spanned<String>,
+    pub dt: Option<Spanned<f64>>,
+    pub steps: Option<u64>,
+    pub until: Option<f64>,
+    /// Move to the centre-of-mass frame before the run (only if nothing is fixed).
+    #[serde(default)]
+    pub centre_of_mass: bool,
+}
+
+fn default_integrator() -> Spanned<String> {
+    Spanned::new(0..0, "leapfrog".into())
+}
+
+impl Default for RunSettings {
+    fn default() -> Self {
+        Self {
+            integrator: default_integrator(),
+            dt: None,
+            steps: None,
+            until: None,
+            centre_of_mass: false,
+        }
+    }
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSettings {
+    /// Folder of the output files (default `out/<scene name>`).
+    pub dir: Option<String>,
+    /// Steps between rows of observables.csv; 0 turns it off.
+    #[serde(default = "default_observables_every")]
+    pub observables_every: u64,
+    /// Steps between frames of trajectory.xyz; 0 turns it off.
+    #[serde(default = "default_trajectory_every")]
+    pub trajectory_every: u64,
+    /// Per-particle quantities added to observables.csv, e.g. `["z[30]", "speed[1]"]`.
+    #[serde(default)]
+    pub inspect: Vec<Spanned<String>>,
+}
+
+fn default_observables_every() -> u64 {
+    10
+}
+fn default_trajectory_every() -> u64 {
+    100
+}
+
+impl Default for OutputSettings {
+    fn default() -> Self {
+        Self {
+            dir: None,
+            observables_every: default_observables_every(),
+            trajectory_every: default_trajectory_every(),
+            inspect: Vec::new(),
+        }
+    }
+}
+
+/// `[box]`: an orthorhombic simulation box.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSettings {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+    #[serde(default = "all_free")]
+    pub periodic: [bool; 3],
+}
+
+/// The box of `[box]`, else the one an `[[fcc]]` crystal set, else none.
+pub fn boundary(
+    bounds: &Option<Spanned<BoxSettings>>,
+    fcc_box: Option<Boundary>,
+    src: Source,
+) -> Result<Boundary, ParseError> {
+    Ok(match bounds {
+        Some(b) => {
+            let v = b.get_ref();
+            if (0..3).any(|k| v.hi[k].is_nan() || v.lo[k].is_nan() || v.hi[k] <= v.lo[k]) {
+                return Err(src.error(b.span(), "[box] needs lo < hi on every axis"));
+            }
+            Boundary {
+                lo: DVec3::from(v.lo),
+                hi: DVec3::from(v.hi),
+                periodic: v.periodic,
+            }
+        }
+        None => fcc_box.unwrap_or_default(),
+    })
+}
+
+impl RunSettings {
+    /// The integrator, the time step and the length of the run (if the
+    /// scene gives one).
+    pub fn schedule(
+        &self,
+        src: Source,
+    ) -> Result<(Integrator, f64, Option<RunLength>), ParseError> {
+        let integrator = Integrator::from_name(self.integrator.get_ref()).ok_or_else(|| {
+            src.error(
+                self.integrator.span(),
+                format!(
+                    "unknown integrator '{}': expected {}",
+                    self.integrator.get_ref(),
+                    Integrator::NAMES
+                ),
+            )
+        })?;
+        let dt = match &self.dt {
+            Some(dt) if *dt.get_ref() > 0.0 && dt.get_ref().is_finite() => *dt.get_ref(),
+            Some(dt) => {
+                return Err(src.error(
+                    dt.span(),
+                    format!("dt must be positive, found {}", dt.get_ref()),
+                ))
+            }
+            None => return Err(src.whole("[run] needs a time step: dt = ...")),
+        };
+        let length = match (self.steps, self.until) {
+            (Some(_), Some(_)) => return Err(src.whole("[run] takes steps or until, not both")),
+            (Some(s), None) => Some(RunLength::Steps(s)),
+            (None, Some(t)) => Some(RunLength::Until(t)),
+            (None, None) => None,
+        };
+        Ok((integrator, dt, length))
+    }
+}
+
+impl OutputSettings {
+    /// The per-particle columns of `inspect`, checked against the `n` particles.
+    pub fn probes(&self, src: Source, n: usize) -> Result<Vec<Probe>, ParseError> {
+        let mut probes = Vec::new();
+        for p in &self.inspect {
+            let probe = Probe::parse(p.get_ref()).map_err(|m| src.error(p.span(), m))?;
+            if probe.particle >= n {
+                return Err(src.error(
+                    p.span(),
+                    format!("inspect '{}': there are only {n} particles", p.get_ref()),
+                ));
+            }
+            probes.push(probe);
+        }
+        Ok(probes)
+    }
+}
