@@ -95,20 +95,48 @@ pub struct Scene {
     pub speed: Option<f64>,
     /// Random seed (the command line's `--seed` wins).
     pub seed: Option<u64>,
-    /// Simulated time of the run (after `equilibrate`).
-    #[serde(default = "default_time")]
+    /// `[run]`: the length of the run, as for every engine.
+    #[serde(default)]
+    pub run: RunSection,
+    /// `[output]`: the files, as for every engine.
+    #[serde(default)]
+    pub output: OutputSection,
+    /// Deprecated top-level keys of the first scene format, kept for one
+    /// release; [`Scene::parse`] turns them into the fields below and a note.
+    #[serde(rename = "time")]
+    legacy_time: Option<f64>,
+    #[serde(rename = "equilibrate")]
+    legacy_equilibrate: Option<f64>,
+    #[serde(rename = "output_interval")]
+    legacy_output_interval: Option<f64>,
+    #[serde(rename = "trajectory")]
+    legacy_trajectory: Option<String>,
+    #[serde(rename = "observables")]
+    legacy_observables: Option<String>,
+    #[serde(rename = "histogram")]
+    legacy_histogram: Option<String>,
+    /// Simulated time measured (after `equilibrate`); from `[run] until`
+    /// (default equilibrate + 10).
+    #[serde(skip)]
     pub time: f64,
     /// Simulated time run first, without measuring.
-    #[serde(default)]
+    #[serde(skip)]
     pub equilibrate: f64,
     /// Time between output rows and frames (default time/100).
+    #[serde(skip)]
     pub output_interval: Option<f64>,
-    /// Extended XYZ trajectory file (relative to the scene file).
+    /// Extended XYZ trajectory file, in the output folder.
+    #[serde(skip)]
     pub trajectory: Option<String>,
-    /// CSV of observables per output interval.
+    /// CSV of observables per output interval, in the output folder.
+    #[serde(skip)]
     pub observables: Option<String>,
     /// CSV of the speed histogram at the end, beside Maxwell–Boltzmann.
+    #[serde(skip)]
     pub histogram: Option<String>,
+    /// What the scene should say differently (deprecated keys), for the summary.
+    #[serde(skip)]
+    pub notes: Vec<String>,
     /// Explicit particles.
     pub particles: Option<Vec<ParticleSpec>>,
     /// Initial state from the last frame of an extended XYZ file.
@@ -118,19 +146,66 @@ pub struct Scene {
     pub check_overlaps: bool,
 }
 
+/// `[run]` of an event-driven scene: the keys every engine shares that
+/// apply without a time step.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RunSection {
+    /// End time of the run, equilibration included (default equilibrate + 10).
+    pub until: Option<f64>,
+    /// Simulated time run first, without measuring (default 0).
+    pub equilibrate: Option<f64>,
+    /// Keys of the time-stepped engines, read only to be refused with the reason.
+    dt: Option<toml::Value>,
+    steps: Option<toml::Value>,
+    integrator: Option<toml::Value>,
+}
+
+/// `[output]` of an event-driven scene. Files go to `dir` (default
+/// `out/<scene name>`) under the names every engine uses.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSection {
+    pub dir: Option<String>,
+    /// Simulated time between rows of observables.csv and frames of
+    /// trajectory.xyz (default a hundredth of the measured time).
+    pub interval: Option<f64>,
+    /// Write observables.csv (default true).
+    #[serde(default = "yes")]
+    pub observables: bool,
+    /// Write trajectory.xyz (default true).
+    #[serde(default = "yes")]
+    pub trajectory: bool,
+    /// Write speeds.csv, the speed histogram at the end (default true).
+    #[serde(default = "yes")]
+    pub histogram: bool,
+    /// Keys of the time-stepped engines, read only to be refused with the reason.
+    observables_every: Option<toml::Value>,
+    trajectory_every: Option<toml::Value>,
+}
+
+impl Default for OutputSection {
+    fn default() -> Self {
+        Self {
+            dir: None,
+            interval: None,
+            observables: true,
+            trajectory: true,
+            histogram: true,
+            observables_every: None,
+            trajectory_every: None,
+        }
+    }
+}
+
+/// Measured time of a scene that gives no length.
+const DEFAULT_TIME: f64 = 10.0;
+
 fn default_dim() -> usize {
     3
 }
-fn default_time() -> f64 {
-    10.0
-}
 fn yes() -> bool {
     true
-}
-
-/// Line (1-based) of a byte offset in `text`.
-fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].matches('\n').count() + 1
 }
 
 /// Line where `key = ` is first set, or 1.
@@ -182,11 +257,135 @@ impl Scene {
     pub fn parse(text: &str, file: &str) -> Result<Self, EdmdError> {
         let scene: Scene = toml::from_str(text).map_err(|e| EdmdError::Scene {
             file: file.to_string(),
-            line: e.span().map(|s| line_of(text, s.start)).unwrap_or(1),
+            line: e
+                .span()
+                .map_or(1, |s| mote_io::Source::new(file, text).line_of(s.start)),
             message: e.message().trim().to_string(),
         })?;
+        let mut scene = scene;
+        scene.resolve(text, file)?;
         scene.validate(text, file)?;
         Ok(scene)
+    }
+
+    /// Fills the run length and files from `[run]` and `[output]`, or from
+    /// the deprecated top-level keys (with a note each); the two together
+    /// are refused.
+    fn resolve(&mut self, text: &str, file: &str) -> Result<(), EdmdError> {
+        let has_table = |name: &str| {
+            text.parse::<toml::Table>()
+                .is_ok_and(|t| t.contains_key(name))
+        };
+        let err = |key: &str, message: String| EdmdError::Scene {
+            file: file.to_string(),
+            line: key_line(text, key),
+            message,
+        };
+        let stepped = [
+            ("dt", self.run.dt.is_some(), "[run] until = (end time)"),
+            (
+                "steps",
+                self.run.steps.is_some(),
+                "[run] until = (end time)",
+            ),
+            (
+                "integrator",
+                self.run.integrator.is_some(),
+                "nothing: collisions are predicted exactly",
+            ),
+            (
+                "observables_every",
+                self.output.observables_every.is_some(),
+                "[output] interval = (simulated time)",
+            ),
+            (
+                "trajectory_every",
+                self.output.trajectory_every.is_some(),
+                "[output] interval = (simulated time)",
+            ),
+        ];
+        if let Some((key, _, instead)) = stepped.iter().find(|(_, given, _)| *given) {
+            return Err(err(
+                key,
+                format!("`{key}` is for time-stepped engines; event-driven dynamics jumps from collision to collision, with no time step: give {instead}"),
+            ));
+        }
+        let old_run = [
+            ("time", self.legacy_time.is_some()),
+            ("equilibrate", self.legacy_equilibrate.is_some()),
+        ];
+        let old_output = [
+            ("output_interval", self.legacy_output_interval.is_some()),
+            ("trajectory", self.legacy_trajectory.is_some()),
+            ("observables", self.legacy_observables.is_some()),
+            ("histogram", self.legacy_histogram.is_some()),
+        ];
+        for (table, keys) in [("run", &old_run[..]), ("output", &old_output[..])] {
+            if let Some((key, _)) = keys.iter().find(|(_, given)| *given) {
+                if has_table(table) {
+                    return Err(err(
+                        key,
+                        format!("`{key}` (deprecated) and [{table}] cannot be mixed: move it into [{table}] (see docs/edmd.md)"),
+                    ));
+                }
+            }
+        }
+        if old_run.iter().any(|(_, given)| *given) {
+            self.equilibrate = self.legacy_equilibrate.unwrap_or(0.0);
+            self.time = self.legacy_time.unwrap_or(DEFAULT_TIME);
+            let mut keys = Vec::new();
+            if let Some(t) = self.legacy_time {
+                keys.push(format!("until = {}", self.equilibrate + t));
+            }
+            if let Some(e) = self.legacy_equilibrate {
+                keys.push(format!("equilibrate = {e}"));
+            }
+            self.notes.push(format!(
+                "note: top-level `time` and `equilibrate` are deprecated and go in one release: write [run] {}",
+                keys.join(", ")
+            ));
+        } else {
+            self.equilibrate = self.run.equilibrate.unwrap_or(0.0);
+            self.time = match self.run.until {
+                Some(until) => {
+                    if !(until >= self.equilibrate && until.is_finite()) {
+                        return Err(err(
+                            "until",
+                            format!(
+                                "[run] until = {until} must be a time at or after equilibrate = {}",
+                                self.equilibrate
+                            ),
+                        ));
+                    }
+                    until - self.equilibrate
+                }
+                None => DEFAULT_TIME,
+            };
+        }
+        if old_output.iter().any(|(_, given)| *given) {
+            self.output_interval = self.legacy_output_interval;
+            self.trajectory = self.legacy_trajectory.clone();
+            self.observables = self.legacy_observables.clone();
+            self.histogram = self.legacy_histogram.clone();
+            let named: Vec<&str> = old_output
+                .iter()
+                .filter(|(_, given)| *given)
+                .map(|(k, _)| *k)
+                .collect();
+            self.notes.push(format!(
+                "note: top-level `{}` {} deprecated and go{} in one release: write [output] interval = ... and switch observables.csv, trajectory.xyz, speeds.csv on or off there (see docs/edmd.md)",
+                named.join("`, `"),
+                if named.len() == 1 { "is" } else { "are" },
+                if named.len() == 1 { "es" } else { "" },
+            ));
+        } else {
+            let o = &self.output;
+            self.output_interval = o.interval;
+            self.trajectory = o.trajectory.then(|| "trajectory.xyz".to_string());
+            self.observables = o.observables.then(|| "observables.csv".to_string());
+            self.histogram = o.histogram.then(|| "speeds.csv".to_string());
+        }
+        Ok(())
     }
 
     /// Reads and parses a scene file.
@@ -261,7 +460,14 @@ impl Scene {
             }
         }
         if !(self.time >= 0.0 && self.time.is_finite()) {
-            return Err(err("time", format!("time = {} must be ≥ 0", self.time)));
+            return Err(err(
+                if self.legacy_time.is_some() {
+                    "time"
+                } else {
+                    "until"
+                },
+                format!("the measured time {} must be ≥ 0", self.time),
+            ));
         }
         if !(self.equilibrate >= 0.0 && self.equilibrate.is_finite()) {
             return Err(err(
@@ -272,8 +478,12 @@ impl Scene {
         if let Some(dt) = self.output_interval {
             if dt.is_nan() || dt <= 0.0 {
                 return Err(err(
-                    "output_interval",
-                    format!("output_interval = {dt} must be positive"),
+                    if self.legacy_output_interval.is_some() {
+                        "output_interval"
+                    } else {
+                        "interval"
+                    },
+                    format!("the output interval {dt} must be positive"),
                 ));
             }
         }
@@ -785,5 +995,74 @@ pub fn frame<const D: usize>(sys: &System<D>) -> mote_io::xyz::Frame {
         positions: sys.positions().iter().map(to3).collect(),
         velocities: sys.velocities().iter().map(to3).collect(),
         radii: sys.radii().to_vec(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SYSTEM: &str = "dimension = 3\nn = 500\npacking_fraction = 0.2\n";
+
+    /// The shared `[run]`/`[output]` sections and the first format's
+    /// top-level keys describe the same run; only the old keys carry notes.
+    #[test]
+    fn shared_sections_and_deprecated_keys_give_the_same_run() {
+        let new = Scene::parse(
+            &format!("{SYSTEM}[run]\nuntil = 6.0\nequilibrate = 2.0\n[output]\ninterval = 0.5\ntrajectory = false\nhistogram = false\n"),
+            "new.toml",
+        )
+        .unwrap();
+        let old = Scene::parse(
+            &format!("{SYSTEM}equilibrate = 2.0\ntime = 4.0\noutput_interval = 0.5\nobservables = \"observables.csv\"\n"),
+            "old.toml",
+        )
+        .unwrap();
+        for s in [&new, &old] {
+            assert_eq!((s.equilibrate, s.time), (2.0, 4.0));
+            assert_eq!(s.output_interval, Some(0.5));
+            assert_eq!(s.observables.as_deref(), Some("observables.csv"));
+            assert_eq!(
+                (s.trajectory.as_deref(), s.histogram.as_deref()),
+                (None, None)
+            );
+        }
+        assert!(new.notes.is_empty());
+        assert_eq!(old.notes.len(), 2, "{:?}", old.notes);
+        assert!(old.notes[0].contains("[run] until = 6, equilibrate = 2"));
+    }
+
+    #[test]
+    fn defaults_write_every_file_for_ten_time_units() {
+        let s = Scene::parse(SYSTEM, "s.toml").unwrap();
+        assert_eq!(
+            (s.equilibrate, s.time, s.output_interval),
+            (0.0, 10.0, None)
+        );
+        assert_eq!(s.trajectory.as_deref(), Some("trajectory.xyz"));
+        assert_eq!(s.observables.as_deref(), Some("observables.csv"));
+        assert_eq!(s.histogram.as_deref(), Some("speeds.csv"));
+    }
+
+    #[test]
+    fn mixing_old_keys_and_shared_sections_is_refused_at_the_old_key() {
+        let text = format!("{SYSTEM}time = 4.0\n[run]\nuntil = 5.0\n");
+        let e = Scene::parse(&text, "mixed.toml").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "mixed.toml:4: `time` (deprecated) and [run] cannot be mixed: move it into [run] (see docs/edmd.md)"
+        );
+        let text = format!("{SYSTEM}[run]\ndt = 0.1\n");
+        let e = Scene::parse(&text, "stepped.toml").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "stepped.toml:5: `dt` is for time-stepped engines; event-driven dynamics jumps from collision to collision, with no time step: give [run] until = (end time)"
+        );
+        let text = format!("{SYSTEM}[run]\nuntil = 1.0\nequilibrate = 2.0\n");
+        let e = Scene::parse(&text, "early.toml").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "early.toml:5: [run] until = 1 must be a time at or after equilibrate = 2"
+        );
     }
 }

@@ -80,6 +80,7 @@ pub fn run_with(
     let dir = options
         .output
         .clone()
+        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
         .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
     std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
     let scene_dir = if input.label.starts_with("example:") {
@@ -191,6 +192,7 @@ fn summary(r: &mote_edmd::Run, scene: &Scene, cpu: f64) -> Vec<String> {
         r.ks.0, r.ks.1
     );
     let mut lines = vec![s];
+    lines.extend(scene.notes.iter().cloned());
     if r.n <= 10 {
         let v: Vec<String> = r.speeds.iter().map(|x| format!("{x:.12}")).collect();
         lines.push(format!("final speeds: {}", v.join(" ")));

@@ -7,6 +7,7 @@
 //! Every common option either works for the scene's engine or is refused
 //! with a message that says why ([`RunOptions`]); none is silently ignored.
 
+mod checkpoints;
 pub mod cpu;
 pub mod engine;
 pub mod error;
@@ -116,10 +117,16 @@ pub struct Outcome {
 
 /// Runs what `options` describe with the engine its scene asks for.
 pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, FrontError> {
-    if options.resume.is_some() {
-        // Only time-stepped point-particle runs write checkpoints, so a
-        // checkpoint is always theirs.
-        return particles::run(None, options, monitor);
+    if let Some(path) = &options.resume {
+        // Time-stepped runs write checkpoints: point particles, and rigid
+        // bodies (whose checkpoints say so).
+        let cp = mote_io::checkpoint::read(path)?;
+        let result = match cp.option("engine") {
+            Some("rigid") => rigid::resume(&cp, options, monitor),
+            _ => particles::run(None, options, monitor),
+        };
+        monitor.finish();
+        return result;
     }
     let Some(spec) = options.input.as_deref() else {
         error::refuse!("no input: give a scene file, a particle file or example:NAME");

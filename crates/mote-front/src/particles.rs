@@ -4,11 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use mote_io::checkpoint::{self, Checkpoint};
-use mote_io::{IoError, Provenance};
+use mote_io::IoError;
 use mote_md::output::{ObservablesCsv, TrajectoryXyz};
 use mote_md::scene::{PlistSystem, Scene};
 use mote_md::{MdError, Observables, Observer, RunLength, RunReport, System};
 
+use crate::checkpoints::{hex, restore, trim_outputs};
 use crate::error::{refuse, FrontError};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
@@ -68,95 +69,6 @@ impl Observer for CheckpointWriter {
     fn files(&self) -> Vec<String> {
         vec![self.path.display().to_string()]
     }
-}
-
-fn hex(x: f64) -> String {
-    format!("{:016x}", x.to_bits())
-}
-
-fn unhex(s: &str) -> Result<f64, FrontError> {
-    u64::from_str_radix(s, 16)
-        .map(f64::from_bits)
-        .map_err(|_| FrontError::request("a checkpoint option is not a hexadecimal f64"))
-}
-
-fn number<T: std::str::FromStr>(key: &str, v: String) -> Result<T, FrontError> {
-    v.parse().map_err(|_| {
-        FrontError::request(format!("checkpoint option {key} = '{v}' is not a number"))
-    })
-}
-
-/// Drops what an interrupted run wrote after its last checkpoint (rows past
-/// `step`, frames past `time`), so the resumed run continues the files.
-fn trim_outputs(
-    dir: &Path,
-    step: u64,
-    time: f64,
-    provenance: &Provenance,
-) -> Result<(), FrontError> {
-    let csv = dir.join("observables.csv");
-    if let Ok(text) = std::fs::read_to_string(&csv) {
-        let mut column = None;
-        let mut kept = String::new();
-        for line in text.lines() {
-            let keep = if line.starts_with('#') {
-                true
-            } else if let Some(k) = column {
-                line.split(',')
-                    .nth(k)
-                    .and_then(|v| v.trim().parse::<f64>().ok())
-                    .is_some_and(|s| s <= step as f64)
-            } else {
-                column = line.split(',').position(|c| c.trim() == "step");
-                true
-            };
-            if keep {
-                kept.push_str(line);
-                kept.push('\n');
-            }
-        }
-        std::fs::write(&csv, kept).map_err(|e| IoError::os(&csv, e))?;
-    }
-    let xyz = dir.join("trajectory.xyz");
-    if xyz.exists() {
-        let frames = mote_io::xyz::read_frames(&xyz)?;
-        let mut w = mote_io::xyz::XyzWriter::create(&xyz, provenance.clone())?;
-        for f in frames.iter().filter(|f| f.time <= time) {
-            w.write(f)?;
-        }
-    }
-    Ok(())
-}
-
-/// The input and the options of the run a checkpoint came from.
-fn restore(cp: &Checkpoint, given: &RunOptions) -> Result<(Input, RunOptions), FrontError> {
-    let get = |k: &str| cp.option(k).map(str::to_string);
-    let plist = get("plist").as_deref() == Some("true");
-    let input = Input {
-        name: get("name").unwrap_or_else(|| "run".into()),
-        label: cp.input_label.clone(),
-        text: cp.input_text.clone(),
-        plist,
-    };
-    let options = RunOptions {
-        input: None,
-        resume: given.resume.clone(),
-        checkpoint_every: get("checkpoint-every")
-            .map(|v| number("checkpoint-every", v))
-            .transpose()?,
-        until: None,
-        steps: get("total-steps")
-            .map(|v| number("total-steps", v))
-            .transpose()?,
-        dt: get("dt").map(|v| unhex(&v)).transpose()?,
-        system: get("system").filter(|_| plist),
-        solver: get("solver"),
-        output: get("output").map(PathBuf::from),
-        picture: given.picture.clone(),
-        seed: Some(cp.seed),
-        threads: given.threads,
-    };
-    Ok((input, options))
 }
 
 /// Puts the checkpoint's state into the freshly built simulation.

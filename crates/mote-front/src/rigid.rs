@@ -1,8 +1,10 @@
 //! Rigid clumps of spheres moved by the FRBI (`mote_md::rigid::scene`).
 
-use mote_md::rigid::scene::{run_rigid_scene, RigidRun, RigidScene};
+use mote_io::checkpoint::Checkpoint;
+use mote_md::rigid::scene::{run_rigid_scene, RigidCheckpoints, RigidRun, RigidScene};
 use mote_md::MdError;
 
+use crate::checkpoints::{restore, trim_outputs};
 use crate::error::FrontError;
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
@@ -11,14 +13,28 @@ pub(crate) fn run(
     options: &RunOptions,
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
+    run_with(input, options, None, monitor)
+}
+
+/// Continues the rigid run a checkpoint came from, appending to its files.
+pub(crate) fn resume(
+    cp: &Checkpoint,
+    given: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    let (input, options) = restore(cp, given)?;
+    run_with(&input, &options, Some(cp), monitor)
+}
+
+fn run_with(
+    input: &Input,
+    options: &RunOptions,
+    resumed: Option<&Checkpoint>,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
     options.refuse(
         "rigid bodies",
         &[
-            (
-                options.checkpoint_every.is_some(),
-                "--checkpoint-every",
-                "rigid runs do not write checkpoints yet",
-            ),
             (
                 options.solver.is_some(),
                 "--solver",
@@ -36,13 +52,38 @@ pub(crate) fn run(
     let dir = options
         .output
         .clone()
-        .unwrap_or_else(|| std::path::PathBuf::from(&scene.output.dir));
+        .or_else(|| scene.output.dir.as_ref().map(std::path::PathBuf::from))
+        .unwrap_or_else(|| std::path::Path::new("out").join(&input.name));
+    let provenance = crate::provenance(&input.label, seed);
+    let checkpoints = options.checkpoint_every.map(|every| RigidCheckpoints {
+        every: every.max(1),
+        path: dir.join("checkpoint.mote"),
+        template: Checkpoint {
+            program: provenance.program.clone(),
+            seed,
+            options: vec![
+                ("engine".into(), "rigid".into()),
+                ("name".into(), input.name.clone()),
+                ("plist".into(), "false".into()),
+                ("checkpoint-every".into(), every.to_string()),
+                ("output".into(), dir.display().to_string()),
+            ],
+            input_label: input.label.clone(),
+            input_text: input.text.clone(),
+            ..Checkpoint::default()
+        },
+    });
+    if let Some(cp) = resumed {
+        trim_outputs(&dir, cp.step, cp.time, &provenance)?;
+    }
     let run = RigidRun {
         seed: Some(seed),
         out_dir: Some(dir.clone()),
         dt: options.dt,
         steps: options.steps,
         until: options.until,
+        checkpoints,
+        resume: resumed.cloned(),
     };
     monitor.start(&format!(
         "mote run {}: rigid clumps (FRBI) with dt = {}, {}, {}",

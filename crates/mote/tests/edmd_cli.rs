@@ -78,23 +78,23 @@ fn maxwell2d_writes_trajectory_csv_and_histogram_with_the_seed() {
         .map(|s| s.trim_end_matches('.').parse().unwrap())
         .unwrap();
     assert!(p > 0.01, "{text}");
-    let frames = mote_io::xyz::read_frames(&dir.path().join("maxwell2d.xyz")).unwrap();
+    let frames = mote_io::xyz::read_frames(&dir.path().join("trajectory.xyz")).unwrap();
     assert_eq!(frames.len(), 101);
     assert_eq!(frames[0].positions.len(), 250);
     assert!(frames
         .iter()
         .all(|f| f.positions.iter().all(|p| p[2] == 0.0)));
-    let xyz = std::fs::read_to_string(dir.path().join("maxwell2d.xyz")).unwrap();
+    let xyz = std::fs::read_to_string(dir.path().join("trajectory.xyz")).unwrap();
     assert!(xyz.lines().nth(1).unwrap().contains("seed=99"));
-    let table = mote_io::csv::read_table(&dir.path().join("maxwell2d.csv")).unwrap();
+    let table = mote_io::csv::read_table(&dir.path().join("observables.csv")).unwrap();
     let e = table.column("kinetic_energy").unwrap();
     assert!(
         e.iter().all(|x| (x - 125.0).abs() < 1e-10),
         "energy 250·½·1² conserved"
     );
-    let csv = std::fs::read_to_string(dir.path().join("maxwell2d.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("observables.csv")).unwrap();
     assert!(csv.starts_with("# ") && csv.lines().next().unwrap().contains("seed=99"));
-    let hist = mote_io::csv::read_table(&dir.path().join("maxwell2d-speeds.csv")).unwrap();
+    let hist = mote_io::csv::read_table(&dir.path().join("speeds.csv")).unwrap();
     let dens = hist.column("density").unwrap();
     let dv = hist.column("v").unwrap()[1] - hist.column("v").unwrap()[0];
     let total: f64 = dens.iter().sum::<f64>() * dv;
@@ -141,7 +141,17 @@ fn scene_file_runs_and_errors_name_file_and_line() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Compressibility factor Z"), "{text}");
+    // The first format's top-level keys still work, with a note each on
+    // what to write instead.
     assert!(dir.path().join("eos.csv").exists());
+    assert!(
+        text.contains("note: top-level `time` and `equilibrate` are deprecated and go in one release: write [run] until = 6, equilibrate = 2"),
+        "{text}"
+    );
+    assert!(
+        text.contains("note: top-level `observables` is deprecated"),
+        "{text}"
+    );
 
     let bad = dir.path().join("bad.toml");
     std::fs::write(

@@ -116,7 +116,8 @@ fn examples_are_listed_and_written_and_each_one_runs() {
             mote_front::Engine::EventDriven => {
                 let table: toml::Table = text.parse().unwrap();
                 let equilibrate = table
-                    .get("equilibrate")
+                    .get("run")
+                    .and_then(|r| r.get("equilibrate"))
                     .and_then(|v| v.as_float())
                     .unwrap_or(0.0);
                 ["--until".to_string(), format!("{}", equilibrate + 0.05)]
@@ -175,7 +176,7 @@ fn event_driven_scene_runs_through_mote_run_as_through_mote_edmd() {
         dir.path(),
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    for file in ["maxwell2d.xyz", "maxwell2d.csv", "maxwell2d-speeds.csv"] {
+    for file in ["trajectory.xyz", "observables.csv", "speeds.csv"] {
         let a = std::fs::read(dir.path().join("run").join(file)).unwrap();
         let b = std::fs::read(dir.path().join("edmd").join(file)).unwrap();
         assert!(a.len() > 100, "{file} is nearly empty");
@@ -200,13 +201,13 @@ fn options_an_engine_lacks_are_refused_with_the_reason() {
         "{err}"
     );
     let o = mote(
-        &["run", "example:magnet-in-field", "--checkpoint-every", "10"],
+        &["run", "example:magnet-in-field", "--solver", "rk4"],
         dir.path(),
     );
     assert_eq!(o.status.code(), Some(1));
     let err = stderr(&o);
     assert!(
-        err.contains("--checkpoint-every (rigid runs do not write checkpoints yet)"),
+        err.contains("--solver (rigid bodies are moved by the FRBI only)"),
         "{err}"
     );
     let o = mote(

@@ -71,7 +71,15 @@ struct ContactState {
     last_time: Option<f64>,
     contacts: usize,
     wall_contacts: usize,
+    /// Histories of a resumed run, put in place at the next evaluation:
+    /// touching sphere pairs (a < b) and sphere–wall slots.
+    pending: Vec<(u32, u32, History)>,
+    pending_walls: Vec<(usize, History)>,
 }
+
+/// Numbers per carried sphere-pair row (a, b, shear, roll) and wall row (slot, shear, roll).
+const PAIR_ROW: usize = 8;
+const WALL_ROW: usize = 7;
 
 impl RigidContacts {
     /// Contacts with law `law` between bodies and `wall_law` against
@@ -130,6 +138,24 @@ impl RigidContacts {
 }
 
 impl ContactState {
+    /// Puts the histories of a resumed run into the freshly built list.
+    fn place_pending_pairs(&mut self) {
+        for (a, b, h) in std::mem::take(&mut self.pending) {
+            let Some(range) = self
+                .start
+                .get(a as usize)
+                .zip(self.start.get(a as usize + 1))
+                .map(|(lo, hi)| *lo as usize..*hi as usize)
+            else {
+                continue;
+            };
+            if let Ok(k) = self.partner[range.clone()].binary_search(&b) {
+                self.history[range.start + k] = h;
+                self.touching[range.start + k] = true;
+            }
+        }
+    }
+
     /// Refreshes the list; after a rebuild drops same-body pairs and carries
     /// the histories of pairs still listed.
     fn refresh(&mut self, centres: &[DVec3], body: &[u32], r_max: f64, boundary: &Boundary) {
@@ -200,6 +226,7 @@ impl BodyInteraction for RigidContacts {
         let mut guard = self.state.lock().unwrap();
         let st = &mut *guard;
         st.refresh(centres, body, r_max, &self.boundary);
+        st.place_pending_pairs();
         let dt = st.last_time.map_or(0.0, |t0| t - t0);
         st.last_time = Some(t);
         let image = self.boundary.image();
@@ -282,6 +309,12 @@ impl BodyInteraction for RigidContacts {
             st.wall_history = vec![History::default(); n * n_walls];
             st.wall_touching = vec![false; n * n_walls];
         }
+        for (slot, h) in std::mem::take(&mut st.pending_walls) {
+            if slot < st.wall_history.len() {
+                st.wall_history[slot] = h;
+                st.wall_touching[slot] = true;
+            }
+        }
         let planes: Vec<Option<(DVec3, f64)>> = self
             .walls
             .iter()
@@ -333,6 +366,67 @@ impl BodyInteraction for RigidContacts {
                 st.wall_contacts += 1;
             }
         }
+    }
+
+    /// [time of the last evaluation (NaN if none), number of pair rows,
+    /// pair rows (a, b, shear, roll) of touching sphere pairs, wall rows
+    /// (slot, shear, roll) of touching sphere–wall contacts]. Pairs that
+    /// do not touch carry the zero history, so these rows are the whole state.
+    fn carried_state(&self) -> Vec<f64> {
+        let s = self.state.lock().unwrap();
+        let mut pairs = Vec::new();
+        for a in 0..s.start.len().saturating_sub(1) {
+            for k in s.start[a] as usize..s.start[a + 1] as usize {
+                if s.touching[k] {
+                    let h = s.history[k];
+                    pairs.extend([a as f64, s.partner[k] as f64]);
+                    pairs.extend(h.shear.to_array());
+                    pairs.extend(h.roll.to_array());
+                }
+            }
+        }
+        let mut out = vec![
+            s.last_time.unwrap_or(f64::NAN),
+            (pairs.len() / PAIR_ROW) as f64,
+        ];
+        out.extend(pairs);
+        for (slot, h) in s.wall_history.iter().enumerate() {
+            if s.wall_touching[slot] {
+                out.push(slot as f64);
+                out.extend(h.shear.to_array());
+                out.extend(h.roll.to_array());
+            }
+        }
+        out
+    }
+
+    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
+        let bad = || "rigid contact history: malformed carried state".to_string();
+        let [t, pairs, rows @ ..] = state else {
+            return if state.is_empty() { Ok(()) } else { Err(bad()) };
+        };
+        let n_pairs = *pairs as usize;
+        if n_pairs * PAIR_ROW > rows.len()
+            || !(rows.len() - n_pairs * PAIR_ROW).is_multiple_of(WALL_ROW)
+        {
+            return Err(bad());
+        }
+        let (pair_rows, wall_rows) = rows.split_at(n_pairs * PAIR_ROW);
+        let history = |r: &[f64]| History {
+            shear: DVec3::new(r[0], r[1], r[2]),
+            roll: DVec3::new(r[3], r[4], r[5]),
+        };
+        let mut s = self.state.lock().unwrap();
+        s.last_time = (!t.is_nan()).then_some(*t);
+        s.pending = pair_rows
+            .chunks(PAIR_ROW)
+            .map(|r| (r[0] as u32, r[1] as u32, history(&r[2..])))
+            .collect();
+        s.pending_walls = wall_rows
+            .chunks(WALL_ROW)
+            .map(|r| (r[0] as usize, history(&r[1..])))
+            .collect();
+        Ok(())
     }
 
     /// The Hertz elastic energy Σ (8/15) E* √R* δ^{5/2} of all sphere pairs
@@ -392,5 +486,13 @@ impl<T: BodyInteraction> BodyInteraction for Arc<T> {
 
     fn potential_energy(&self, view: &BodyView<'_>, t: f64) -> f64 {
         (**self).potential_energy(view, t)
+    }
+
+    fn carried_state(&self) -> Vec<f64> {
+        (**self).carried_state()
+    }
+
+    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
+        (**self).restore_carried_state(state)
     }
 }

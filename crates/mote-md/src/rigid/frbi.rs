@@ -287,6 +287,31 @@ impl Frbi {
         b.time += dt;
     }
 
+    /// What the interactions carry from step to step (contact histories),
+    /// by interaction index; interactions that carry nothing are left out.
+    pub fn carried_state(&self) -> Vec<(usize, Vec<f64>)> {
+        self.interactions
+            .iter()
+            .enumerate()
+            .map(|(k, it)| (k, it.carried_state()))
+            .filter(|(_, v)| !v.is_empty())
+            .collect()
+    }
+
+    /// Gives each interaction back what [`Frbi::carried_state`] took.
+    pub fn restore_carried_state(&self, carried: &[(usize, Vec<f64>)]) -> Result<(), String> {
+        for (k, values) in carried {
+            let it = self.interactions.get(*k).ok_or_else(|| {
+                format!(
+                    "state for interaction {k}, but there are {}",
+                    self.interactions.len()
+                )
+            })?;
+            it.restore_carried_state(values)?;
+        }
+        Ok(())
+    }
+
     /// Kinetic and potential energy at the bodies' current time.
     pub fn energies(&mut self, b: &RigidBodies) -> BodyEnergies {
         self.world.update(b);

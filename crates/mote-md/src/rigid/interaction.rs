@@ -28,6 +28,22 @@ pub trait BodyInteraction: Send + Sync {
     fn potential_energy(&self, _view: &BodyView<'_>, _t: f64) -> f64 {
         0.0
     }
+
+    /// What this interaction carries from one evaluation to the next
+    /// (contact histories), as plain numbers for checkpoints; empty if nothing.
+    fn carried_state(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// Restores what [`BodyInteraction::carried_state`] gave, before the
+    /// first evaluation of a resumed run.
+    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
+        if state.is_empty() {
+            Ok(())
+        } else {
+            Err(format!("{} carries no state", self.name()))
+        }
+    }
 }
 
 /// The spheres and dipoles of all bodies in the world frame: scratch space

@@ -66,7 +66,7 @@
 //! steps = 10000                # or until = 1.0
 //!
 //! [output]
-//! dir = "out"
+//! dir = "out/my-scene"          # default out/<scene name>
 //! observables_every = 100
 //! trajectory_every = 1000
 //! ```
@@ -77,6 +77,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 use mote_geom::{from_axis_angle, DE, E};
+use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::csv::CsvWriter;
 use mote_io::xyz::{Frame, XyzWriter};
 use mote_io::{ParseError, Provenance, Source};
@@ -304,34 +305,35 @@ pub struct RunSettings {
     pub until: Option<f64>,
 }
 
-/// `[output]`.
+/// `[output]`: the keys and defaults of every time-stepped engine.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSettings {
-    #[serde(default = "default_dir")]
-    pub dir: String,
-    #[serde(default = "default_every")]
+    /// Folder of the output files (default `out/<scene name>`).
+    pub dir: Option<String>,
+    /// Steps between rows of observables.csv (default 10).
+    #[serde(default = "default_observables_every")]
     pub observables_every: u64,
-    /// 0: no trajectory.
-    #[serde(default)]
+    /// Steps between frames of trajectory.xyz (default 100); 0: none.
+    #[serde(default = "default_trajectory_every")]
     pub trajectory_every: u64,
 }
 
 impl Default for OutputSettings {
     fn default() -> Self {
         Self {
-            dir: default_dir(),
-            observables_every: default_every(),
-            trajectory_every: 0,
+            dir: None,
+            observables_every: default_observables_every(),
+            trajectory_every: default_trajectory_every(),
         }
     }
 }
 
-fn default_dir() -> String {
-    "out".into()
+fn default_observables_every() -> u64 {
+    10
 }
 
-fn default_every() -> u64 {
+fn default_trajectory_every() -> u64 {
     100
 }
 
@@ -861,6 +863,85 @@ pub struct RigidRun {
     pub steps: Option<u64>,
     /// Replaces the run length by an end time (steps = round(t/dt)).
     pub until: Option<f64>,
+    /// Write checkpoints on this schedule.
+    pub checkpoints: Option<RigidCheckpoints>,
+    /// Continue this checkpoint's run (its scene, seed, dt and length must
+    /// be those given), appending to the files an earlier run wrote.
+    pub resume: Option<Checkpoint>,
+}
+
+/// Where and how often a rigid run writes its checkpoint.
+#[derive(Debug, Clone)]
+pub struct RigidCheckpoints {
+    /// Steps between checkpoints.
+    pub every: u64,
+    pub path: PathBuf,
+    /// The run's input, seed and options; the state and the resolved
+    /// `dt` and `total-steps` are added at each write.
+    pub template: Checkpoint,
+}
+
+impl RigidCheckpoints {
+    /// The checkpoint of the bodies and the integrator after `step` of `steps`.
+    fn write(
+        &self,
+        b: &RigidBodies,
+        f: &Frbi,
+        step: u64,
+        steps: u64,
+        dt: f64,
+    ) -> Result<(), MdError> {
+        let mut cp = self.template.clone();
+        cp.options.retain(|(k, _)| k != "dt" && k != "total-steps");
+        cp.options
+            .push(("dt".into(), format!("{:016x}", dt.to_bits())));
+        cp.options.push(("total-steps".into(), steps.to_string()));
+        cp.time = b.time;
+        cp.step = step;
+        cp.positions = b.position.iter().map(|x| x.to_array()).collect();
+        cp.velocities = b.velocity.iter().map(|v| v.to_array()).collect();
+        // For bodies the angular table is (rotation vector r, ω).
+        cp.angular = b
+            .rotation
+            .iter()
+            .zip(&b.omega)
+            .map(|(r, w)| [r.x, r.y, r.z, w.x, w.y, w.z])
+            .collect();
+        cp.carried = f.carried_state();
+        Ok(checkpoint::write(&self.path, &cp)?)
+    }
+}
+
+/// Puts a checkpoint's state into freshly built bodies and integrator.
+fn resume_bodies(
+    cp: &Checkpoint,
+    b: &mut RigidBodies,
+    f: &Frbi,
+    label: &str,
+) -> Result<(), MdError> {
+    let n = b.len();
+    if cp.positions.len() != n || cp.velocities.len() != n || cp.angular.len() != n {
+        return Err(ParseError::new(
+            label,
+            0,
+            format!(
+                "the checkpoint holds {} bodies, the scene makes {n}",
+                cp.positions.len()
+            ),
+        )
+        .into());
+    }
+    for i in 0..n {
+        b.position[i] = DVec3::from(cp.positions[i]);
+        b.velocity[i] = DVec3::from(cp.velocities[i]);
+        let a = cp.angular[i];
+        b.rotation[i] = DVec3::new(a[0], a[1], a[2]);
+        b.omega[i] = DVec3::new(a[3], a[4], a[5]);
+    }
+    b.time = cp.time;
+    f.restore_carried_state(&cp.carried)
+        .map_err(|m| ParseError::new(label, 0, format!("checkpoint: {m}")))?;
+    Ok(())
 }
 
 /// The spheres of every body as an extended-XYZ frame: world positions,
@@ -928,7 +1009,8 @@ pub fn run_rigid_scene(
     let dir = options
         .out_dir
         .clone()
-        .unwrap_or_else(|| PathBuf::from(&scene.output.dir));
+        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("out"));
     std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
     let provenance = Provenance {
         program: format!("mote {}", env!("CARGO_PKG_VERSION")),
@@ -962,18 +1044,28 @@ pub fn run_rigid_scene(
             columns.push(format!("{w}.f{a}"));
         }
     }
+    let resumed = options.resume.as_ref();
     let csv_path = dir.join("observables.csv");
-    let mut csv = CsvWriter::create(&csv_path, &provenance, &columns, &[])?;
+    let mut csv = match resumed {
+        Some(_) => CsvWriter::append(&csv_path, columns.len())?,
+        None => CsvWriter::create(&csv_path, &provenance, &columns, &[])?,
+    };
     let mut files = vec![csv_path];
     let every = scene.output.observables_every.max(1);
     let traj_every = scene.output.trajectory_every;
     let mut xyz = if traj_every > 0 {
         let p = dir.join("trajectory.xyz");
         files.push(p.clone());
-        Some(XyzWriter::create(&p, provenance.clone())?)
+        Some(match resumed {
+            Some(_) => XyzWriter::append(&p, provenance.clone())?,
+            None => XyzWriter::create(&p, provenance.clone())?,
+        })
     } else {
         None
     };
+    if let Some(c) = &options.checkpoints {
+        files.push(c.path.clone());
+    }
     let b = &mut built.bodies;
     let f = &mut built.frbi;
     let contacts = built.contacts.clone();
@@ -1003,11 +1095,20 @@ pub fn run_rigid_scene(
         Ok(xyz.write(&sphere_frame(b))?)
     };
     let start = Instant::now();
-    sample(b, f, &mut csv)?;
-    if let Some(x) = xyz.as_mut() {
-        frame(b, x)?;
-    }
-    for step in 1..=built.steps {
+    let first = match resumed {
+        Some(cp) => {
+            resume_bodies(cp, b, f, file_label)?;
+            cp.step + 1
+        }
+        None => {
+            sample(b, f, &mut csv)?;
+            if let Some(x) = xyz.as_mut() {
+                frame(b, x)?;
+            }
+            1
+        }
+    };
+    for step in first..=built.steps {
         f.step(b, built.dt);
         if step % every == 0 || step == built.steps {
             let (ke, _) = sample(b, f, &mut csv)?;
@@ -1026,6 +1127,11 @@ pub fn run_rigid_scene(
         if let Some(x) = xyz.as_mut() {
             if traj_every > 0 && step % traj_every == 0 {
                 frame(b, x)?;
+            }
+        }
+        if let Some(c) = &options.checkpoints {
+            if step % c.every.max(1) == 0 || step == built.steps {
+                c.write(b, f, step, built.steps, built.dt)?;
             }
         }
         progress(step, built.steps, b.time);

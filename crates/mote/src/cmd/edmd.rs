@@ -82,17 +82,21 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
         Input::read(scene_arg)?
     };
     // The old command's default: outputs beside the scene file, or in the
-    // current folder for examples.
-    let output = args.out_dir.clone().unwrap_or_else(|| {
-        Path::new(scene_arg)
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty() && !scene_arg.starts_with("example:"))
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| PathBuf::from("."))
+    // current folder for examples; a scene's own [output] dir wins over both.
+    let scene_names_dir =
+        mote_edmd::Scene::parse(&input.text, &input.label).is_ok_and(|s| s.output.dir.is_some());
+    let output = args.out_dir.clone().or_else(|| {
+        (!scene_names_dir).then(|| {
+            Path::new(scene_arg)
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty() && !scene_arg.starts_with("example:"))
+                .map(Path::to_path_buf)
+                .unwrap_or_else(|| PathBuf::from("."))
+        })
     });
     let options = RunOptions {
         input: Some(scene_arg.to_string()),
-        output: Some(output),
+        output,
         seed: global.seed,
         threads: global.threads,
         ..RunOptions::default()
