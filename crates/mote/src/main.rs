@@ -30,30 +30,27 @@ enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
-    /// Ray-traced pictures of a trajectory; see `mote render --help`.
-    #[command(disable_help_flag = true, disable_version_flag = true)]
-    Render {
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
-    /// Plot columns of an observables CSV; see `mote plot --help`.
-    #[command(disable_help_flag = true, disable_version_flag = true)]
-    Plot {
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
-    /// Random close packings by growing spheres (Lubachevsky–Stillinger); see `mote pack --help`.
-    #[command(disable_help_flag = true, disable_version_flag = true)]
-    Pack {
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
-    /// Event-driven hard spheres and disks (an alias of `mote run` kept for one release); see `mote edmd --help`.
-    #[command(disable_help_flag = true, disable_version_flag = true)]
-    Edmd {
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
+    /// Ray-traced pictures of a trajectory (extended XYZ, LAMMPS dump, VTU, PVD).
+    Render(cmd::render::RenderArgs),
+    /// Plot columns of an observables CSV (PNG or SVG).
+    Plot(cmd::plot::PlotArgs),
+    /// Random close packings by growing spheres (Lubachevsky–Stillinger); `mote pack analyse FILE` analyses one.
+    ///
+    /// Grows hard spheres (3-D) or disks (2-D) with spheropack's growth rate
+    /// Γ = (1/v_th) d⟨d⟩/dt. Near jamming (pressure above --jam-start) it
+    /// alternates relaxation at fixed size with small growth steps, so the final
+    /// packing is jammed and isostatic (spheropack's `Jammed` protocol; --no-jam
+    /// grows at Γ to the end). Stops when the reduced pressure passes
+    /// --max-pressure (jammed), at --phi, after --max-collisions or --time-limit,
+    /// whichever comes first, and says which.
+    Pack(cmd::pack::PackArgs),
+    /// Event-driven hard spheres and disks (an alias of `mote run` kept for one release).
+    ///
+    /// SCENE is a TOML scene file (keys in docs/edmd.md) or `example:NAME`, one of
+    /// cube, cradle, cradle-two, cradle-symmetric, cradle-heavy, maxwell2d, eos.
+    /// Outputs go next to the scene file, or to the current folder for examples,
+    /// unless --out-dir is given or the scene names its [output] dir.
+    Edmd(cmd::edmd::EdmdArgs),
 }
 
 fn main() -> ExitCode {
@@ -62,10 +59,10 @@ fn main() -> ExitCode {
         Command::Run(args) => cmd::run::run(&cli.global, args),
         Command::Examples(args) => cmd::examples::run(&cli.global, args),
         Command::Rcp { args } => cmd::rcp::run(&cli.global, &args),
-        Command::Edmd { args } => cmd::edmd::run(&cli.global, &args),
-        Command::Pack { args } => cmd::pack::run(&cli.global, &args),
-        Command::Render { args } => cmd::render::run(&cli.global, &args),
-        Command::Plot { args } => cmd::plot::run(&cli.global, &args),
+        Command::Edmd(args) => cmd::edmd::run(&cli.global, args),
+        Command::Pack(args) => cmd::pack::run(&cli.global, args),
+        Command::Render(args) => cmd::render::run(&cli.global, args),
+        Command::Plot(args) => cmd::plot::run(&cli.global, args),
     };
     match result {
         Ok(code) => code,

@@ -33,7 +33,8 @@ use mote_geom::DE;
 
 use super::interaction::{BodyInteraction, BodyView};
 use crate::boundary::Boundary;
-use crate::force::granular::{ContactLaw, History, Wall, WallShape};
+use crate::force::granular::history::{history_of, PAIR_ROW};
+use crate::force::granular::{ContactLaw, History, PairHistories, Wall, WallShape};
 use crate::neighbor::VerletList;
 
 /// Contact parameters shared by all sphere pairs and walls. Stiffness comes
@@ -59,11 +60,8 @@ struct ContactState {
     skin: f64,
     /// Wrapped sphere centres (periodic boundaries only).
     wrapped: Vec<DVec3>,
-    /// Pairs of different bodies: `partner[start[s]..start[s + 1]]` (sorted).
-    start: Vec<u32>,
-    partner: Vec<u32>,
-    history: Vec<History>,
-    touching: Vec<bool>,
+    /// Pairs of spheres of different bodies, with their histories.
+    pairs: PairHistories,
     /// history[s · walls + w]: sphere s against wall w.
     wall_history: Vec<History>,
     wall_touching: Vec<bool>,
@@ -71,14 +69,11 @@ struct ContactState {
     last_time: Option<f64>,
     contacts: usize,
     wall_contacts: usize,
-    /// Histories of a resumed run, put in place at the next evaluation:
-    /// touching sphere pairs (a < b) and sphere–wall slots.
-    pending: Vec<(u32, u32, History)>,
+    /// Sphere–wall histories of a resumed run, put in place at the next evaluation.
     pending_walls: Vec<(usize, History)>,
 }
 
-/// Numbers per carried sphere-pair row (a, b, shear, roll) and wall row (slot, shear, roll).
-const PAIR_ROW: usize = 8;
+/// Numbers per carried sphere–wall row: slot, ξ (3), ψ (3).
 const WALL_ROW: usize = 7;
 
 impl RigidContacts {
@@ -94,7 +89,6 @@ impl RigidContacts {
             state: Arc::new(Mutex::new(ContactState {
                 skin,
                 wall_force: vec![DVec3::ZERO; n_walls],
-                start: vec![0],
                 ..Default::default()
             })),
         }
@@ -129,33 +123,11 @@ impl RigidContacts {
 
     /// The contact history of spheres (a, b) of different bodies, if listed.
     pub fn history(&self, a: usize, b: usize) -> Option<History> {
-        let s = self.state.lock().unwrap();
-        let (a, b) = if a < b { (a, b) } else { (b, a) };
-        let range = *s.start.get(a)? as usize..*s.start.get(a + 1)? as usize;
-        let k = s.partner[range.clone()].binary_search(&(b as u32)).ok()?;
-        Some(s.history[range.start + k])
+        self.state.lock().unwrap().pairs.get(a, b)
     }
 }
 
 impl ContactState {
-    /// Puts the histories of a resumed run into the freshly built list.
-    fn place_pending_pairs(&mut self) {
-        for (a, b, h) in std::mem::take(&mut self.pending) {
-            let Some(range) = self
-                .start
-                .get(a as usize)
-                .zip(self.start.get(a as usize + 1))
-                .map(|(lo, hi)| *lo as usize..*hi as usize)
-            else {
-                continue;
-            };
-            if let Ok(k) = self.partner[range.clone()].binary_search(&b) {
-                self.history[range.start + k] = h;
-                self.touching[range.start + k] = true;
-            }
-        }
-    }
-
     /// Refreshes the list; after a rebuild drops same-body pairs and carries
     /// the histories of pairs still listed.
     fn refresh(&mut self, centres: &[DVec3], body: &[u32], r_max: f64, boundary: &Boundary) {
@@ -173,7 +145,7 @@ impl ContactState {
             centres
         };
         let rebuilt = self.list.update(pos, boundary);
-        if !rebuilt && self.start.len() == centres.len() + 1 {
+        if !rebuilt && self.pairs.rows() == centres.len() {
             return;
         }
         let n = centres.len();
@@ -184,29 +156,7 @@ impl ContactState {
             partner.extend(self.list.of(s).iter().filter(|&&j| body[j as usize] != bs));
             start.push(partner.len() as u32);
         }
-        let mut history = vec![History::default(); partner.len()];
-        let mut touching = vec![false; partner.len()];
-        let old_n = self.start.len().saturating_sub(1);
-        for s in 0..n.min(old_n) {
-            let (mut a, a_end) = (self.start[s] as usize, self.start[s + 1] as usize);
-            let (mut b, b_end) = (start[s] as usize, start[s + 1] as usize);
-            while a < a_end && b < b_end {
-                match self.partner[a].cmp(&partner[b]) {
-                    std::cmp::Ordering::Less => a += 1,
-                    std::cmp::Ordering::Greater => b += 1,
-                    std::cmp::Ordering::Equal => {
-                        history[b] = self.history[a];
-                        touching[b] = self.touching[a];
-                        a += 1;
-                        b += 1;
-                    }
-                }
-            }
-        }
-        self.start = start;
-        self.partner = partner;
-        self.history = history;
-        self.touching = touching;
+        self.pairs.carry_to(&start, &partner);
     }
 }
 
@@ -226,7 +176,6 @@ impl BodyInteraction for RigidContacts {
         let mut guard = self.state.lock().unwrap();
         let st = &mut *guard;
         st.refresh(centres, body, r_max, &self.boundary);
-        st.place_pending_pairs();
         let dt = st.last_time.map_or(0.0, |t0| t - t0);
         st.last_time = Some(t);
         let image = self.boundary.image();
@@ -237,17 +186,16 @@ impl BodyInteraction for RigidContacts {
 
         // Sphere–sphere.
         for s in 0..n {
-            let lo = st.start[s] as usize;
-            let hi = st.start[s + 1] as usize;
-            if lo == hi {
+            let range = st.pairs.range(s);
+            if range.is_empty() {
                 continue;
             }
             let (cs, rs) = (pos[s], radius[s]);
             let a = body[s] as usize;
             let (xa, va, wa) = (bodies.position[a], bodies.velocity[a], bodies.omega[a]);
             let ma = bodies.template(a).mass();
-            for k in lo..hi {
-                let o = st.partner[k] as usize;
+            for k in range {
+                let o = st.pairs.partner(k) as usize;
                 let d = if periodic {
                     image.apply(cs - pos[o])
                 } else {
@@ -256,13 +204,13 @@ impl BodyInteraction for RigidContacts {
                 let reach = rs + radius[o];
                 let r2 = d.length_squared();
                 if r2 >= reach * reach {
-                    if st.touching[k] {
-                        st.touching[k] = false;
-                        st.history[k] = History::default();
+                    if st.pairs.touching[k] {
+                        st.pairs.touching[k] = false;
+                        st.pairs.history[k] = History::default();
                     }
                     continue;
                 }
-                st.touching[k] = true;
+                st.pairs.touching[k] = true;
                 let r = r2.sqrt();
                 let nrm = d / r;
                 let delta = reach - r;
@@ -284,7 +232,7 @@ impl BodyInteraction for RigidContacts {
                     rs * radius[o] / reach,
                     ma * mb / (ma + mb),
                     dt,
-                    &mut st.history[k],
+                    &mut st.pairs.history[k],
                 );
                 let wa_ = view.wrench_at(a, centres[s], c.force);
                 wrench[a].omega += wa_.omega + c.torque_i;
@@ -375,16 +323,7 @@ impl BodyInteraction for RigidContacts {
     fn carried_state(&self) -> Vec<f64> {
         let s = self.state.lock().unwrap();
         let mut pairs = Vec::new();
-        for a in 0..s.start.len().saturating_sub(1) {
-            for k in s.start[a] as usize..s.start[a + 1] as usize {
-                if s.touching[k] {
-                    let h = s.history[k];
-                    pairs.extend([a as f64, s.partner[k] as f64]);
-                    pairs.extend(h.shear.to_array());
-                    pairs.extend(h.roll.to_array());
-                }
-            }
-        }
+        s.pairs.write_rows(&mut pairs);
         let mut out = vec![
             s.last_time.unwrap_or(f64::NAN),
             (pairs.len() / PAIR_ROW) as f64,
@@ -412,19 +351,16 @@ impl BodyInteraction for RigidContacts {
             return Err(bad());
         }
         let (pair_rows, wall_rows) = rows.split_at(n_pairs * PAIR_ROW);
-        let history = |r: &[f64]| History {
-            shear: DVec3::new(r[0], r[1], r[2]),
-            roll: DVec3::new(r[3], r[4], r[5]),
-        };
         let mut s = self.state.lock().unwrap();
         s.last_time = (!t.is_nan()).then_some(*t);
-        s.pending = pair_rows
-            .chunks(PAIR_ROW)
-            .map(|r| (r[0] as u32, r[1] as u32, history(&r[2..])))
-            .collect();
+        // The sphere count is known at the next evaluation; rows naming
+        // spheres beyond it are never listed, so never placed.
+        s.pairs
+            .restore_rows(pair_rows, u32::MAX as usize)
+            .map_err(|m| format!("rigid {m}"))?;
         s.pending_walls = wall_rows
             .chunks(WALL_ROW)
-            .map(|r| (r[0] as usize, history(&r[1..])))
+            .map(|r| (r[0] as usize, history_of(&r[1..])))
             .collect();
         Ok(())
     }
@@ -450,8 +386,8 @@ impl BodyInteraction for RigidContacts {
         };
         let mut u = 0.0;
         for s in 0..n {
-            for &o in &st.partner[st.start[s] as usize..st.start[s + 1] as usize] {
-                let o = o as usize;
+            for k in st.pairs.range(s) {
+                let o = st.pairs.partner(k) as usize;
                 let reach = radius[s] + radius[o];
                 let r = image.apply(pos[s] - pos[o]).length();
                 if r < reach {

@@ -8,22 +8,15 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use clap::Parser;
 use mote_edmd::scene::{example, EXAMPLES};
 use mote_front::event_driven::EdmdWords;
 use mote_front::{Input, RunOptions};
 
 use crate::progress::Terminal;
 
-/// Event-driven molecular dynamics of hard spheres (3-D) and disks (2-D).
-///
-/// SCENE is a TOML scene file (keys in docs/edmd.md) or `example:NAME`, one of
-/// cube, cradle, cradle-two, cradle-symmetric, cradle-heavy, maxwell2d, eos.
-/// Outputs (extended XYZ, CSV) go next to the scene file, or to the current
-/// folder for examples, unless --out-dir is given.
-#[derive(Parser, Debug)]
-#[command(name = "mote edmd", version)]
-struct Args {
+/// The old command's words (its help text is the `Edmd` variant's in main.rs).
+#[derive(clap::Args, Debug)]
+pub struct EdmdArgs {
     /// Scene file or `example:NAME`.
     #[arg(value_name = "SCENE")]
     scene: Option<String>,
@@ -39,27 +32,9 @@ struct Args {
     /// Write no trajectory, observables or histogram files.
     #[arg(long)]
     no_output: bool,
-    /// Seed of the random number generator (default: the scene's, else chosen and printed).
-    #[arg(long, value_name = "N")]
-    seed: Option<u64>,
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    quiet: bool,
-    /// Accepted for symmetry with other commands; the event loop is serial.
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
 }
 
-pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let args = match super::parse_words::<Args>("mote edmd", args) {
-        Ok(a) => a,
-        Err(code) => return Ok(code),
-    };
-    let global = global.merged(&super::GlobalOpts {
-        quiet: args.quiet,
-        threads: args.threads,
-        seed: args.seed,
-    });
+pub fn run(global: &super::GlobalOpts, args: EdmdArgs) -> anyhow::Result<ExitCode> {
     if args.list {
         for (name, text) in EXAMPLES {
             println!(

@@ -39,16 +39,6 @@ pub struct GlobalOpts {
 }
 
 impl GlobalOpts {
-    /// These options joined with the same options given after a subcommand
-    /// that parses its own words (`mote render ... --threads 1`).
-    pub fn merged(&self, after: &GlobalOpts) -> GlobalOpts {
-        GlobalOpts {
-            quiet: self.quiet || after.quiet,
-            threads: after.threads.or(self.threads),
-            seed: after.seed.or(self.seed),
-        }
-    }
-
     /// Sets up the global rayon pool with the requested thread count.
     pub fn init_threads(&self) -> anyhow::Result<()> {
         if let Some(n) = self.threads {

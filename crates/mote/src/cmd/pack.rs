@@ -10,25 +10,18 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use anyhow::Context;
-use clap::Parser;
 use mote_edmd::analyse::{bond_order, contacts, deepest_overlap, pair_correlation};
 use mote_edmd::pack::{Finish, PackSettings, Packer, SizeSpec, Stop};
 use mote_edmd::{Boundary, SimBox};
 
 use super::GlobalOpts;
 
-/// Random close packings by growing spheres (3-D) or disks (2-D): the
-/// Lubachevsky–Stillinger algorithm with spheropack's growth rate
-/// Γ = (1/v_th) d⟨d⟩/dt. Near jamming (pressure above --jam-start) it
-/// alternates relaxation at fixed size with small growth steps, so the final
-/// packing is jammed and isostatic (spheropack's `Jammed` protocol;
-/// --no-jam grows at Γ to the end). Stops when the reduced pressure passes
-/// --max-pressure (jammed), at --phi, after --max-collisions or
-/// --time-limit, whichever comes first, and says which.
-/// `mote pack analyse FILE` analyses a packing.
-#[derive(Parser, Debug)]
-#[command(name = "mote pack", version)]
-struct Args {
+/// The words of `mote pack` (its help text is the `Pack` variant's in main.rs).
+#[derive(clap::Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct PackArgs {
+    #[command(subcommand)]
+    command: Option<PackCommand>,
     /// Number of particles (ignored with --dist file:PATH).
     #[arg(long, short = 'n', default_value_t = 1000)]
     n: usize,
@@ -87,21 +80,18 @@ struct Args {
     /// Render the packing to this PNG.
     #[arg(long, value_name = "FILE.png")]
     picture: Option<PathBuf>,
-    /// Seed of the random number generator (chosen and printed if not given).
-    #[arg(long, value_name = "N")]
-    seed: Option<u64>,
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    quiet: bool,
-    /// Accepted for symmetry with other commands; the event loop is serial.
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum PackCommand {
+    /// Structure of a packing: φ, contacts, rattlers, g(r), Q6.
+    #[command(alias = "analyze")]
+    Analyse(AnalyseArgs),
 }
 
 /// Structure of a packing: φ, contacts at a relative gap tolerance, rattlers,
 /// g(r) and the bond-orientational order (Q6 in 3-D, |ψ6| in 2-D).
-#[derive(Parser, Debug)]
-#[command(name = "mote pack analyse", version)]
+#[derive(clap::Args, Debug)]
 struct AnalyseArgs {
     /// Extended XYZ file with radii (the last frame is analysed).
     #[arg(value_name = "FILE")]
@@ -120,27 +110,13 @@ struct AnalyseArgs {
     /// Largest r of g(r), in mean diameters.
     #[arg(long, default_value_t = 3.0)]
     rmax: f64,
-    /// Print nothing but errors.
-    #[arg(long, short = 'q')]
-    quiet: bool,
 }
 
-pub fn run(global: &GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    if matches!(
-        args.first().map(String::as_str),
-        Some("analyse") | Some("analyze")
-    ) {
-        let a = match super::parse_words::<AnalyseArgs>("mote pack analyse", &args[1..]) {
-            Ok(a) => a,
-            Err(code) => return Ok(code),
-        };
-        return analyse_cmd(global, &a);
+pub fn run(global: &GlobalOpts, args: PackArgs) -> anyhow::Result<ExitCode> {
+    match &args.command {
+        Some(PackCommand::Analyse(a)) => analyse_cmd(global, a),
+        None => pack_cmd(global, &args),
     }
-    let a = match super::parse_words::<Args>("mote pack", args) {
-        Ok(a) => a,
-        Err(code) => return Ok(code),
-    };
-    pack_cmd(global, &a)
 }
 
 /// Reads one radius per line (`#` starts a comment); errors as `file:line: ...`.
@@ -177,8 +153,8 @@ fn read_radii(path: &Path) -> anyhow::Result<Vec<f64>> {
     Ok(radii)
 }
 
-fn pack_cmd(global: &GlobalOpts, a: &Args) -> anyhow::Result<ExitCode> {
-    let quiet = global.quiet || a.quiet;
+fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
+    let quiet = global.quiet;
     anyhow::ensure!(a.dim == 2 || a.dim == 3, "--dim {}: must be 2 or 3", a.dim);
     let sizes = match a.dist.strip_prefix("file:") {
         Some(p) => SizeSpec::Radii(read_radii(Path::new(p))?),
@@ -204,7 +180,7 @@ fn pack_cmd(global: &GlobalOpts, a: &Args) -> anyhow::Result<ExitCode> {
             "--tol {t}: must be a non-negative number"
         );
     }
-    let (seed, chosen) = mote_front::seed::resolve(a.seed.or(global.seed), None);
+    let (seed, chosen) = mote_front::seed::resolve(global.seed, None);
     let settings = PackSettings {
         n: a.n,
         sizes,
@@ -251,7 +227,7 @@ fn pack_cmd(global: &GlobalOpts, a: &Args) -> anyhow::Result<ExitCode> {
 
 fn pack_dim<const D: usize>(
     settings: PackSettings,
-    a: &Args,
+    a: &PackArgs,
     provenance: &mote_io::Provenance,
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
@@ -408,7 +384,7 @@ fn write_pov(frame: &mote_io::xyz::Frame, path: &Path) -> anyhow::Result<()> {
 }
 
 fn analyse_cmd(global: &GlobalOpts, a: &AnalyseArgs) -> anyhow::Result<ExitCode> {
-    let quiet = global.quiet || a.quiet;
+    let quiet = global.quiet;
     let frames = mote_io::xyz::read_frames(&a.file)?;
     let frame = frames
         .last()

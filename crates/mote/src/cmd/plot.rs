@@ -5,20 +5,15 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
-use clap::Parser;
 
 use mote_render::plot::{axis_label, Plot, Series};
 
 /// Plots columns of a CSV written by mote (or any CSV of numbers with a header row).
-#[derive(Parser, Debug)]
+#[derive(clap::Args, Debug)]
 #[command(
-    name = "mote plot",
-    about = "Plot columns of an observables CSV (PNG or SVG)",
     after_help = "Examples:\n  mote plot energy.csv --x time --y total_energy -o energy.png\n  mote plot energy.csv --x time --y kinetic_energy --y potential_energy --logy -o e.svg"
 )]
-struct PlotArgs {
-    #[command(flatten)]
-    global: super::GlobalOpts,
+pub struct PlotArgs {
     /// The CSV file (lines starting with # are comments; `# units: u1,u2,...` gives units).
     file: PathBuf,
     /// Column for the horizontal axis.
@@ -44,13 +39,7 @@ struct PlotArgs {
     size: String,
 }
 
-pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let a = match super::parse_words::<PlotArgs>("mote plot", args) {
-        Ok(a) => a,
-        Err(code) => return Ok(code),
-    };
-    // Global options may also come after the subcommand.
-    let global = &global.merged(&a.global);
+pub fn run(global: &super::GlobalOpts, a: PlotArgs) -> anyhow::Result<ExitCode> {
     let (width, height) = parse_size(&a.size)?;
     // (The error's own text already names the file; no second copy of its cause.)
     let table = mote_io::csv::read_table(&a.file).map_err(|e| anyhow::anyhow!("{e}"))?;

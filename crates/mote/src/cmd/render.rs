@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
-use clap::Parser;
 use mote_render::Vec3;
 
 use mote_io::xyz::Frame;
@@ -13,15 +12,11 @@ use mote_render::frame::{default_radius, scene_from_frame, ColorBy, QUANTITIES};
 use mote_render::{Camera, ColorMap, RenderOptions, Renderer};
 
 /// Ray-traced pictures of a trajectory (extended XYZ, LAMMPS dump, VTU or PVD).
-#[derive(Parser, Debug)]
+#[derive(clap::Args, Debug)]
 #[command(
-    name = "mote render",
-    about = "Ray-traced pictures of a trajectory (extended XYZ, LAMMPS dump, VTU, PVD)",
     after_help = "Examples:\n  mote render traj.xyz -o last.png\n  mote render traj.xyz --all -o movie/frame.png --color-by speed --shadows\n  mote render traj.xyz --frame 0 -o first.png --anaglyph --lattice 0.2\n  mote render traj.xyz -o scene.png --pov scene.pov   (POV-Ray twin of the picture)"
 )]
-struct RenderArgs {
-    #[command(flatten)]
-    global: super::GlobalOpts,
+pub struct RenderArgs {
     /// Trajectory: .xyz (extended XYZ), .dump/.lammpstrj (LAMMPS), .vtu or .pvd.
     traj: PathBuf,
     /// Output picture (.png). With --all, frames become NAME_00000.png, NAME_00001.png, ...
@@ -83,13 +78,7 @@ struct RenderArgs {
     pov: Option<PathBuf>,
 }
 
-pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
-    let a = match super::parse_words::<RenderArgs>("mote render", args) {
-        Ok(a) => a,
-        Err(code) => return Ok(code),
-    };
-    // Global options may also come after the subcommand.
-    let global = &global.merged(&a.global);
+pub fn run(global: &super::GlobalOpts, a: RenderArgs) -> anyhow::Result<ExitCode> {
     global.init_threads()?;
     let opts_view = parse_vec3(a.view.as_deref(), "--view")?;
     let (w, h) = parse_size(&a.size)?;

@@ -4,6 +4,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::history::PairHistories;
 use super::law::{ContactLaw, History};
 use crate::boundary::Boundary;
 use crate::force::{Interaction, Spin, State};
@@ -12,26 +13,15 @@ use crate::neighbor::VerletList;
 /// Hertz–Mindlin contacts between all spheres (see [`super::law`]).
 ///
 /// The history (tangential and rolling elongations) sits beside the
-/// neighbour list, one entry per listed pair, so the force loop reads it
-/// without a search; when the list is rebuilt the entries of pairs that are
-/// still listed are carried over (both lists are sorted by partner, so this
-/// is a merge). A pair leaves the list only when it is farther apart than
-/// the skin, long after its contact has ended.
+/// neighbour list, one entry per listed pair ([`PairHistories`]).
 #[derive(Debug, Clone)]
 pub struct GranularContacts {
     pub law: ContactLaw,
     pub boundary: Boundary,
     pub list: VerletList,
     radius: Vec<f64>,
-    history: Vec<History>,
-    /// Whether each listed pair touched at the last evaluation; only those
-    /// entries' histories are read or cleared.
-    touching: Vec<bool>,
-    history_start: Vec<u32>,
-    history_partner: Vec<u32>,
+    pairs: PairHistories,
     last_time: Option<f64>,
-    /// Histories restored from a checkpoint, placed at the next evaluation.
-    pending: Vec<(u32, u32, History)>,
     /// One (force, torque) buffer per extra block of particles.
     buffers: Vec<(Vec<DVec3>, Vec<DVec3>)>,
     contacts: usize,
@@ -47,12 +37,8 @@ impl GranularContacts {
             boundary,
             list: VerletList::half(2.0 * r_max, skin),
             radius: radius.to_vec(),
-            history: Vec::new(),
-            touching: Vec::new(),
-            history_start: vec![0],
-            history_partner: Vec::new(),
+            pairs: PairHistories::default(),
             last_time: None,
-            pending: Vec::new(),
             buffers: Vec::new(),
             contacts: 0,
             virial: 0.0,
@@ -66,56 +52,14 @@ impl GranularContacts {
 
     /// The contact history of pair (i, j), if they are listed.
     pub fn history(&self, i: usize, j: usize) -> Option<History> {
-        let (i, j) = if i < j { (i, j) } else { (j, i) };
-        let range = self.history_start.get(i)?.to_owned() as usize
-            ..self.history_start.get(i + 1)?.to_owned() as usize;
-        let k = self.history_partner[range.clone()]
-            .binary_search(&(j as u32))
-            .ok()?;
-        Some(self.history[range.start + k])
+        self.pairs.get(i, j)
     }
 
-    /// Puts restored histories into the list (every touching pair is listed,
-    /// since touching means closer than 2 r_max).
-    fn place_pending(&mut self) {
-        for (i, j, h) in std::mem::take(&mut self.pending) {
-            let (i, j) = (i as usize, j);
-            let range = self.list.start[i] as usize..self.list.start[i + 1] as usize;
-            if let Ok(k) = self.list.neighbors[range.clone()].binary_search(&j) {
-                self.history[range.start + k] = h;
-                self.touching[range.start + k] = true;
-            }
+    /// Refreshes the list; after a rebuild the histories move with it.
+    fn refresh(&mut self, pos: &[DVec3]) {
+        if self.list.update(pos, &self.boundary) || self.pairs.len() != self.list.neighbors.len() {
+            self.pairs.carry_to(&self.list.start, &self.list.neighbors);
         }
-    }
-
-    /// Carries the history over to a freshly built list.
-    fn carry_history(&mut self) {
-        let n = self.list.start.len().saturating_sub(1);
-        let mut history = vec![History::default(); self.list.neighbors.len()];
-        let mut touching = vec![false; self.list.neighbors.len()];
-        let old_n = self.history_start.len().saturating_sub(1);
-        for i in 0..n.min(old_n) {
-            let old = self.history_start[i] as usize..self.history_start[i + 1] as usize;
-            let new = self.list.start[i] as usize..self.list.start[i + 1] as usize;
-            let (mut a, mut b) = (old.start, new.start);
-            while a < old.end && b < new.end {
-                let (pa, pb) = (self.history_partner[a], self.list.neighbors[b]);
-                match pa.cmp(&pb) {
-                    std::cmp::Ordering::Less => a += 1,
-                    std::cmp::Ordering::Greater => b += 1,
-                    std::cmp::Ordering::Equal => {
-                        history[b] = self.history[a];
-                        touching[b] = self.touching[a];
-                        a += 1;
-                        b += 1;
-                    }
-                }
-            }
-        }
-        self.history = history;
-        self.touching = touching;
-        self.history_start.clone_from(&self.list.start);
-        self.history_partner.clone_from(&self.list.neighbors);
     }
 
     fn evaluate(
@@ -127,13 +71,7 @@ impl GranularContacts {
     ) {
         let pos = state.position;
         let n = pos.len();
-        if self.list.update(pos, &self.boundary) || self.history.len() != self.list.neighbors.len()
-        {
-            self.carry_history();
-        }
-        if !self.pending.is_empty() {
-            self.place_pending();
-        }
+        self.refresh(pos);
         let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
         self.last_time = Some(state.time);
 
@@ -142,8 +80,8 @@ impl GranularContacts {
         self.buffers
             .resize_with(blocks.saturating_sub(1), Default::default);
         let mut buffers = std::mem::take(&mut self.buffers);
-        let mut history = std::mem::take(&mut self.history);
-        let mut touching = std::mem::take(&mut self.touching);
+        let mut history = std::mem::take(&mut self.pairs.history);
+        let mut touching = std::mem::take(&mut self.pairs.touching);
 
         // Split the history into the slices owned by each block of i.
         let mut history_blocks: Vec<(&mut [History], &mut [bool])> = Vec::with_capacity(blocks);
@@ -197,8 +135,8 @@ impl GranularContacts {
                     }
                 });
         }
-        self.history = history;
-        self.touching = touching;
+        self.pairs.history = history;
+        self.pairs.touching = touching;
         self.buffers = buffers;
         self.contacts = results.iter().map(|r| r.0).sum();
         self.virial = results.iter().map(|r| r.1).sum();
@@ -308,17 +246,7 @@ impl Interaction for GranularContacts {
     /// i, j, ξ (3), ψ (3)].
     fn carried_state(&self) -> Vec<f64> {
         let mut out = vec![self.last_time.unwrap_or(f64::NAN)];
-        let n = self.list.start.len().saturating_sub(1);
-        for i in 0..n.min(self.history_start.len().saturating_sub(1)) {
-            for k in self.history_start[i] as usize..self.history_start[i + 1] as usize {
-                if self.touching.get(k) == Some(&true) {
-                    let h = self.history[k];
-                    out.extend([i as f64, self.history_partner[k] as f64]);
-                    out.extend(h.shear.to_array());
-                    out.extend(h.roll.to_array());
-                }
-            }
-        }
+        self.pairs.write_rows(&mut out);
         out
     }
 
@@ -326,33 +254,16 @@ impl Interaction for GranularContacts {
         let Some((&t, rows)) = state.split_first() else {
             return Ok(());
         };
-        if rows.len() % 8 != 0 {
-            return Err("granular contact history: rows of 8 numbers expected".into());
-        }
         self.last_time = (!t.is_nan()).then_some(t);
-        let n = self.radius.len();
-        self.pending.clear();
-        for r in rows.chunks(8) {
-            let (i, j) = (r[0] as usize, r[1] as usize);
-            if i >= n || j >= n || i >= j {
-                return Err(format!("granular contact history names pair ({i}, {j})"));
-            }
-            let h = History {
-                shear: DVec3::new(r[2], r[3], r[4]),
-                roll: DVec3::new(r[5], r[6], r[7]),
-            };
-            self.pending.push((i as u32, j as u32, h));
-        }
-        Ok(())
+        self.pairs
+            .restore_rows(rows, self.radius.len())
+            .map_err(|m| format!("granular {m}"))
     }
 
     /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}.
     fn potential_energy(&mut self, state: &State) -> f64 {
         let pos = state.position;
-        self.list.update(pos, &self.boundary);
-        if self.history.len() != self.list.neighbors.len() {
-            self.carry_history();
-        }
+        self.refresh(pos);
         let image = self.boundary.image();
         let mut u = 0.0;
         for i in 0..pos.len() {

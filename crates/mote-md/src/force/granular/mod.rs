@@ -5,9 +5,11 @@
 //! friction, adhesion, walls).
 
 pub mod contacts;
+pub mod history;
 pub mod law;
 pub mod walls;
 
 pub use contacts::GranularContacts;
+pub use history::PairHistories;
 pub use law::{ContactForce, ContactLaw, Damping, History, Material};
 pub use walls::{GranularWalls, Wall, WallShape};
