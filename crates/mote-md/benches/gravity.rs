@@ -35,12 +35,7 @@ fn gravity(c: &mut Criterion) {
                 |b, _| {
                     b.iter(|| {
                         pool.install(|| {
-                            let state = State {
-                                position: &pos,
-                                velocity: &vel,
-                                mass: &mass,
-                                time: 0.0,
-                            };
+                            let state = State::new(&pos, &vel, &mass, 0.0);
                             g.add_forces(&state, &mut force)
                         })
                     })

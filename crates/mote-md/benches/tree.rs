@@ -46,12 +46,7 @@ fn criterion_benches(c: &mut Criterion) {
                 |b, _| {
                     b.iter(|| {
                         pool.install(|| {
-                            let state = State {
-                                position: &pos,
-                                velocity: &vel,
-                                mass: &mass,
-                                time: 0.0,
-                            };
+                            let state = State::new(&pos, &vel, &mass, 0.0);
                             tree.add_forces(&state, &mut force)
                         })
                     })
@@ -84,12 +79,7 @@ fn plain(n: usize, steps: usize, threads: usize) {
     let dt = 1e-3;
     let mut eval = |pos: &[DVec3], vel: &[DVec3], force: &mut Vec<DVec3>| {
         force.iter_mut().for_each(|f| *f = DVec3::ZERO);
-        let state = State {
-            position: pos,
-            velocity: vel,
-            mass: &mass,
-            time: 0.0,
-        };
+        let state = State::new(pos, vel, &mass, 0.0);
         pool.install(|| tree.add_forces(&state, force));
     };
     eval(&pos, &vel, &mut force); // warm-up

@@ -113,12 +113,7 @@ impl BrownianStepper {
         self.force.resize(n, DVec3::ZERO);
         self.torque.clear();
         self.torque.resize(n, DVec3::ZERO);
-        let state = State {
-            position: &p.position,
-            velocity: &p.velocity,
-            mass: &p.mass,
-            time: sys.time,
-        };
+        let state = State::of(sys, &p.position, &p.velocity, sys.time);
         let spin = Spin {
             angular_velocity: &p.angular_velocity,
             dipole: &p.dipole,

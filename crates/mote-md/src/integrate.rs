@@ -119,12 +119,7 @@ impl Stepper {
         acc: &mut Vec<DVec3>,
     ) {
         acc.resize(x.len(), DVec3::ZERO);
-        let state = State {
-            position: x,
-            velocity: v,
-            mass: &sys.particles.mass,
-            time: t,
-        };
+        let state = State::of(sys, x, v, t);
         ff.accelerations(&state, &sys.particles.mobility, acc);
     }
 
@@ -140,12 +135,7 @@ impl Stepper {
         let p = &sys.particles;
         acc.resize(p.len(), DVec3::ZERO);
         alpha.resize(p.len(), DVec3::ZERO);
-        let state = State {
-            position: &p.position,
-            velocity: &p.velocity,
-            mass: &p.mass,
-            time: t,
-        };
+        let state = State::of(sys, &p.position, &p.velocity, t);
         let spin = Spin {
             angular_velocity: &p.angular_velocity,
             dipole: &p.dipole,

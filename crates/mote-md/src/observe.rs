@@ -55,12 +55,7 @@ impl Observables {
         }
         let translational = kinetic;
         kinetic += rotational;
-        let state = State {
-            position: &p.position,
-            velocity: &p.velocity,
-            mass: &p.mass,
-            time: sys.time,
-        };
+        let state = State::of(sys, &p.position, &p.velocity, sys.time);
         let (potential, _) = ff.potential_energy(&state);
         let nf = sys.degrees_of_freedom();
         let volume = sys.boundary.volume();

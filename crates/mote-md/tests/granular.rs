@@ -59,6 +59,11 @@ fn contact_time(m_eff: f64, r_eff: f64, e_star: f64, v: f64) -> f64 {
 /// error in e; 1000 steps per contact keep it below 0.3 % at e = 0.1.
 const STEPS_PER_CONTACT: f64 = 1000.0;
 
+/// The largest radius (the contact list's reach is twice it).
+fn r_max(radius: &[f64]) -> f64 {
+    radius.iter().cloned().fold(0.0, f64::max)
+}
+
 #[test]
 fn head_on_impact_gives_back_the_restitution() {
     let r = 1e-3;
@@ -79,12 +84,8 @@ fn head_on_impact_gives_back_the_restitution() {
             ));
             let m = p.mass[0];
             let tc = contact_time(m / 2.0, r / 2.0, law.e_star, 2.0 * v);
-            let mut ff = ForceField::new().with(GranularContacts::new(
-                law,
-                &p.radius,
-                0.2 * r,
-                Boundary::open(),
-            ));
+            let mut ff =
+                ForceField::new().with(GranularContacts::new(law, r_max(&p.radius), 0.2 * r));
             let mut sys = System::new(p);
             let dt = tc / STEPS_PER_CONTACT;
             run(&mut sys, &mut ff, dt, 100_000, |s| {
@@ -125,7 +126,7 @@ fn sliding_oblique_impact_matches_the_rigid_body_result() {
     let walls = GranularWalls::new(
         law,
         vec![Wall::plane("floor", DVec3::ZERO, DVec3::Z)],
-        &p.radius,
+        p.len(),
     );
     let mut ff = ForceField::new().with(walls);
     let mut sys = System::new(p);
@@ -184,7 +185,7 @@ fn rolling_resistance_decelerates_at_five_sevenths_mu_r_g() {
     let walls = GranularWalls::new(
         law,
         vec![Wall::plane("floor", DVec3::ZERO, DVec3::Z)],
-        &p.radius,
+        p.len(),
     );
     let mut ff = ForceField::new().with(walls).with(UniformField {
         g: DVec3::new(0.0, 0.0, -g),
@@ -244,9 +245,9 @@ fn settled_bed_weighs_on_its_walls() {
     let walls = GranularWalls::new(
         law,
         Wall::closed_box("box", DVec3::ZERO, DVec3::new(lx, ly, lz)),
-        &p.radius,
+        p.len(),
     );
-    let contacts = GranularContacts::new(law, &p.radius, 0.2 * r, Boundary::open());
+    let contacts = GranularContacts::new(law, r_max(&p.radius), 0.2 * r);
     let mut ff = ForceField::new()
         .with(contacts)
         .with(walls)
@@ -301,12 +302,7 @@ fn colliding_cloud_conserves_momentum_and_angular_momentum() {
         p.push(s);
     }
     let law = ContactLaw::new(glass(), glass(), 0.5, 0.4, Damping::Exact, false);
-    let mut ff = ForceField::new().with(GranularContacts::new(
-        law,
-        &p.radius,
-        2e-4,
-        Boundary::open(),
-    ));
+    let mut ff = ForceField::new().with(GranularContacts::new(law, r_max(&p.radius), 2e-4));
     let mut sys = System::new(p);
     let before = Observables::measure(&sys, &mut ff);
     let mut stepper = Stepper::new(Integrator::LeapFrog);

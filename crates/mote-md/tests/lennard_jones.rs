@@ -221,12 +221,7 @@ fn lj_through_list(lj: &mut mote_md::force::LennardJones, pos: &[DVec3]) -> (Vec
     use mote_md::{Interaction, State};
     let zero = vec![DVec3::ZERO; pos.len()];
     let mass = vec![1.0; pos.len()];
-    let state = State {
-        position: pos,
-        velocity: &zero,
-        mass: &mass,
-        time: 0.0,
-    };
+    let state = State::new(pos, &zero, &mass, 0.0);
     let mut force = vec![DVec3::ZERO; pos.len()];
     lj.add_forces(&state, &mut force);
     let virial = lj.virial();

@@ -23,12 +23,7 @@ fn plummer(n: usize, seed: u64) -> (Vec<DVec3>, Vec<DVec3>, Vec<f64>) {
 }
 
 fn state<'a>(pos: &'a [DVec3], vel: &'a [DVec3], mass: &'a [f64]) -> State<'a> {
-    State {
-        position: pos,
-        velocity: vel,
-        mass,
-        time: 0.0,
-    }
+    State::new(pos, vel, mass, 0.0)
 }
 
 /// θ = 0.5 meets 1e-3 at the 99th percentile, and the error falls with θ.

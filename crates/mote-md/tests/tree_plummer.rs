@@ -31,12 +31,7 @@ fn plummer_sample_has_the_model_profile_and_energies() {
         );
     }
     let mass = vec![m; pos.len()];
-    let state = State {
-        position: &pos,
-        velocity: &vel,
-        mass: &mass,
-        time: 0.0,
-    };
+    let state = State::new(&pos, &vel, &mass, 0.0);
     let u = DirectGravity::new(sphere.g, 0.0).potential_energy(&state);
     let k: f64 = vel.iter().map(|v| 0.5 * m * v.length_squared()).sum();
     let model = sphere.potential_energy();

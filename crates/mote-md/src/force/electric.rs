@@ -12,6 +12,8 @@
 //! An applied field E(t) = E₀ cos(ωt + φ) (constant for ω = 0) pushes each
 //! charge with F_i = q_i E(t); its potential energy U = −Σ q_i E(t)·r_i is
 //! defined only where the field's direction is not periodic.
+//!
+//! Both read the charges from the step's [`State`], as the system holds them.
 
 use glam::DVec3;
 
@@ -22,17 +24,24 @@ use super::{DirectGravity, Interaction, State};
 pub struct DirectCoulomb {
     /// Coulomb's constant k = 1/(4πε₀).
     pub k: f64,
-    /// Charge of each particle.
-    pub charge: Vec<f64>,
     kernel: DirectGravity,
     field: Vec<DVec3>,
 }
 
+/// The charges of a state, which must give one per particle.
+fn charges<'a>(state: &State<'a>) -> &'a [f64] {
+    assert_eq!(
+        state.charge.len(),
+        state.position.len(),
+        "charges must come with the state, one per particle"
+    );
+    state.charge
+}
+
 impl DirectCoulomb {
-    pub fn new(k: f64, charge: Vec<f64>, softening: f64) -> Self {
+    pub fn new(k: f64, softening: f64) -> Self {
         Self {
             k,
-            charge,
             kernel: DirectGravity::new(1.0, softening),
             field: Vec::new(),
         }
@@ -51,17 +60,21 @@ impl Interaction for DirectCoulomb {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         // The kernel gives Σ_j q_j (r_j − r_i)/r³: like charges repel.
+        let charge = charges(state);
         self.field.clear();
         self.field.resize(state.position.len(), DVec3::ZERO);
         self.kernel
-            .inverse_square_field(state.position, &self.charge, &mut self.field);
-        for ((f, e), q) in force.iter_mut().zip(&self.field).zip(&self.charge) {
+            .inverse_square_field(state.position, charge, &mut self.field);
+        for ((f, e), q) in force.iter_mut().zip(&self.field).zip(charge) {
             *f -= *e * (self.k * q);
         }
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
-        0.5 * self.k * self.kernel.pair_potential_sum(state.position, &self.charge)
+        0.5 * self.k
+            * self
+                .kernel
+                .pair_potential_sum(state.position, charges(state))
     }
 }
 
@@ -74,11 +87,6 @@ pub struct ElectricField {
     pub angular_frequency: f64,
     /// Phase φ.
     pub phase: f64,
-    /// Charge of each particle.
-    pub charge: Vec<f64>,
-    /// Whether −Σ q E·r is the potential energy (false when the box is
-    /// periodic along the field, where it is not defined): then 0 is reported.
-    pub has_potential: bool,
 }
 
 impl ElectricField {
@@ -99,20 +107,22 @@ impl Interaction for ElectricField {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let e = self.at(state.time);
-        for (f, q) in force.iter_mut().zip(&self.charge) {
+        for (f, q) in force.iter_mut().zip(charges(state)) {
             *f += e * *q;
         }
     }
 
+    /// −Σ q E·r, or 0 where the box is periodic along the field (there the
+    /// potential is not defined).
     fn potential_energy(&mut self, state: &State) -> f64 {
-        if !self.has_potential {
+        let e = self.at(state.time);
+        if (0..3).any(|a| state.boundary.periodic[a] && self.amplitude[a] != 0.0) {
             return 0.0;
         }
-        let e = self.at(state.time);
         -state
             .position
             .iter()
-            .zip(&self.charge)
+            .zip(charges(state))
             .map(|(r, q)| q * e.dot(*r))
             .sum::<f64>()
     }
@@ -122,13 +132,13 @@ impl Interaction for ElectricField {
 mod tests {
     use super::*;
 
-    fn state<'a>(pos: &'a [DVec3], vel: &'a [DVec3], mass: &'a [f64]) -> State<'a> {
-        State {
-            position: pos,
-            velocity: vel,
-            mass,
-            time: 0.0,
-        }
+    fn state<'a>(
+        pos: &'a [DVec3],
+        vel: &'a [DVec3],
+        mass: &'a [f64],
+        charge: &'a [f64],
+    ) -> State<'a> {
+        State::new(pos, vel, mass, 0.0).with_charges(charge)
     }
 
     /// Two charges: F = k q₁ q₂ / r² along the line, repulsive for like
@@ -138,14 +148,15 @@ mod tests {
         let pos = [DVec3::new(0.5, -1.0, 2.0), DVec3::new(0.5, 2.0, 2.0)];
         let (vel, mass) = ([DVec3::ZERO; 2], [1.0; 2]);
         for (q1, q2) in [(2.0, 3.0), (2.0, -3.0)] {
-            let mut c = DirectCoulomb::new(0.7, vec![q1, q2], 0.0);
+            let q = [q1, q2];
+            let mut c = DirectCoulomb::new(0.7, 0.0);
             let mut f = [DVec3::ZERO; 2];
-            c.add_forces(&state(&pos, &vel, &mass), &mut f);
+            c.add_forces(&state(&pos, &vel, &mass, &q), &mut f);
             let magnitude = 0.7 * q1 * q2 / 9.0;
             assert!((f[0].y + magnitude).abs() < 1e-15 * magnitude.abs());
             assert!((f[1].y - magnitude).abs() < 1e-15 * magnitude.abs());
             assert_eq!(f[0].x, 0.0);
-            let u = c.potential_energy(&state(&pos, &vel, &mass));
+            let u = c.potential_energy(&state(&pos, &vel, &mass, &q));
             assert!((u - 0.7 * q1 * q2 / 3.0).abs() < 1e-15);
         }
     }
@@ -165,17 +176,17 @@ mod tests {
             .map(|k| if k % 2 == 0 { 1.5 } else { -1.5 })
             .collect();
         let (vel, mass) = (vec![DVec3::ZERO; n], vec![1.0; n]);
-        let mut c = DirectCoulomb::new(1.0, charge, 0.05);
+        let mut c = DirectCoulomb::new(1.0, 0.05);
         let mut f = vec![DVec3::ZERO; n];
-        c.add_forces(&state(&pos, &vel, &mass), &mut f);
+        c.add_forces(&state(&pos, &vel, &mass, &charge), &mut f);
         let h = 1e-6;
         for i in [0, 7, 33] {
             for a in 0..3 {
                 let mut p = pos.clone();
                 p[i][a] += h;
-                let up = c.potential_energy(&state(&p, &vel, &mass));
+                let up = c.potential_energy(&state(&p, &vel, &mass, &charge));
                 p[i][a] -= 2.0 * h;
-                let down = c.potential_energy(&state(&p, &vel, &mass));
+                let down = c.potential_energy(&state(&p, &vel, &mass, &charge));
                 let numeric = -(up - down) / (2.0 * h);
                 assert!(
                     (numeric - f[i][a]).abs() < 1e-6 * f[i].length().max(1.0),
@@ -192,17 +203,18 @@ mod tests {
             amplitude: DVec3::new(0.0, 2.0, 0.0),
             angular_frequency: 3.0,
             phase: 0.25,
-            charge: vec![-0.5],
-            has_potential: true,
         };
         let pos = [DVec3::new(1.0, 4.0, 0.0)];
         let (vel, mass) = ([DVec3::ZERO], [1.0]);
-        let mut s = state(&pos, &vel, &mass);
+        let mut s = state(&pos, &vel, &mass, &[-0.5]);
         s.time = 0.4;
         let mut f = [DVec3::ZERO];
         e.add_forces(&s, &mut f);
         let c = (3.0f64 * 0.4 + 0.25).cos();
         assert_eq!(f[0], DVec3::new(0.0, -0.5 * 2.0 * c, 0.0));
         assert!((e.potential_energy(&s) - 0.5 * 2.0 * c * 4.0).abs() < 1e-15);
+        // Periodic along the field: no potential.
+        let periodic = crate::boundary::Boundary::periodic(DVec3::ZERO, DVec3::splat(10.0));
+        assert_eq!(e.potential_energy(&s.in_box(&periodic)), 0.0);
     }
 }

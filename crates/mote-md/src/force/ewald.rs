@@ -422,23 +422,32 @@ fn phase(ph: &[(f64, f64)], j: usize, w: usize, m: i32, nk: &[i32; 3]) -> (f64, 
 }
 
 /// Coulomb interaction of point charges in a cubic periodic box by Ewald
-/// summation: U and F are those of [`Ewald::charges`] times `k`.
+/// summation: U and F are those of [`Ewald::charges`] times `k`, with the
+/// charges of the step's [`State`].
 #[derive(Debug, Clone)]
 pub struct EwaldCoulomb {
     pub ewald: Ewald,
     /// Coulomb constant of the unit system.
     pub k: f64,
-    /// Charge of each particle.
-    pub charge: Vec<f64>,
 }
 
 impl EwaldCoulomb {
     /// α and n_max from the requested RMS force error `accuracy` (in force
-    /// units, i.e. including `k`).
-    pub fn new(k: f64, charge: Vec<f64>, box_length: f64, r_cut: f64, accuracy: f64) -> Self {
-        let ewald = Ewald::for_charges(box_length, r_cut, accuracy / k.abs(), &charge);
-        Self { ewald, k, charge }
+    /// units, i.e. including `k`) for these charges.
+    pub fn new(k: f64, charge: &[f64], box_length: f64, r_cut: f64, accuracy: f64) -> Self {
+        let ewald = Ewald::for_charges(box_length, r_cut, accuracy / k.abs(), charge);
+        Self { ewald, k }
     }
+}
+
+/// The charges of a state, which must give one per particle.
+fn charges<'a>(state: &State<'a>) -> &'a [f64] {
+    assert_eq!(
+        state.charge.len(),
+        state.position.len(),
+        "charges must come with the state, one per particle"
+    );
+    state.charge
 }
 
 impl Interaction for EwaldCoulomb {
@@ -449,14 +458,14 @@ impl Interaction for EwaldCoulomb {
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let mut f = vec![DVec3::ZERO; force.len()];
         self.ewald
-            .charges(state.position, &self.charge, Some(&mut f));
+            .charges(state.position, charges(state), Some(&mut f));
         for (a, b) in force.iter_mut().zip(&f) {
             *a += *b * self.k;
         }
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
-        self.k * self.ewald.charges(state.position, &self.charge, None)
+        self.k * self.ewald.charges(state.position, charges(state), None)
     }
 }
 

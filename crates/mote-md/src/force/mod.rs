@@ -22,14 +22,79 @@ pub use uniform::UniformField;
 
 use glam::DVec3;
 
-/// A read-only view of the state at which forces are evaluated (the
-/// integrator's stage, which need not be the system's current state).
+use crate::boundary::Boundary;
+use crate::particles::System;
+
+/// The per-step context of every interaction: a read-only view of the
+/// state at which forces are evaluated (the integrator's stage, which need
+/// not be the system's current state) and the particles' properties and box
+/// as the system holds them. Interactions read radii, charges and the box
+/// from here and keep no copies.
 #[derive(Clone, Copy)]
 pub struct State<'a> {
     pub position: &'a [DVec3],
     pub velocity: &'a [DVec3],
     pub mass: &'a [f64],
     pub time: f64,
+    /// Radius of each particle (empty when the caller gives none).
+    pub radius: &'a [f64],
+    /// Charge of each particle (empty when the caller gives none).
+    pub charge: &'a [f64],
+    /// The simulation box.
+    pub boundary: &'a Boundary,
+}
+
+/// The box of a state given without one.
+static OPEN_SPACE: Boundary = Boundary {
+    lo: DVec3::NEG_INFINITY,
+    hi: DVec3::INFINITY,
+    periodic: [false; 3],
+};
+
+impl<'a> State<'a> {
+    /// Positions, velocities and masses alone, in open space, with no radii
+    /// or charges (kernels and their tests).
+    pub fn new(position: &'a [DVec3], velocity: &'a [DVec3], mass: &'a [f64], time: f64) -> Self {
+        Self {
+            position,
+            velocity,
+            mass,
+            time,
+            radius: &[],
+            charge: &[],
+            boundary: &OPEN_SPACE,
+        }
+    }
+
+    /// The system's particles at an integrator stage (`position`,
+    /// `velocity`, `time`), with their radii, charges and box.
+    pub fn of(sys: &'a System, position: &'a [DVec3], velocity: &'a [DVec3], time: f64) -> Self {
+        let p = &sys.particles;
+        Self {
+            position,
+            velocity,
+            mass: &p.mass,
+            time,
+            radius: &p.radius,
+            charge: &p.charge,
+            boundary: &sys.boundary,
+        }
+    }
+
+    /// The same state with these charges.
+    pub fn with_charges(self, charge: &'a [f64]) -> Self {
+        Self { charge, ..self }
+    }
+
+    /// The same state with these radii.
+    pub fn with_radii(self, radius: &'a [f64]) -> Self {
+        Self { radius, ..self }
+    }
+
+    /// The same state in this box.
+    pub fn in_box(self, boundary: &'a Boundary) -> Self {
+        Self { boundary, ..self }
+    }
 }
 
 /// The rotational state at which torques are evaluated, beside [`State`].

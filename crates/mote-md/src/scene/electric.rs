@@ -87,7 +87,7 @@ impl Section for CoulombSettings {
                 refuse("theta", self.theta.is_some(), "direct")?;
                 refuse("cutoff", self.cutoff.is_some(), "direct")?;
                 refuse("accuracy", self.accuracy.is_some(), "direct")?;
-                b.forces.push(DirectCoulomb::new(k, charge, softening));
+                b.forces.push(DirectCoulomb::new(k, softening));
             }
             "tree" => {
                 open("tree")?;
@@ -99,7 +99,7 @@ impl Section for CoulombSettings {
                         "[coulomb] theta must be in [0, 1.2), found {theta}"
                     )));
                 }
-                b.forces.push(TreeCoulomb::new(k, charge, softening, theta));
+                b.forces.push(TreeCoulomb::new(k, softening, theta));
             }
             "ewald" => {
                 refuse("softening", self.softening.is_some(), "ewald")?;
@@ -120,7 +120,8 @@ impl Section for CoulombSettings {
                     err("[coulomb] method = \"ewald\" needs accuracy = the RMS force error aimed at (force units)".into())
                 })?;
                 positive(src, span.clone(), "[coulomb] accuracy", accuracy)?;
-                b.forces.push(EwaldCoulomb::new(k, charge, l, rc, accuracy));
+                b.forces
+                    .push(EwaldCoulomb::new(k, &charge, l, rc, accuracy));
             }
             other => {
                 return Err(err(format!(
@@ -159,13 +160,10 @@ impl Section for ElectricFieldSettings {
                 "[electric_field] e, angular_frequency and phase must be finite",
             ));
         }
-        let has_potential = (0..3).all(|a| !(b.boundary.periodic[a] && self.e[a] != 0.0));
         b.forces.push(ElectricField {
             amplitude: DVec3::from(self.e),
             angular_frequency: self.angular_frequency,
             phase: self.phase,
-            charge: b.particles.charge.clone(),
-            has_potential,
         });
         Ok(())
     }

@@ -80,10 +80,9 @@ pub struct WallSpec {
 impl Section for GranularSettings {
     fn add_to(&self, span: Range<usize>, scene: &Scene, b: &mut Build) -> Result<(), ParseError> {
         let src = b.src;
-        let boundary = b.boundary;
         let err = |span: Range<usize>, msg: String| src.error(span, msg);
         let v = self;
-        let radius: Vec<f64> = b.particles.radius.clone();
+        let radius = &b.particles.radius;
         let bad = |msg: &str| Err(err(span.clone(), msg.to_string()));
         if v.young.is_nan()
             || v.young <= 0.0
@@ -133,12 +132,13 @@ impl Section for GranularSettings {
         law.rolling_friction = v.rolling_friction;
         law.adhesion = v.adhesion;
         let d_min = radius.iter().cloned().fold(f64::INFINITY, f64::min) * 2.0;
+        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+        let n = radius.len();
         let skin = v.skin.unwrap_or(0.25 * d_min);
         if skin.is_nan() || skin <= 0.0 {
             return bad("[granular] skin must be positive");
         }
-        b.forces
-            .push(GranularContacts::new(law, &radius, skin, boundary));
+        b.forces.push(GranularContacts::new(law, r_max, skin));
         if !scene.wall.is_empty() {
             let wall_material = Material {
                 young: v.wall_young.unwrap_or(v.young),
@@ -158,7 +158,7 @@ impl Section for GranularSettings {
             for (k, w) in scene.wall.iter().enumerate() {
                 walls.extend(w.get_ref().walls(k).map_err(|m| err(w.span(), m))?);
             }
-            b.forces.push(GranularWalls::new(wall_law, walls, &radius));
+            b.forces.push(GranularWalls::new(wall_law, walls, n));
         }
         Ok(())
     }

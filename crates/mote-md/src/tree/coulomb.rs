@@ -13,25 +13,32 @@ use super::barnes_hut::{BarnesHut, WalkCounts};
 use super::ForceError;
 use crate::force::{Interaction, State};
 
-/// Point charges by a Barnes–Hut tree. Charges are the interaction's own
-/// parameters (one per particle, in the particles' order).
+/// Point charges by a Barnes–Hut tree; the charges come with the step's
+/// [`State`] (one per particle).
 #[derive(Debug, Clone)]
 pub struct TreeCoulomb {
     /// Coulomb constant k.
     pub k: f64,
     /// Softening length ε (0 for bare charges).
     pub softening: f64,
-    /// Charge of each particle.
-    pub charge: Vec<f64>,
     bh: BarnesHut,
 }
 
+/// The charges of a state, which must give one per particle.
+fn charges<'a>(state: &State<'a>) -> &'a [f64] {
+    assert_eq!(
+        state.charge.len(),
+        state.position.len(),
+        "charges must come with the state, one per particle"
+    );
+    state.charge
+}
+
 impl TreeCoulomb {
-    pub fn new(k: f64, charge: Vec<f64>, softening: f64, theta: f64) -> Self {
+    pub fn new(k: f64, softening: f64, theta: f64) -> Self {
         Self {
             k,
             softening,
-            charge,
             bh: BarnesHut::new(theta, softening),
         }
     }
@@ -53,7 +60,7 @@ impl TreeCoulomb {
         let mut f = vec![DVec3::ZERO; n];
         self.forces(state, &mut f);
         let eps2 = self.softening * self.softening;
-        let (pos, q) = (state.position, &self.charge);
+        let (pos, q) = (state.position, charges(state));
         let errors: Vec<f64> = (0..n)
             .into_par_iter()
             .step_by(stride.max(1))
@@ -72,19 +79,20 @@ impl Interaction for TreeCoulomb {
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
+        let charge = charges(state);
         self.bh.eps2 = self.softening * self.softening;
-        self.bh.build(state.position, &self.charge);
+        self.bh.build(state.position, charge);
         self.bh.evaluate(false);
         for (k, g) in self.bh.gradient().iter().enumerate() {
             let i = self.bh.index(k);
-            force[i] -= *g * (self.k * self.charge[i]);
+            force[i] -= *g * (self.k * charge[i]);
         }
     }
 
     /// U = (k/2) Σ_i q_i ψ_i from the tree walk.
     fn potential_energy(&mut self, state: &State) -> f64 {
         self.bh.eps2 = self.softening * self.softening;
-        self.bh.build(state.position, &self.charge);
+        self.bh.build(state.position, charges(state));
         self.bh.evaluate(true);
         let psi = self.bh.potential();
         let q = self.bh.strength();

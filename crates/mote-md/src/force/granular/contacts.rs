@@ -13,13 +13,12 @@ use crate::neighbor::VerletList;
 /// Hertz–Mindlin contacts between all spheres (see [`super::law`]).
 ///
 /// The history (tangential and rolling elongations) sits beside the
-/// neighbour list, one entry per listed pair ([`PairHistories`]).
+/// neighbour list, one entry per listed pair ([`PairHistories`]). Radii and
+/// the box come with the step's [`State`].
 #[derive(Debug, Clone)]
 pub struct GranularContacts {
     pub law: ContactLaw,
-    pub boundary: Boundary,
     pub list: VerletList,
-    radius: Vec<f64>,
     pairs: PairHistories,
     last_time: Option<f64>,
     /// One (force, torque) buffer per extra block of particles.
@@ -29,14 +28,12 @@ pub struct GranularContacts {
 }
 
 impl GranularContacts {
-    /// Contacts among spheres of the given radii; `skin` is the Verlet skin.
-    pub fn new(law: ContactLaw, radius: &[f64], skin: f64, boundary: Boundary) -> Self {
-        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+    /// Contacts among spheres with radii up to `r_max` (the list's reach is
+    /// 2 r_max + `skin`).
+    pub fn new(law: ContactLaw, r_max: f64, skin: f64) -> Self {
         Self {
             law,
-            boundary,
             list: VerletList::half(2.0 * r_max, skin),
-            radius: radius.to_vec(),
             pairs: PairHistories::default(),
             last_time: None,
             buffers: Vec::new(),
@@ -56,8 +53,8 @@ impl GranularContacts {
     }
 
     /// Refreshes the list; after a rebuild the histories move with it.
-    fn refresh(&mut self, pos: &[DVec3]) {
-        if self.list.update(pos, &self.boundary) || self.pairs.len() != self.list.neighbors.len() {
+    fn refresh(&mut self, pos: &[DVec3], boundary: &Boundary) {
+        if self.list.update(pos, boundary) || self.pairs.len() != self.list.neighbors.len() {
             self.pairs.carry_to(&self.list.start, &self.list.neighbors);
         }
     }
@@ -71,7 +68,7 @@ impl GranularContacts {
     ) {
         let pos = state.position;
         let n = pos.len();
-        self.refresh(pos);
+        self.refresh(pos, state.boundary);
         let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
         self.last_time = Some(state.time);
 
@@ -159,19 +156,20 @@ impl GranularContacts {
         let pos = state.position;
         let vel = state.velocity;
         let mass = state.mass;
-        let image = self.boundary.image();
+        let radius = state.radius;
+        let image = state.boundary.image();
         let offset = self.list.start[range.start] as usize;
         let mut contacts = 0usize;
         let mut virial = 0.0;
         for i in range {
-            let (ri, vi, wi, radi, mi) = (pos[i], vel[i], omega[i], self.radius[i], mass[i]);
+            let (ri, vi, wi, radi, mi) = (pos[i], vel[i], omega[i], radius[i], mass[i]);
             let (mut fi, mut ti) = (DVec3::ZERO, DVec3::ZERO);
             let lo = self.list.start[i] as usize;
             for (k, &j) in self.list.of(i).iter().enumerate() {
                 let j = j as usize;
                 let slot = lo + k - offset;
                 let d = image.apply(ri - pos[j]);
-                let reach = radi + self.radius[j];
+                let reach = radi + radius[j];
                 let r2 = d.length_squared();
                 if r2 >= reach * reach {
                     if touch[slot] {
@@ -185,10 +183,10 @@ impl GranularContacts {
                 let r = r2.sqrt();
                 let nrm = d / r;
                 let delta = reach - r;
-                let (arm_i, arm_j) = (radi - 0.5 * delta, self.radius[j] - 0.5 * delta);
+                let (arm_i, arm_j) = (radi - 0.5 * delta, radius[j] - 0.5 * delta);
                 let wj = omega[j];
                 let v_rel = vi - vel[j] - (wi * arm_i + wj * arm_j).cross(nrm);
-                let r_eff = radi * self.radius[j] / reach;
+                let r_eff = radi * radius[j] / reach;
                 let m_eff = mi * mass[j] / (mi + mass[j]);
                 let c = self.law.force(
                     delta,
@@ -256,24 +254,25 @@ impl Interaction for GranularContacts {
         };
         self.last_time = (!t.is_nan()).then_some(t);
         self.pairs
-            .restore_rows(rows, self.radius.len())
+            .restore_rows(rows, usize::MAX)
             .map_err(|m| format!("granular {m}"))
     }
 
     /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}.
     fn potential_energy(&mut self, state: &State) -> f64 {
         let pos = state.position;
-        self.refresh(pos);
-        let image = self.boundary.image();
+        self.refresh(pos, state.boundary);
+        let image = state.boundary.image();
+        let radius = state.radius;
         let mut u = 0.0;
         for i in 0..pos.len() {
             for &j in self.list.of(i) {
                 let j = j as usize;
-                let reach = self.radius[i] + self.radius[j];
+                let reach = radius[i] + radius[j];
                 let r = image.apply(pos[i] - pos[j]).length();
                 if r < reach {
                     let delta = reach - r;
-                    let r_eff = self.radius[i] * self.radius[j] / reach;
+                    let r_eff = radius[i] * radius[j] / reach;
                     u += 8.0 / 15.0 * self.law.e_star * r_eff.sqrt() * delta.powf(2.5);
                 }
             }

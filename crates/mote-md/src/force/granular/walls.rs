@@ -115,12 +115,11 @@ impl Wall {
     }
 }
 
-/// Contacts of every sphere with a set of walls.
+/// Contacts of every sphere with a set of walls (radii from the step's [`State`]).
 #[derive(Debug, Clone)]
 pub struct GranularWalls {
     pub law: ContactLaw,
     pub walls: Vec<Wall>,
-    radius: Vec<f64>,
     /// history[i · walls + w]: the contact of particle i with wall w.
     history: Vec<History>,
     /// Whether particle i touched wall w at the last evaluation (same layout).
@@ -131,15 +130,14 @@ pub struct GranularWalls {
 }
 
 impl GranularWalls {
-    pub fn new(law: ContactLaw, walls: Vec<Wall>, radius: &[f64]) -> Self {
-        let n = radius.len();
+    /// Contacts of `n` spheres with `walls`.
+    pub fn new(law: ContactLaw, walls: Vec<Wall>, n: usize) -> Self {
         Self {
             law,
             history: vec![History::default(); n * walls.len()],
             touching: vec![false; n * walls.len()],
             wall_force: vec![DVec3::ZERO; walls.len()],
             walls,
-            radius: radius.to_vec(),
             last_time: None,
         }
     }
@@ -164,7 +162,7 @@ impl GranularWalls {
         if n_walls == 0 {
             return;
         }
-        let radius = &self.radius;
+        let radius = state.radius;
         // Planes as (n, c) with gap = x·n − c at this time.
         let planes: Vec<Option<(DVec3, f64)>> = walls
             .iter()
@@ -312,7 +310,7 @@ impl Interaction for GranularWalls {
         let mut u = 0.0;
         for wall in &self.walls {
             for (i, &x) in state.position.iter().enumerate() {
-                let r = self.radius[i];
+                let r = state.radius[i];
                 let (gap, _) = wall.gap(x, state.time);
                 if gap < r && gap > -r {
                     u += 8.0 / 15.0 * self.law.e_star * r.sqrt() * (r - gap).powf(2.5);

@@ -289,12 +289,7 @@ mod tests {
         let pos = [DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0)];
         let vel = [DVec3::ZERO; 2];
         let mass = [3.0, 5.0];
-        let state = State {
-            position: &pos,
-            velocity: &vel,
-            mass: &mass,
-            time: 0.0,
-        };
+        let state = State::new(&pos, &vel, &mass, 0.0);
         let mut g = DirectGravity::new(0.5, 0.0);
         let mut f = [DVec3::ZERO; 2];
         g.add_forces(&state, &mut f);
@@ -336,12 +331,7 @@ mod tests {
     fn every_kernel_agrees_with_the_exact_sum() {
         for n in [37, 203, 1500] {
             let (pos, vel, mass) = cloud(n);
-            let state = State {
-                position: &pos,
-                velocity: &vel,
-                mass: &mass,
-                time: 0.0,
-            };
+            let state = State::new(&pos, &vel, &mass, 0.0);
             for eps in [0.0, 1e-3] {
                 let mut g = DirectGravity::new(1.0, eps);
                 g.load(&state);
@@ -375,12 +365,7 @@ mod tests {
     #[test]
     fn potential_agrees_with_the_exact_pair_sum() {
         let (pos, vel, mass) = cloud(203);
-        let state = State {
-            position: &pos,
-            velocity: &vel,
-            mass: &mass,
-            time: 0.0,
-        };
+        let state = State::new(&pos, &vel, &mass, 0.0);
         for eps in [0.0, 1e-3] {
             let mut exact = 0.0;
             for i in 0..pos.len() {
@@ -413,12 +398,7 @@ mod tests {
             .collect();
         let vel = vec![DVec3::ZERO; n];
         let mass: Vec<f64> = (0..n).map(|k| 1.0 + (k % 3) as f64).collect();
-        let state = State {
-            position: &pos,
-            velocity: &vel,
-            mass: &mass,
-            time: 0.0,
-        };
+        let state = State::new(&pos, &vel, &mass, 0.0);
         let mut f = vec![DVec3::ZERO; n];
         DirectGravity::new(1.0, 0.01).add_forces(&state, &mut f);
         let total: DVec3 = f.iter().copied().sum();
