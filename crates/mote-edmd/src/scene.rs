@@ -498,6 +498,12 @@ impl Scene {
         if self.n == Some(0) {
             return Err(err("n", "n must be at least 1".into()));
         }
+        if let Some(n) = self.n {
+            // Positions, velocities, radii, times, event, cell and
+            // neighbour entries: at least 300 bytes a particle.
+            mote_io::system::check_fits(&format!("n = {n}"), n as f64 * 300.0)
+                .map_err(|m| err("n", m))?;
+        }
         if self.n.is_some() && self.box_size.is_none() && self.packing_fraction.is_none() {
             return Err(err(
                 "n",

@@ -75,6 +75,25 @@ impl RunOptions {
     }
 }
 
+impl RunOptions {
+    /// Refuses values no engine can run: a time step or an end time that is
+    /// not a positive finite number, zero steps between checkpoints.
+    pub fn check_values(&self) -> Result<(), FrontError> {
+        let input = self.input.as_deref().unwrap_or("the scene");
+        for (option, value) in [("--dt", self.dt), ("--until", self.until)] {
+            if let Some(v) = value {
+                if !(v > 0.0 && v.is_finite()) {
+                    error::refuse!("{input}: {option} {v}: must be a positive, finite number");
+                }
+            }
+        }
+        if self.checkpoint_every == Some(0) {
+            error::refuse!("{input}: --checkpoint-every 0: must be at least 1 step");
+        }
+        Ok(())
+    }
+}
+
 /// What a caller shows while a run goes: the opening line and progress.
 pub trait Monitor {
     /// The line that opens a run: what it is, its size, its seed.
@@ -141,6 +160,7 @@ pub fn run_input(
     options: &RunOptions,
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
+    options.check_values()?;
     let result = match input.engine() {
         Engine::Particles => particles::run(Some(input.clone()), options, monitor),
         Engine::Rigid => rigid::run(input, options, monitor),

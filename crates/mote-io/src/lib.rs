@@ -12,6 +12,7 @@ pub mod lammps_data;
 pub mod lammps_dump;
 pub mod plist;
 pub mod png;
+pub mod system;
 pub mod vtu;
 pub mod xyz;
 

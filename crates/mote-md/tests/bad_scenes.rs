@@ -47,3 +47,22 @@ fn every_bad_scene_is_refused_with_its_file_line_and_message() {
     }
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));
 }
+
+/// A request larger than the machine is refused before anything is
+/// allocated, with both numbers (the available memory is the machine's, so
+/// only the request's part is pinned).
+#[test]
+fn a_scene_too_large_for_the_machine_is_refused_before_allocating() {
+    let text =
+        "units = \"lj\"\n[run]\ndt = 0.001\n[[fcc]]\ncells = [2000, 2000, 2000]\ndensity = 0.8\n";
+    let e = Scene::parse(text, "huge.toml")
+        .and_then(|s| s.build(text, "huge.toml", 1))
+        .err()
+        .expect("a 3.2e10-particle crystal must be refused")
+        .to_string();
+    assert!(
+        e.starts_with("huge.toml:4: the scene makes 32000000000 particles (32000000000 from this [[fcc]]), which needs at least 14.4 TB, and this machine has "),
+        "{e}"
+    );
+    assert!(e.ends_with(" available"), "{e}");
+}

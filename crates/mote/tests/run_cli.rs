@@ -533,3 +533,98 @@ fn granular_observables_split_translation_and_rotation() {
     let header = std::fs::read_to_string(dir.path().join("drum/observables.csv")).unwrap();
     assert!(header.contains("translational_energy"));
 }
+
+/// Negative numbers on the command line are values, not flags: each is
+/// refused with what it must be (exit 1), never "unexpected argument".
+#[test]
+fn negative_numbers_are_refused_as_values() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, says) in [
+        (
+            &["run", "example:sun-earth", "--until", "-1"][..],
+            "--until -1: must be a positive, finite number",
+        ),
+        (
+            &["run", "example:sun-earth", "--dt", "-0.5", "--steps", "2"][..],
+            "--dt -0.5: must be a positive, finite number",
+        ),
+        (
+            &["run", "example:magnet-in-field", "--until", "-3"][..],
+            "--until -3: must be a positive, finite number",
+        ),
+        (
+            &["edmd", "example:cube", "--time", "-5"][..],
+            "--time -5: must be a non-negative number",
+        ),
+        (
+            &["pack", "--rate", "-1"][..],
+            "growth rate Γ = -1 must be positive",
+        ),
+    ] {
+        let o = mote(args, dir.path());
+        assert_eq!(o.status.code(), Some(1), "{args:?}");
+        let err = stderr(&o);
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains("unexpected argument"), "{args:?}: {err}");
+    }
+}
+
+/// Requests larger than the machine are refused at once with both numbers
+/// (exit 1, no abort, no endless run): a hard-sphere scene, a packing and
+/// a rod packing.
+#[test]
+fn requests_too_large_for_the_machine_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("hs.toml"),
+        "dimension = 3\nn = 100000000000\npacking_fraction = 0.3\n",
+    )
+    .unwrap();
+    let o = mote(&["run", "hs.toml"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(
+        err.contains("hs.toml:2: n = 100000000000 needs at least 30.0 TB, and this machine has"),
+        "{err}"
+    );
+    std::fs::write(
+        dir.path().join("rig.toml"),
+        "[rigid]\n[[rigid.template]]\nname = \"b\"\ngenerator = \"sphere\"\nradius = 1.0\ndensity = 1.0\n\
+         [[rigid.random]]\ntemplate = \"b\"\nn = 100000000000\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, 1.0]\n\
+         [run]\ndt = 0.01\nsteps = 1\n",
+    )
+    .unwrap();
+    let o = mote(&["run", "rig.toml", "-q"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("rig.toml:7: 100000000000 bodies of 1 spheres needs at least 14.0 TB"),
+        "{}",
+        stderr(&o)
+    );
+    let o = mote(&["pack", "--n", "100000000000"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("--n 100000000000: the packing needs at least 30.0 TB"),
+        "{}",
+        stderr(&o)
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(["rcp", "-l", "-N", "99999999999"])
+        .current_dir(dir.path())
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .and_then(|mut c| {
+            use std::io::Write;
+            c.stdin.take().unwrap().write_all(b"2 0.5\n")?;
+            c.wait_with_output()
+        })
+        .unwrap();
+    assert!(!o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(
+        text.contains("-N 99999999999: the rod packing needs at least 800.0 GB"),
+        "{text}"
+    );
+}

@@ -493,6 +493,15 @@ impl RigidScene {
                 let (span, ps) = (p.span(), p.get_ref());
                 let k = kind_of(&ps.template, span.clone())?;
                 let bound = bodies.templates[k as usize].props.bounding_radius;
+                // Placement, velocities and kind of each body (100 B) and the
+                // world-frame centre, radius and owner of each sphere (40 B):
+                // refused before anything is allocated when it cannot fit.
+                let spheres = bodies.templates[k as usize].sphere_count() as f64;
+                mote_io::system::check_fits(
+                    &format!("{} bodies of {} spheres", ps.n, spheres),
+                    ps.n as f64 * (100.0 + 40.0 * spheres),
+                )
+                .map_err(|m| err(span.clone(), m))?;
                 let (lo, hi) = (DVec3::from(ps.lo), DVec3::from(ps.hi));
                 if (0..3).any(|d| hi[d] < lo[d]) {
                     return Err(err(span, "lo must not exceed hi".into()));

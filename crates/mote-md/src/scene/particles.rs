@@ -262,9 +262,69 @@ pub struct Made {
     pub fcc_box: Option<Boundary>,
 }
 
+/// Bytes per particle, a lower bound while a scene is built: the particle
+/// arrays (six vectors, four scalars, a colour: 200 B), the generators'
+/// staging copy (about as much) and the integrator's carried accelerations.
+const BYTES_PER_PARTICLE: f64 = 450.0;
+
+/// The number of particles the generators will make (files not counted),
+/// and the table that makes the most, refused before anything is allocated
+/// when their arrays alone would not fit in the available memory.
+fn refuse_too_large(scene: &Scene, src: Source) -> Result<(), ParseError> {
+    let mut total = 0.0f64;
+    let mut largest: Option<(std::ops::Range<usize>, &str, f64)> = None;
+    let mut count = |span: std::ops::Range<usize>, table: &'static str, n: f64| {
+        total += n;
+        if largest.as_ref().is_none_or(|(_, _, m)| n > *m) {
+            largest = Some((span, table, n));
+        }
+    };
+    for spec in &scene.lattice {
+        let n = spec.get_ref().n;
+        count(
+            spec.span(),
+            "[[lattice]]",
+            n.iter().map(|&k| k as f64).product(),
+        );
+    }
+    for spec in &scene.fcc {
+        let c = spec.get_ref().cells;
+        count(
+            spec.span(),
+            "[[fcc]]",
+            4.0 * c.iter().map(|&k| k as f64).product::<f64>(),
+        );
+    }
+    for spec in &scene.ring {
+        count(spec.span(), "[[ring]]", spec.get_ref().n as f64);
+    }
+    for spec in &scene.annulus {
+        count(spec.span(), "[[annulus]]", spec.get_ref().n as f64);
+    }
+    for spec in &scene.random_box {
+        count(spec.span(), "[[random_box]]", spec.get_ref().n as f64);
+    }
+    for spec in &scene.cloud {
+        count(spec.span(), "[[cloud]]", spec.get_ref().n as f64);
+    }
+    for spec in &scene.plummer {
+        count(spec.span(), "[[plummer]]", spec.get_ref().n as f64);
+    }
+    total += scene.particle.len() as f64;
+    let Some((span, table, n)) = largest else {
+        return Ok(());
+    };
+    mote_io::system::check_fits(
+        &format!("the scene makes {total:.0} particles ({n:.0} from this {table}), which"),
+        total * BYTES_PER_PARTICLE,
+    )
+    .map_err(|m| src.error(span, m))
+}
+
 /// Makes every particle of the scene, in the order of the module's doc,
 /// drawing from `rng` in that order.
 pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<Made, ParseError> {
+    refuse_too_large(scene, src)?;
     let file = src.file;
     let err = |span: std::ops::Range<usize>, msg: String| src.error(span, msg);
     let g_const = scene

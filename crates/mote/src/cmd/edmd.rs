@@ -16,6 +16,7 @@ use crate::progress::Terminal;
 
 /// The old command's words (its help text is the `Edmd` variant's in main.rs).
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct EdmdArgs {
     /// Scene file or `example:NAME`.
     #[arg(value_name = "SCENE")]

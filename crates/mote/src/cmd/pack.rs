@@ -18,7 +18,7 @@ use super::GlobalOpts;
 
 /// The words of `mote pack` (its help text is the `Pack` variant's in main.rs).
 #[derive(clap::Args, Debug)]
-#[command(args_conflicts_with_subcommands = true)]
+#[command(args_conflicts_with_subcommands = true, allow_negative_numbers = true)]
 pub struct PackArgs {
     #[command(subcommand)]
     command: Option<PackCommand>,
@@ -92,6 +92,7 @@ enum PackCommand {
 /// Structure of a packing: φ, contacts at a relative gap tolerance, rattlers,
 /// g(r) and the bond-orientational order (Q6 in 3-D, |ψ6| in 2-D).
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 struct AnalyseArgs {
     /// Extended XYZ file with radii (the last frame is analysed).
     #[arg(value_name = "FILE")]
@@ -156,6 +157,10 @@ fn read_radii(path: &Path) -> anyhow::Result<Vec<f64>> {
 fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     let quiet = global.quiet;
     anyhow::ensure!(a.dim == 2 || a.dim == 3, "--dim {}: must be 2 or 3", a.dim);
+    // Positions, velocities, radii, times, event, cell and neighbour entries:
+    // at least 300 bytes a sphere.
+    mote_io::system::check_fits(&format!("--n {}: the packing", a.n), a.n as f64 * 300.0)
+        .map_err(anyhow::Error::msg)?;
     let sizes = match a.dist.strip_prefix("file:") {
         Some(p) => SizeSpec::Radii(read_radii(Path::new(p))?),
         None => SizeSpec::parse(&a.dist).map_err(|e| anyhow::anyhow!("--dist: {e}"))?,

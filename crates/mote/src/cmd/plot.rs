@@ -11,6 +11,7 @@ use mote_render::plot::{axis_label, Plot, Series};
 /// Plots columns of a CSV written by mote (or any CSV of numbers with a header row).
 #[derive(clap::Args, Debug)]
 #[command(
+    allow_negative_numbers = true,
     after_help = "Examples:\n  mote plot energy.csv --x time --y total_energy -o energy.png\n  mote plot energy.csv --x time --y kinetic_energy --y potential_energy --logy -o e.svg"
 )]
 pub struct PlotArgs {

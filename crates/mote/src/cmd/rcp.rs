@@ -25,6 +25,8 @@ const ERROR_EXIT: u8 = 255;
 
 /// Rod counts from which a progress bar is shown.
 const PROGRESS_FROM: usize = 10_000_000;
+/// N rods on the periodic line leave N gaps, 8 bytes each, in the packer.
+const BYTES_PER_ROD: f64 = 8.0;
 
 pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode> {
     match args.first().map(String::as_str) {
@@ -414,6 +416,12 @@ fn classic<R: BufRead, W: Write>(
     if verbose {
         writeln!(out, "Constructing and packing the rods:")?;
     }
+    if let Err(m) = mote_io::system::check_fits(
+        &format!("-N {n}: the rod packing"),
+        n as f64 * BYTES_PER_ROD,
+    ) {
+        return err(format!("Error: {m}."));
+    }
     let estimator = RodPacking::default().rods(n).gap_fraction(f).erfc(flavour);
     let bar = if n >= PROGRESS_FROM && !global.quiet {
         let bar = ProgressBar::with_draw_target(Some(n as u64), ProgressDrawTarget::stderr());
@@ -632,6 +640,11 @@ impl DesignInput {
         if self.rods < 2 {
             bail!("-N {}: the rod packing needs at least 2 rods", self.rods);
         }
+        mote_io::system::check_fits(
+            &format!("-N {}: the rod packing", self.rods),
+            self.rods as f64 * BYTES_PER_ROD,
+        )
+        .map_err(anyhow::Error::msg)?;
         Ok(RodPacking::default()
             .rods(self.rods)
             .gap_fraction(f64::from(self.f) * 1e-4)

@@ -14,6 +14,7 @@ use mote_render::{Camera, ColorMap, RenderOptions, Renderer};
 /// Ray-traced pictures of a trajectory (extended XYZ, LAMMPS dump, VTU or PVD).
 #[derive(clap::Args, Debug)]
 #[command(
+    allow_negative_numbers = true,
     after_help = "Examples:\n  mote render traj.xyz -o last.png\n  mote render traj.xyz --all -o movie/frame.png --color-by speed --shadows\n  mote render traj.xyz --frame 0 -o first.png --anaglyph --lattice 0.2\n  mote render traj.xyz -o scene.png --pov scene.pov   (POV-Ray twin of the picture)"
 )]
 pub struct RenderArgs {

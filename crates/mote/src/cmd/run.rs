@@ -9,6 +9,7 @@ use mote_front::{Ending, RunOptions};
 use crate::progress::Terminal;
 
 #[derive(clap::Args, Debug, Clone)]
+#[command(allow_negative_numbers = true)]
 pub struct RunArgs {
     /// Scene file (.toml), MPPphys particle file (.plist or any other name), or `example:NAME`.
     #[arg(required_unless_present = "resume")]

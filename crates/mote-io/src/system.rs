@@ -1,0 +1,64 @@
+//! What the machine offers, read from the kernel's plain-text files: the
+//! memory a request may use, so that engines refuse one too large before
+//! allocating (rather than abort on a failed allocation).
+
+/// Bytes of memory available to a new allocation (Linux `MemAvailable` in
+/// /proc/meminfo), or `None` where that cannot be read.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    parse_available(&text)
+}
+
+fn parse_available(meminfo: &str) -> Option<u64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// A byte count for people: "512 B", "3.4 MB", "11.2 TB" (powers of 1000).
+pub fn human_bytes(bytes: f64) -> String {
+    let units = ["B", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut x = bytes;
+    let mut k = 0;
+    while x >= 1000.0 && k + 1 < units.len() {
+        x /= 1000.0;
+        k += 1;
+    }
+    if k == 0 {
+        format!("{x:.0} B")
+    } else {
+        format!("{x:.1} {}", units[k])
+    }
+}
+
+/// `Err(message)` when `bytes` (a lower bound of what `what` needs) exceeds
+/// the available memory; the message gives both numbers.
+pub fn check_fits(what: &str, bytes: f64) -> Result<(), String> {
+    match available_memory() {
+        Some(free) if bytes > free as f64 => Err(format!(
+            "{what} needs at least {}, and this machine has {} available",
+            human_bytes(bytes),
+            human_bytes(free as f64)
+        )),
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_available_memory_and_prints_bytes() {
+        let info = "MemTotal:       24000000 kB\nMemFree:  100 kB\nMemAvailable:   23000000 kB\n";
+        assert_eq!(parse_available(info), Some(23_000_000 * 1024));
+        assert_eq!(parse_available("MemTotal: 5 kB\n"), None);
+        assert_eq!(human_bytes(512.0), "512 B");
+        assert_eq!(human_bytes(3.4e6), "3.4 MB");
+        assert_eq!(human_bytes(1.12e13), "11.2 TB");
+        assert!(check_fits("a request", 1e30)
+            .unwrap_err()
+            .contains("needs at least"));
+        assert!(check_fits("a request", 1.0).is_ok());
+    }
+}
