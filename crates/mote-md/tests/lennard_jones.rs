@@ -217,11 +217,15 @@ fn jittered(n: usize, l: DVec3, rng: &mut Xoshiro256PlusPlus) -> Vec<DVec3> {
     pos
 }
 
-fn lj_through_list(lj: &mut mote_md::force::LennardJones, pos: &[DVec3]) -> (Vec<DVec3>, f64, f64) {
+fn lj_through_list(
+    lj: &mut mote_md::force::LennardJones,
+    pos: &[DVec3],
+    b: &Boundary,
+) -> (Vec<DVec3>, f64, f64) {
     use mote_md::{Interaction, State};
     let zero = vec![DVec3::ZERO; pos.len()];
     let mass = vec![1.0; pos.len()];
-    let state = State::new(pos, &zero, &mass, 0.0);
+    let state = State::new(pos, &zero, &mass, 0.0).in_box(b);
     let mut force = vec![DVec3::ZERO; pos.len()];
     lj.add_forces(&state, &mut force);
     let virial = lj.virial();
@@ -249,8 +253,8 @@ fn lj_forces_match_brute_force_over_images() {
         };
         let pos: Vec<DVec3> = jittered(n, l, &mut rng).iter().map(|p| *p + b.lo).collect();
         for shifted in [true, false] {
-            let mut lj = mote_md::force::LennardJones::new(1.0, 1.0, 2.5, shifted, 0.3, b);
-            let (f, u, w) = lj_through_list(&mut lj, &pos);
+            let mut lj = mote_md::force::LennardJones::new(1.0, 1.0, 2.5, shifted, 0.3);
+            let (f, u, w) = lj_through_list(&mut lj, &pos, &b);
             let (fb, ub, wb) = lj_brute(&pos, &b, &lj);
             let scale = fb.iter().fold(0.0f64, |a, f| a.max(f.length()));
             for i in 0..pos.len() {
@@ -292,9 +296,9 @@ fn lj_rows_agree_across_kernels_and_threads() {
             .build()
             .unwrap();
         pool.install(|| {
-            let mut lj = mote_md::force::LennardJones::new(1.0, 1.0, 2.5, true, 0.3, b);
+            let mut lj = mote_md::force::LennardJones::new(1.0, 1.0, 2.5, true, 0.3);
             lj.set_simd(simd);
-            lj_through_list(&mut lj, &pos)
+            lj_through_list(&mut lj, &pos, &b)
         })
     };
     let (f1, u1, w1) = run(true, 1);

@@ -35,8 +35,7 @@ tau = 0.1
     let mut sim = build(&text).simulation;
     let n = sim.system.particles.len() as f64;
     let rho = n / sim.system.boundary.volume();
-    let (u_tail, p_tail) =
-        LennardJones::new(1.0, 1.0, 2.5, false, 0.3, sim.system.boundary).tail_corrections(rho);
+    let (u_tail, p_tail) = LennardJones::new(1.0, 1.0, 2.5, false, 0.3).tail_corrections(rho);
     let run = |sim: &mut mote_md::Simulation, steps: u64| {
         for _ in 0..steps {
             sim.stepper.step(&mut sim.system, &mut sim.forces, sim.dt);

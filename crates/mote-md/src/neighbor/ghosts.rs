@@ -59,6 +59,9 @@ pub struct GhostList {
     since_build: u64,
     /// Number of builds so far.
     pub builds: u64,
+    /// A restored build (updates since it, wrapped positions), made at the
+    /// next update, when the box is at hand.
+    pending: Option<(u64, Vec<DVec3>)>,
 }
 
 impl GhostList {
@@ -100,6 +103,7 @@ impl GhostList {
     /// Counts one step: rebuilds the list if it is due or stale, else moves
     /// the copies to `pos`. Returns whether it rebuilt.
     pub fn update(&mut self, pos: &[DVec3], boundary: &Boundary) -> bool {
+        self.build_restored(boundary);
         self.since_build += 1;
         let due = self.every > 0 && self.since_build >= self.every;
         self.follow(pos, boundary, due)
@@ -108,7 +112,16 @@ impl GhostList {
     /// Moves the copies to `pos` (rebuilding if a particle has gone too far)
     /// without counting a step: for energies between steps.
     pub fn refresh(&mut self, pos: &[DVec3], boundary: &Boundary) -> bool {
+        self.build_restored(boundary);
         self.follow(pos, boundary, false)
+    }
+
+    /// Makes the build a checkpoint described ([`GhostList::restore`]).
+    fn build_restored(&mut self, boundary: &Boundary) {
+        if let Some((since, reference)) = self.pending.take() {
+            self.build(&reference, boundary);
+            self.since_build = since;
+        }
     }
 
     fn follow(&mut self, pos: &[DVec3], boundary: &Boundary, due: bool) -> bool {
@@ -161,19 +174,19 @@ impl GhostList {
         out
     }
 
-    /// Rebuilds the list [`GhostList::carried_state`] describes. Wrapping is
+    /// Takes the list [`GhostList::carried_state`] describes; it is built
+    /// at the next update or refresh, in the box given there. Wrapping is
     /// idempotent, so the build at the stored positions is the one the
     /// uninterrupted run made, row order and all.
-    pub fn restore(&mut self, state: &[f64], boundary: &Boundary) -> Result<(), String> {
+    pub fn restore(&mut self, state: &[f64]) -> Result<(), String> {
         let Some((&since, xyz)) = state.split_first() else {
             return Ok(());
         };
-        if xyz.len() % 3 != 0 || !(since >= 0.0 && since.fract() == 0.0) {
+        if !(xyz.len().is_multiple_of(3) && since >= 0.0 && since.fract() == 0.0) {
             return Err("neighbour list: a step count and x y z triples expected".into());
         }
         let reference: Vec<DVec3> = xyz.chunks(3).map(DVec3::from_slice).collect();
-        self.build(&reference, boundary);
-        self.since_build = since as u64;
+        self.pending = Some((since as u64, reference));
         Ok(())
     }
 

@@ -47,10 +47,10 @@ impl Section for LennardJonesSettings {
         }
         let skin = v.skin.unwrap_or(0.3 * v.sigma);
         let mut pair = if v.wca {
-            LennardJones::wca(v.epsilon, v.sigma, skin, boundary)
+            LennardJones::wca(v.epsilon, v.sigma, skin)
         } else {
             let rc = v.cutoff.unwrap_or(2.5 * v.sigma);
-            LennardJones::new(v.epsilon, v.sigma, rc, v.shifted, skin, boundary)
+            LennardJones::new(v.epsilon, v.sigma, rc, v.shifted, skin)
         };
         if pair.cutoff <= 0.0 || skin < 0.0 {
             return Err(err(

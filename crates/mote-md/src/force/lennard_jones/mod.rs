@@ -18,7 +18,6 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::{Interaction, State};
-use crate::boundary::Boundary;
 use crate::neighbor::{Copy4, GhostList};
 
 #[cfg(target_arch = "x86_64")]
@@ -35,7 +34,6 @@ pub struct LennardJones {
     pub cutoff: f64,
     /// Subtract U(r_c) so the energy is continuous at the cut-off.
     pub shifted: bool,
-    pub boundary: Boundary,
     pub list: GhostList,
     virial: f64,
     /// Force on the particle of each row (see [`GhostList`]).
@@ -65,20 +63,14 @@ pub(crate) struct RowSum {
 }
 
 impl LennardJones {
-    pub fn new(
-        epsilon: f64,
-        sigma: f64,
-        cutoff: f64,
-        shifted: bool,
-        skin: f64,
-        boundary: Boundary,
-    ) -> Self {
+    /// LJ cut at `cutoff` (shifted or not) through a list with `skin`; the
+    /// box comes with each step's [`State`].
+    pub fn new(epsilon: f64, sigma: f64, cutoff: f64, shifted: bool, skin: f64) -> Self {
         Self {
             epsilon,
             sigma,
             cutoff,
             shifted,
-            boundary,
             list: GhostList::new(cutoff, skin),
             virial: 0.0,
             sorted_force: Vec::new(),
@@ -87,15 +79,8 @@ impl LennardJones {
     }
 
     /// WCA: shifted LJ cut at 2^{1/6} σ.
-    pub fn wca(epsilon: f64, sigma: f64, skin: f64, boundary: Boundary) -> Self {
-        Self::new(
-            epsilon,
-            sigma,
-            2f64.powf(1.0 / 6.0) * sigma,
-            true,
-            skin,
-            boundary,
-        )
+    pub fn wca(epsilon: f64, sigma: f64, skin: f64) -> Self {
+        Self::new(epsilon, sigma, 2f64.powf(1.0 / 6.0) * sigma, true, skin)
     }
 
     /// Uses the AVX-512 rows where the CPU has them (the default) or the
@@ -249,7 +234,7 @@ impl Interaction for LennardJones {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let pos = state.position;
-        self.list.update(pos, &self.boundary);
+        self.list.update(pos, state.boundary);
         let mut sorted = std::mem::take(&mut self.sorted_force);
         sorted.resize(pos.len(), DVec3::ZERO);
         self.virial = self.rows(Some(&mut sorted), false).0;
@@ -263,7 +248,7 @@ impl Interaction for LennardJones {
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
-        self.list.refresh(state.position, &self.boundary);
+        self.list.refresh(state.position, state.boundary);
         // The virial comes with the energy, so a pressure measured before
         // the first step (no force evaluation yet) is right too.
         let (virial, energy) = self.rows(None, true);
@@ -283,6 +268,6 @@ impl Interaction for LennardJones {
     }
 
     fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.list.restore(state, &self.boundary)
+        self.list.restore(state)
     }
 }
