@@ -42,4 +42,8 @@ pub enum EdmdError {
     /// Output failed.
     #[error(transparent)]
     Io(#[from] mote_io::IoError),
+    /// A signal asked the run to stop; it stopped between events with its
+    /// files flushed.
+    #[error("the run was interrupted by signal {signal} at t = {time}")]
+    Interrupted { signal: i32, time: f64 },
 }

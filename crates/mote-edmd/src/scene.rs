@@ -844,6 +844,12 @@ pub fn run_scene<const D: usize>(
         }
         events += sys.run_until(scene.equilibrate * k as f64 / chunks as f64);
         progress(sys.time() / total.max(1e-300));
+        if let Some(signal) = mote_io::system::stop_requested() {
+            return Err(EdmdError::Interrupted {
+                signal,
+                time: sys.time(),
+            });
+        }
     }
     sys.reset_counters();
     let t0 = sys.time();
@@ -898,6 +904,13 @@ pub fn run_scene<const D: usize>(
         progress((sys.time()) / total.max(1e-300));
         if target >= t0 + scene.time {
             break;
+        }
+        if let Some(signal) = mote_io::system::stop_requested() {
+            // The writers flush as they drop.
+            return Err(EdmdError::Interrupted {
+                signal,
+                time: sys.time(),
+            });
         }
         k += 1;
     }

@@ -116,7 +116,27 @@ pub fn run_with(
         2 => run_scene::<2>(&scene, seed, &out, progress),
         _ => run_scene::<3>(&scene, seed, &out, progress),
     };
-    let r = r.map_err(|e| FrontError::request(format!("{}: run stopped: {e}", input.label)))?;
+    let r = match r {
+        Ok(r) => r,
+        Err(e @ mote_edmd::EdmdError::Interrupted { signal, .. }) => {
+            return Ok(Outcome {
+                engine: Engine::EventDriven,
+                seed,
+                dir,
+                summary: Vec::new(),
+                ending: Ending::Interrupted {
+                    signal,
+                    message: e.to_string(),
+                },
+            })
+        }
+        Err(e) => {
+            return Err(FrontError::request(format!(
+                "{}: run stopped: {e}",
+                input.label
+            )))
+        }
+    };
     let cpu = crate::cpu::cpu_seconds() - cpu0;
     let mut outcome = Outcome {
         engine: Engine::EventDriven,

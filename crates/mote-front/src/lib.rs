@@ -121,6 +121,9 @@ pub enum Ending {
     /// It went unstable (a non-finite number); the message names the step
     /// and the particle, and the files written so far are kept.
     Unstable(String),
+    /// A signal (SIGINT, SIGTERM) stopped it cleanly: files flushed, a
+    /// final checkpoint written where checkpoints are on.
+    Interrupted { signal: i32, message: String },
 }
 
 /// What a run did: the summary lines to print, where the files went, how

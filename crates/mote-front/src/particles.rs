@@ -69,6 +69,10 @@ impl Observer for CheckpointWriter {
     fn files(&self) -> Vec<String> {
         vec![self.path.display().to_string()]
     }
+
+    fn at_interruption(&self) -> bool {
+        true
+    }
 }
 
 /// Puts the checkpoint's state into the freshly built simulation.
@@ -304,6 +308,12 @@ pub(crate) fn run(
             }
         }
         Err(e @ MdError::Unstable { .. }) => outcome.ending = Ending::Unstable(e.to_string()),
+        Err(e @ MdError::Interrupted { signal, .. }) => {
+            outcome.ending = Ending::Interrupted {
+                signal,
+                message: e.to_string(),
+            }
+        }
         Err(e) => return Err(e.into()),
     }
     Ok(outcome)

@@ -110,6 +110,13 @@ fn run_with(
             outcome.ending = Ending::Unstable(e.to_string());
             return Ok(outcome);
         }
+        Err(e @ MdError::Interrupted { signal, .. }) => {
+            outcome.ending = Ending::Interrupted {
+                signal,
+                message: e.to_string(),
+            };
+            return Ok(outcome);
+        }
         Err(e) => return Err(e.into()),
     };
     outcome.summary.push(format!(

@@ -1,6 +1,10 @@
 //! What the machine offers, read from the kernel's plain-text files: the
 //! memory a request may use, so that engines refuse one too large before
-//! allocating (rather than abort on a failed allocation).
+//! allocating (rather than abort on a failed allocation); and the request
+//! to stop that a signal makes.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
 
 /// Bytes of memory available to a new allocation (Linux `MemAvailable` in
 /// /proc/meminfo), or `None` where that cannot be read.
@@ -42,6 +46,29 @@ pub fn check_fits(what: &str, bytes: f64) -> Result<(), String> {
         )),
         _ => Ok(()),
     }
+}
+
+/// A request to stop the run in progress, by signal number (SIGINT 2,
+/// SIGTERM 15; 0: none). Signal handlers set it (async-signal-safe: one
+/// atomic store); every engine's loop reads it once a step and then ends
+/// the run cleanly: files flushed, a final checkpoint where checkpoints are
+/// on.
+pub fn stop_flag() -> &'static Arc<AtomicUsize> {
+    static FLAG: OnceLock<Arc<AtomicUsize>> = OnceLock::new();
+    FLAG.get_or_init(|| Arc::new(AtomicUsize::new(0)))
+}
+
+/// The signal that asked the run to stop, if one did.
+pub fn stop_requested() -> Option<i32> {
+    match stop_flag().load(Ordering::Relaxed) {
+        0 => None,
+        s => Some(s as i32),
+    }
+}
+
+/// Asks the run in progress to stop as if signal `signal` had come.
+pub fn request_stop(signal: i32) {
+    stop_flag().store(signal as usize, Ordering::Relaxed);
 }
 
 #[cfg(test)]

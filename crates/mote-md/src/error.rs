@@ -16,4 +16,9 @@ pub enum MdError {
         particle: usize,
         what: String,
     },
+    /// A signal asked the run to stop; it stopped after a whole step, with
+    /// its files flushed and, where checkpoints are on, a checkpoint of
+    /// that step written.
+    #[error("the run was interrupted by signal {signal} after step {step} (t = {time})")]
+    Interrupted { signal: i32, step: u64, time: f64 },
 }

@@ -54,6 +54,12 @@ pub trait Observer {
     fn observe_forces(&mut self, forces: &ForceField) {
         let _ = forces;
     }
+    /// Whether to sample the step at which a signal stops the run (true
+    /// for checkpoints; false for tables and trajectories, whose files a
+    /// resumed run then continues as if never interrupted).
+    fn at_interruption(&self) -> bool {
+        false
+    }
 }
 
 /// What a run did.
@@ -151,6 +157,21 @@ impl Simulation {
                 self.sample(last_step, &last)?;
             }
             progress(&self.system);
+            if let Some(signal) = mote_io::system::stop_requested() {
+                if !last_step {
+                    for o in &mut self.observers {
+                        if o.at_interruption() && !step.is_multiple_of(o.every().max(1)) {
+                            o.observe_forces(&self.forces);
+                            o.observe(&self.system, &last)?;
+                        }
+                    }
+                    return Err(MdError::Interrupted {
+                        signal,
+                        step,
+                        time: self.system.time,
+                    });
+                }
+            }
         }
         Ok(RunReport {
             steps: self.system.step - first_step,

@@ -53,8 +53,34 @@ enum Command {
     Edmd(cmd::edmd::EdmdArgs),
 }
 
+/// SIGINT and SIGTERM during `mote run` (and its alias `mote edmd`): the
+/// first asks the run to stop after its current step (files flushed, a
+/// last checkpoint where checkpoints are on; exit 128 + the signal's
+/// number); a second one ends the program at once. Other subcommands keep
+/// the default: a signal ends them at once.
+fn stop_cleanly_on_signals() {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    use signal_hook::flag;
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+    let asked = Arc::new(AtomicBool::new(false));
+    for signal in [SIGINT, SIGTERM] {
+        // Registration fails only for forbidden signals; these two are not.
+        let _ = flag::register_conditional_shutdown(signal, 128 + signal, Arc::clone(&asked));
+        let _ = flag::register_usize(
+            signal,
+            Arc::clone(mote_io::system::stop_flag()),
+            signal as usize,
+        );
+        let _ = flag::register(signal, Arc::clone(&asked));
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if matches!(cli.command, Command::Run(_) | Command::Edmd(_)) {
+        stop_cleanly_on_signals();
+    }
     let result = match cli.command {
         Command::Run(args) => cmd::run::run(&cli.global, args),
         Command::Examples(args) => cmd::examples::run(&cli.global, args),

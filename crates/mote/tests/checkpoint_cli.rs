@@ -402,3 +402,157 @@ fn killed_rigid_run_resumes_bit_for_bit() {
         );
     }
 }
+
+/// Sends `signal` (by name, e.g. "INT") to a run once its checkpoint has
+/// reached `from_step`; returns the run's exit code.
+fn signal_when_checkpointed(
+    child: &mut std::process::Child,
+    checkpoint: &Path,
+    from_step: u64,
+    signal: &str,
+) -> Option<i32> {
+    let start = Instant::now();
+    loop {
+        if mote_io::checkpoint::read(checkpoint).is_ok_and(|cp| cp.step >= from_step) {
+            break;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no checkpoint appeared"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let pid = child.id().to_string();
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &pid])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    child.wait().unwrap().code()
+}
+
+/// Ctrl-C (SIGINT) ends a point-particle run after its current step with
+/// exit status 130 and a checkpoint of that step; resumed, the run ends in
+/// the bits of an uninterrupted one, and the observables are those of an
+/// uninterrupted run, byte for byte (no row at the interrupted step).
+#[test]
+fn sigint_stops_cleanly_with_a_last_checkpoint_and_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("lj.toml"), SCENE).unwrap();
+    let args = |out: &'static str| {
+        vec![
+            "run",
+            "lj.toml",
+            "--threads",
+            "1",
+            "-q",
+            "-o",
+            out,
+            "--checkpoint-every",
+            "200",
+        ]
+    };
+    let o = mote(&args("whole"), dir.path());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let whole = state(&dir.path().join("whole/checkpoint.mote"));
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(args("cut"))
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let cp_path = dir.path().join("cut/checkpoint.mote");
+    let code = signal_when_checkpointed(&mut child, &cp_path, 400, "INT");
+    let at_stop = state(&cp_path).0;
+    assert!(at_stop < 3000, "finished before the signal");
+    assert_eq!(code, Some(130), "exit status after SIGINT");
+
+    let o = mote(
+        &[
+            "run",
+            "--resume",
+            "cut/checkpoint.mote",
+            "--threads",
+            "1",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let resumed = state(&cp_path);
+    assert_eq!(resumed, whole, "stopped at step {at_stop}");
+    let a = std::fs::read(dir.path().join("whole/observables.csv")).unwrap();
+    let b = std::fs::read(dir.path().join("cut/observables.csv")).unwrap();
+    assert!(a == b, "observables differ (stopped at step {at_stop})");
+}
+
+/// SIGTERM ends a rigid run with exit status 143 and a checkpoint; SIGTERM
+/// ends an event-driven run with 143 and its files flushed and readable.
+#[test]
+fn sigterm_stops_rigid_and_event_driven_runs_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("r.toml"), RIGID).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args([
+            "run",
+            "r.toml",
+            "--threads",
+            "1",
+            "-q",
+            "-o",
+            "cut",
+            "--checkpoint-every",
+            "1000",
+        ])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let cp_path = dir.path().join("cut/checkpoint.mote");
+    let code = signal_when_checkpointed(&mut child, &cp_path, 1000, "TERM");
+    assert_eq!(code, Some(143), "exit status after SIGTERM");
+    let cp = mote_io::checkpoint::read(&cp_path).unwrap();
+    assert!(cp.step >= 1000 && cp.step < 20000, "step {}", cp.step);
+    let o = mote(
+        &[
+            "run",
+            "--resume",
+            "cut/checkpoint.mote",
+            "--threads",
+            "1",
+            "-q",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(mote_io::checkpoint::read(&cp_path).unwrap().step, 20000);
+
+    // Hard spheres: no checkpoints, files flushed.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(["run", "example:eos", "--until", "400", "-q", "-o", "hs"])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let csv = dir.path().join("hs/observables.csv");
+    let start = Instant::now();
+    while mote_io::csv::read_table(&csv).map_or(true, |t| t.rows.len() < 2) {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no rows appeared"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert_eq!(child.wait().unwrap().code(), Some(143));
+    let t = mote_io::csv::read_table(&csv).unwrap();
+    assert!(
+        t.rows.len() >= 2 && t.rows.len() < 380,
+        "{} rows",
+        t.rows.len()
+    );
+}

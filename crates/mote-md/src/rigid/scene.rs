@@ -1138,12 +1138,23 @@ pub fn run_rigid_scene(
                 frame(b, x)?;
             }
         }
-        if let Some(c) = &options.checkpoints {
-            if step % c.every.max(1) == 0 || step == built.steps {
-                c.write(b, f, step, built.steps, built.dt)?;
-            }
+        let scheduled = |c: &RigidCheckpoints| step % c.every.max(1) == 0 || step == built.steps;
+        if let Some(c) = options.checkpoints.as_ref().filter(|c| scheduled(c)) {
+            c.write(b, f, step, built.steps, built.dt)?;
         }
         progress(step, built.steps, b.time);
+        if let Some(signal) = mote_io::system::stop_requested() {
+            if step < built.steps {
+                if let Some(c) = options.checkpoints.as_ref().filter(|c| !scheduled(c)) {
+                    c.write(b, f, step, built.steps, built.dt)?;
+                }
+                return Err(MdError::Interrupted {
+                    signal,
+                    step,
+                    time: b.time,
+                });
+            }
+        }
     }
     let wall_seconds = start.elapsed().as_secs_f64();
     let e = f.energies(b);

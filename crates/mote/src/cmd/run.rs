@@ -71,7 +71,8 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
 }
 
 /// Prints a run's summary (unless quiet) and gives its exit status: 3 for
-/// a run that went unstable, whose files are kept.
+/// a run that went unstable, whose files are kept; 128 + the signal's
+/// number (130 for SIGINT, 143 for SIGTERM) for a run a signal stopped.
 pub fn report(outcome: &mote_front::Outcome, quiet: bool) -> ExitCode {
     match &outcome.ending {
         Ending::Finished => {
@@ -89,6 +90,19 @@ pub fn report(outcome: &mote_front::Outcome, quiet: bool) -> ExitCode {
                 outcome.dir.display()
             );
             ExitCode::from(3)
+        }
+        Ending::Interrupted { signal, message } => {
+            eprintln!("{message}");
+            eprintln!(
+                "the files are flushed in {}{}",
+                outcome.dir.display(),
+                if outcome.dir.join("checkpoint.mote").exists() {
+                    "; continue with `mote run --resume` on its checkpoint.mote"
+                } else {
+                    ""
+                }
+            );
+            ExitCode::from((128 + signal).clamp(0, 255) as u8)
         }
     }
 }
