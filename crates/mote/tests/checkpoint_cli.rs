@@ -40,6 +40,18 @@ fn mote(args: &[&str], dir: &Path) -> std::process::Output {
         .unwrap()
 }
 
+/// Waits (up to two minutes) until a running job's checkpoint has reached `step`.
+fn wait_for_checkpoint(path: &Path, step: u64) {
+    let start = Instant::now();
+    while !mote_io::checkpoint::read(path).is_ok_and(|cp| cp.step >= step) {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no checkpoint of step {step} appeared"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
 fn state(path: &Path) -> (u64, Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let cp = mote_io::checkpoint::read(path).unwrap();
     (cp.step, cp.positions, cp.velocities)
@@ -84,19 +96,7 @@ fn killed_run_resumes_bit_for_bit() {
         .spawn()
         .unwrap();
     let cp_path = dir.path().join("cut/checkpoint.mote");
-    let start = Instant::now();
-    loop {
-        if let Ok(cp) = mote_io::checkpoint::read(&cp_path) {
-            if cp.step >= 400 {
-                break;
-            }
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no checkpoint appeared"
-        );
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    wait_for_checkpoint(&cp_path, 400);
     child.kill().unwrap(); // SIGKILL
     child.wait().unwrap();
     let at_kill = state(&cp_path).0;
@@ -205,20 +205,7 @@ fn killed_granular_run_resumes_bit_for_bit() {
         .spawn()
         .unwrap();
     let cp_path = dir.path().join("cut/checkpoint.mote");
-    let start = Instant::now();
-    loop {
-        if let Ok(cp) = mote_io::checkpoint::read(&cp_path) {
-            // Past the impact on the floor, so histories are carried.
-            if cp.step >= 1500 {
-                break;
-            }
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no checkpoint appeared"
-        );
-        std::thread::sleep(Duration::from_millis(2));
-    }
+    wait_for_checkpoint(&cp_path, 1500);
     child.kill().unwrap();
     child.wait().unwrap();
     let at_kill = mote_io::checkpoint::read(&cp_path).unwrap();
@@ -347,20 +334,7 @@ fn killed_rigid_run_resumes_bit_for_bit() {
         .spawn()
         .unwrap();
     let cp_path = dir.path().join("cut/checkpoint.mote");
-    let start = Instant::now();
-    loop {
-        if let Ok(cp) = mote_io::checkpoint::read(&cp_path) {
-            // The pile has formed by then, so histories are carried.
-            if cp.step >= 6000 {
-                break;
-            }
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no checkpoint appeared"
-        );
-        std::thread::sleep(Duration::from_millis(2));
-    }
+    wait_for_checkpoint(&cp_path, 6000);
     child.kill().unwrap(); // SIGKILL
     child.wait().unwrap();
     let at_kill = mote_io::checkpoint::read(&cp_path).unwrap();
@@ -411,17 +385,7 @@ fn signal_when_checkpointed(
     from_step: u64,
     signal: &str,
 ) -> Option<i32> {
-    let start = Instant::now();
-    loop {
-        if mote_io::checkpoint::read(checkpoint).is_ok_and(|cp| cp.step >= from_step) {
-            break;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no checkpoint appeared"
-        );
-        std::thread::sleep(Duration::from_millis(2));
-    }
+    wait_for_checkpoint(checkpoint, from_step);
     let pid = child.id().to_string();
     let sent = Command::new("kill")
         .args([&format!("-{signal}"), &pid])

@@ -28,16 +28,6 @@ pub struct DirectCoulomb {
     field: Vec<DVec3>,
 }
 
-/// The charges of a state, which must give one per particle.
-fn charges<'a>(state: &State<'a>) -> &'a [f64] {
-    assert_eq!(
-        state.charge.len(),
-        state.position.len(),
-        "charges must come with the state, one per particle"
-    );
-    state.charge
-}
-
 impl DirectCoulomb {
     pub fn new(k: f64, softening: f64) -> Self {
         Self {
@@ -60,7 +50,7 @@ impl Interaction for DirectCoulomb {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         // The kernel gives Σ_j q_j (r_j − r_i)/r³: like charges repel.
-        let charge = charges(state);
+        let charge = state.charges();
         self.field.clear();
         self.field.resize(state.position.len(), DVec3::ZERO);
         self.kernel
@@ -74,7 +64,7 @@ impl Interaction for DirectCoulomb {
         0.5 * self.k
             * self
                 .kernel
-                .pair_potential_sum(state.position, charges(state))
+                .pair_potential_sum(state.position, state.charges())
     }
 }
 
@@ -107,7 +97,7 @@ impl Interaction for ElectricField {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let e = self.at(state.time);
-        for (f, q) in force.iter_mut().zip(charges(state)) {
+        for (f, q) in force.iter_mut().zip(state.charges()) {
             *f += e * *q;
         }
     }
@@ -122,7 +112,7 @@ impl Interaction for ElectricField {
         -state
             .position
             .iter()
-            .zip(charges(state))
+            .zip(state.charges())
             .map(|(r, q)| q * e.dot(*r))
             .sum::<f64>()
     }

@@ -440,16 +440,6 @@ impl EwaldCoulomb {
     }
 }
 
-/// The charges of a state, which must give one per particle.
-fn charges<'a>(state: &State<'a>) -> &'a [f64] {
-    assert_eq!(
-        state.charge.len(),
-        state.position.len(),
-        "charges must come with the state, one per particle"
-    );
-    state.charge
-}
-
 impl Interaction for EwaldCoulomb {
     fn name(&self) -> &'static str {
         "coulomb"
@@ -458,14 +448,14 @@ impl Interaction for EwaldCoulomb {
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let mut f = vec![DVec3::ZERO; force.len()];
         self.ewald
-            .charges(state.position, charges(state), Some(&mut f));
+            .charges(state.position, state.charges(), Some(&mut f));
         for (a, b) in force.iter_mut().zip(&f) {
             *a += *b * self.k;
         }
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
-        self.k * self.ewald.charges(state.position, charges(state), None)
+        self.k * self.ewald.charges(state.position, state.charges(), None)
     }
 }
 

@@ -81,6 +81,17 @@ impl<'a> State<'a> {
         }
     }
 
+    /// The charges, one per particle (an interaction that needs them
+    /// panics with this message when the caller gave none).
+    pub fn charges(&self) -> &'a [f64] {
+        assert_eq!(
+            self.charge.len(),
+            self.position.len(),
+            "charges must come with the state, one per particle"
+        );
+        self.charge
+    }
+
     /// The same state with these charges.
     pub fn with_charges(self, charge: &'a [f64]) -> Self {
         Self { charge, ..self }
@@ -157,6 +168,29 @@ pub trait Interaction: Send {
     fn virial(&self) -> f64 {
         0.0
     }
+}
+
+/// (force, torque) buffers of the parallel blocks of a half-list pair loop.
+pub(crate) type BlockBuffers = Vec<(Vec<DVec3>, Vec<DVec3>)>;
+
+/// Adds the blocks' buffers to `force` and `torque`, buffer after buffer in
+/// block order for every particle, so every thread count gives the same bits.
+pub(crate) fn add_block_buffers(force: &mut [DVec3], torque: &mut [DVec3], buffers: &BlockBuffers) {
+    use rayon::prelude::*;
+    if buffers.is_empty() {
+        return;
+    }
+    force
+        .par_iter_mut()
+        .zip(torque.par_iter_mut())
+        .enumerate()
+        .with_min_len(1024)
+        .for_each(|(i, (f, t))| {
+            for (bf, bt) in buffers {
+                *f += bf[i];
+                *t += bt[i];
+            }
+        });
 }
 
 /// All interactions of a run.

@@ -107,8 +107,10 @@ pub struct RigidScene {
     pub title: Option<String>,
     pub rigid: Spanned<RigidSettings>,
     pub run: Spanned<RunSettings>,
+    /// The `[output]` of every time-stepped engine (`inspect`, which names
+    /// point particles, is refused).
     #[serde(default)]
-    pub output: OutputSettings,
+    pub output: crate::scene::OutputSettings,
 }
 
 #[derive(Debug, Deserialize)]
@@ -305,38 +307,6 @@ pub struct RunSettings {
     pub until: Option<f64>,
 }
 
-/// `[output]`: the keys and defaults of every time-stepped engine.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputSettings {
-    /// Folder of the output files (default `out/<scene name>`).
-    pub dir: Option<String>,
-    /// Steps between rows of observables.csv (default 10).
-    #[serde(default = "default_observables_every")]
-    pub observables_every: u64,
-    /// Steps between frames of trajectory.xyz (default 100); 0: none.
-    #[serde(default = "default_trajectory_every")]
-    pub trajectory_every: u64,
-}
-
-impl Default for OutputSettings {
-    fn default() -> Self {
-        Self {
-            dir: None,
-            observables_every: default_observables_every(),
-            trajectory_every: default_trajectory_every(),
-        }
-    }
-}
-
-fn default_observables_every() -> u64 {
-    10
-}
-
-fn default_trajectory_every() -> u64 {
-    100
-}
-
 /// The built scene: bodies, the integrator and what to run.
 pub struct BuiltRigid {
     pub bodies: RigidBodies,
@@ -394,6 +364,12 @@ impl RigidScene {
         let err = |span: std::ops::Range<usize>, msg: String| src.error(span, msg);
         let seed = seed.or(self.seed).unwrap_or(1);
         let rigid = self.rigid.get_ref();
+        if let Some(p) = self.output.inspect.first() {
+            return Err(err(
+                p.span(),
+                "[output] inspect names point particles; a rigid scene has bodies (their observables are in observables.csv)".into(),
+            ));
+        }
         let mut frbi = Frbi::new();
         if let Some(f) = &rigid.free_flight {
             frbi.flight = match f.get_ref().as_str() {

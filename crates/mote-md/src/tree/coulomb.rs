@@ -24,16 +24,6 @@ pub struct TreeCoulomb {
     bh: BarnesHut,
 }
 
-/// The charges of a state, which must give one per particle.
-fn charges<'a>(state: &State<'a>) -> &'a [f64] {
-    assert_eq!(
-        state.charge.len(),
-        state.position.len(),
-        "charges must come with the state, one per particle"
-    );
-    state.charge
-}
-
 impl TreeCoulomb {
     pub fn new(k: f64, softening: f64, theta: f64) -> Self {
         Self {
@@ -60,7 +50,7 @@ impl TreeCoulomb {
         let mut f = vec![DVec3::ZERO; n];
         self.forces(state, &mut f);
         let eps2 = self.softening * self.softening;
-        let (pos, q) = (state.position, charges(state));
+        let (pos, q) = (state.position, state.charges());
         let errors: Vec<f64> = (0..n)
             .into_par_iter()
             .step_by(stride.max(1))
@@ -79,7 +69,7 @@ impl Interaction for TreeCoulomb {
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
-        let charge = charges(state);
+        let charge = state.charges();
         self.bh.eps2 = self.softening * self.softening;
         self.bh.build(state.position, charge);
         self.bh.evaluate(false);
@@ -92,7 +82,7 @@ impl Interaction for TreeCoulomb {
     /// U = (k/2) Σ_i q_i ψ_i from the tree walk.
     fn potential_energy(&mut self, state: &State) -> f64 {
         self.bh.eps2 = self.softening * self.softening;
-        self.bh.build(state.position, charges(state));
+        self.bh.build(state.position, state.charges());
         self.bh.evaluate(true);
         let psi = self.bh.potential();
         let q = self.bh.strength();

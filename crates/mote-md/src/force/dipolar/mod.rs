@@ -61,7 +61,7 @@ use rayon::prelude::*;
 
 mod avx512;
 
-use super::{Interaction, Spin, State};
+use super::{add_block_buffers, BlockBuffers, Interaction, Spin, State};
 use crate::boundary::Boundary;
 use crate::neighbor::VerletList;
 use crate::units::UnitSystem;
@@ -230,7 +230,7 @@ pub struct DipoleDipole {
     dipoles: Vec<DVec3>,
     virial: f64,
     /// Per-block force and torque buffers (cut-off mode).
-    buffers: Vec<(Vec<DVec3>, Vec<DVec3>)>,
+    buffers: BlockBuffers,
     /// Structure-of-arrays copies for the all-pairs loop.
     soa: Soa,
 }
@@ -473,17 +473,7 @@ impl DipoleDipole {
                 w
             })
             .collect();
-        force
-            .par_iter_mut()
-            .zip(torque.par_iter_mut())
-            .enumerate()
-            .with_min_len(1024)
-            .for_each(|(i, (f, t))| {
-                for (fb, tb) in &buffers {
-                    *f += fb[i];
-                    *t += tb[i];
-                }
-            });
+        add_block_buffers(force, torque, &buffers);
         self.buffers = buffers;
         virials.iter().sum()
     }

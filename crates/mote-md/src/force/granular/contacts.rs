@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::history::PairHistories;
 use super::law::{ContactLaw, History};
 use crate::boundary::Boundary;
-use crate::force::{Interaction, Spin, State};
+use crate::force::{add_block_buffers, BlockBuffers, Interaction, Spin, State};
 use crate::neighbor::VerletList;
 
 /// Hertz–Mindlin contacts between all spheres (see [`super::law`]).
@@ -22,7 +22,7 @@ pub struct GranularContacts {
     pairs: PairHistories,
     last_time: Option<f64>,
     /// One (force, torque) buffer per extra block of particles.
-    buffers: Vec<(Vec<DVec3>, Vec<DVec3>)>,
+    buffers: BlockBuffers,
     contacts: usize,
     virial: f64,
 }
@@ -119,19 +119,7 @@ impl GranularContacts {
             })
             .collect();
 
-        if !buffers.is_empty() {
-            force
-                .par_iter_mut()
-                .zip(torque.par_iter_mut())
-                .enumerate()
-                .with_min_len(1024)
-                .for_each(|(i, (f, t))| {
-                    for (bf, bt) in &buffers {
-                        *f += bf[i];
-                        *t += bt[i];
-                    }
-                });
-        }
+        add_block_buffers(force, torque, &buffers);
         self.pairs.history = history;
         self.pairs.touching = touching;
         self.buffers = buffers;
