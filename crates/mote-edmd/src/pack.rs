@@ -220,6 +220,8 @@ pub enum Stop {
     Collisions,
     /// The wall-clock limit passed.
     WallClock,
+    /// A signal (SIGINT, SIGTERM) asked the run to stop.
+    Interrupted,
 }
 
 impl Stop {
@@ -229,6 +231,7 @@ impl Stop {
             Stop::TargetPhi => "target-phi",
             Stop::Collisions => "collisions",
             Stop::WallClock => "wall-clock",
+            Stop::Interrupted => "interrupted",
         }
     }
 }
@@ -536,6 +539,9 @@ impl<const D: usize> Packer<D> {
                         return Ok(Stop::WallClock);
                     }
                 }
+                if mote_io::system::stop_requested().is_some() {
+                    return Ok(Stop::Interrupted);
+                }
             }
             if z > self.settings.max_pressure {
                 return Ok(Stop::Pressure);
@@ -606,6 +612,9 @@ impl<const D: usize> Packer<D> {
                 if start.elapsed() >= limit {
                     break Stop::WallClock;
                 }
+            }
+            if mote_io::system::stop_requested().is_some() {
+                break Stop::Interrupted;
             }
         };
         self.sys.synchronize();

@@ -14,6 +14,8 @@ use crate::init::{
     ball_volume, fixed_speed_velocities, lattice, min_pair_distance, random_placement,
     thermal_velocities,
 };
+use mote_io::checkpoint::Checkpoint;
+
 use crate::system::{Boundary, SimBox, System};
 use crate::theory;
 use crate::vecd::to3;
@@ -766,6 +768,140 @@ pub struct Outputs {
     /// Folder the scene's own relative paths (`file = ...`) resolve against.
     pub scene_dir: PathBuf,
     pub provenance: mote_io::Provenance,
+    /// Write a checkpoint every this many output intervals, from this
+    /// template (input, seed, options); the state is added at each write.
+    pub checkpoints: Option<(u64, PathBuf, Checkpoint)>,
+    /// Continue this checkpoint's run, appending to the files.
+    pub resume: Option<Checkpoint>,
+}
+
+/// What a checkpoint of an event-driven run carries beside positions and
+/// velocities, as `carried` entries: radii (0), masses (1) and the run's
+/// bookkeeping (2): E₀, P₀ (3 components), the momentum scale, the largest
+/// energy drift so far, the events so far, the counters, and the time
+/// measuring began.
+mod carried {
+    pub const RADII: usize = 0;
+    pub const MASSES: usize = 1;
+    pub const RUN: usize = 2;
+}
+
+/// The bookkeeping of a run that a checkpoint carries.
+#[derive(Debug, Clone, Copy)]
+struct Ledger<const D: usize> {
+    e0: f64,
+    p0: [f64; D],
+    pscale: f64,
+    drift: f64,
+    events: u64,
+    /// Global time at which measuring began (the end of equilibration).
+    t0: f64,
+}
+
+/// The system rebuilt from its state now, at local time 0 with its
+/// counters shifted: every checkpoint rebuilds, so a run resumed from one
+/// continues in exactly the bits of the run that wrote it.
+fn rebuild<const D: usize>(sys: &System<D>) -> Result<System<D>, EdmdError> {
+    let mut fresh = System::new(
+        *sys.simbox(),
+        sys.positions(),
+        sys.velocities(),
+        sys.radii(),
+        sys.masses(),
+    )?;
+    let mut c = *sys.counters();
+    c.since -= sys.time();
+    fresh.set_counters(c);
+    Ok(fresh)
+}
+
+fn write_checkpoint<const D: usize>(
+    (path, template): (&Path, &Checkpoint),
+    sys: &System<D>,
+    time: f64,
+    k: u64,
+    ledger: Ledger<D>,
+) -> Result<(), EdmdError> {
+    let c = sys.counters();
+    let mut run = vec![ledger.e0];
+    run.extend(to3(&ledger.p0));
+    run.extend([
+        ledger.pscale,
+        ledger.drift,
+        ledger.events as f64,
+        c.collisions as f64,
+        c.wall_hits as f64,
+        c.rebuilds as f64,
+        c.invalid as f64,
+        c.virial,
+        c.wall_impulse_sum,
+        c.since,
+        ledger.t0,
+    ]);
+    let cp = Checkpoint {
+        time,
+        step: k,
+        positions: sys.positions().iter().map(to3).collect(),
+        velocities: sys.velocities().iter().map(to3).collect(),
+        carried: vec![
+            (carried::RADII, sys.radii()),
+            (carried::MASSES, sys.masses()),
+            (carried::RUN, run),
+        ],
+        ..template.clone()
+    };
+    Ok(mote_io::checkpoint::write(path, &cp)?)
+}
+
+/// The system, clock offset, output index and ledger a checkpoint holds.
+fn resumed<const D: usize>(
+    cp: &Checkpoint,
+    simbox: SimBox<D>,
+) -> Result<(System<D>, f64, u64, Ledger<D>), EdmdError> {
+    let bad = |what: &str| EdmdError::Invalid(format!("checkpoint: {what}"));
+    let get = |k: usize| {
+        cp.carried
+            .iter()
+            .find(|(i, _)| *i == k)
+            .map(|(_, v)| v.clone())
+            .ok_or_else(|| bad("radii, masses or the run's ledger missing"))
+    };
+    let (radii, masses, run) = (
+        get(carried::RADII)?,
+        get(carried::MASSES)?,
+        get(carried::RUN)?,
+    );
+    let n = cp.positions.len();
+    if radii.len() != n || masses.len() != n || cp.velocities.len() != n || run.len() != 15 {
+        return Err(bad("tables of different lengths"));
+    }
+    let cut = |v: &[f64; 3]| -> [f64; D] { std::array::from_fn(|d| v[d]) };
+    let mut sys = System::new(
+        simbox,
+        cp.positions.iter().map(cut).collect(),
+        cp.velocities.iter().map(cut).collect(),
+        radii,
+        masses,
+    )?;
+    let c = crate::system::Counters {
+        collisions: run[7] as u64,
+        wall_hits: run[8] as u64,
+        rebuilds: run[9] as u64,
+        invalid: run[10] as u64,
+        virial: run[11],
+        wall_impulse_sum: run[12],
+        since: run[13],
+    };
+    sys.set_counters(c);
+    let ledger = Ledger {
+        e0: run[0],
+        p0: std::array::from_fn(|d| run[1 + d]),
+        pscale: run[4],
+        drift: run[5],
+        events: run[6] as u64,
+        t0: run[14],
+    };
+    Ok((sys, cp.time, cp.step, ledger))
 }
 
 /// Runs a scene: builds the system, equilibrates, runs `time` with outputs
@@ -776,22 +912,42 @@ pub fn run_scene<const D: usize>(
     out: &Outputs,
     mut progress: impl FnMut(f64),
 ) -> Result<Run, EdmdError> {
-    let mut sys = scene.build::<D>(seed, &out.scene_dir)?;
+    let built = scene.build::<D>(seed, &out.scene_dir)?;
+    // A resumed run starts from its checkpoint's (rebuilt) system, clock
+    // offset, output index and ledger; a fresh one from the scene.
+    let (mut sys, mut t_offset, k_done, ledger) = match &out.resume {
+        Some(cp) => resumed(cp, *built.simbox())?,
+        None => {
+            let pscale: f64 = built
+                .velocities()
+                .iter()
+                .zip(built.masses())
+                .map(|(v, m)| m * crate::vecd::dot(v, v).sqrt())
+                .sum::<f64>()
+                .max(f64::MIN_POSITIVE);
+            let ledger = Ledger {
+                e0: built.kinetic_energy(),
+                p0: built.momentum(),
+                pscale,
+                drift: 0.0,
+                events: 0,
+                t0: 0.0,
+            };
+            (built, 0.0, 0, ledger)
+        }
+    };
+    let resuming = out.resume.is_some();
     let n = sys.len();
-    let e0 = sys.kinetic_energy();
-    let p0 = sys.momentum();
-    let pscale: f64 = sys
-        .velocities()
-        .iter()
-        .zip(sys.masses())
-        .map(|(v, m)| m * crate::vecd::dot(v, v).sqrt())
-        .sum::<f64>()
-        .max(f64::MIN_POSITIVE);
+    let (e0, p0, pscale) = (ledger.e0, ledger.p0, ledger.pscale);
     let interval = scene
         .output_interval
         .unwrap_or(scene.time / 100.0)
         .max(1e-300);
     let mut xyz = match &scene.trajectory {
+        Some(f) if resuming => Some(mote_io::xyz::XyzWriter::append(
+            &out.base.join(f),
+            out.provenance.clone(),
+        )?),
         Some(f) => Some(mote_io::xyz::XyzWriter::create(
             &out.base.join(f),
             out.provenance.clone(),
@@ -818,6 +974,10 @@ pub fn run_scene<const D: usize>(
         .map(|s| s.to_string())
         .collect();
     let mut csv = match &scene.observables {
+        Some(f) if resuming => Some(mote_io::csv::CsvWriter::append(
+            &out.base.join(f),
+            cols.len(),
+        )?),
         Some(f) => Some(mote_io::csv::CsvWriter::create(
             &out.base.join(f),
             &out.provenance,
@@ -835,11 +995,11 @@ pub fn run_scene<const D: usize>(
     };
     let start = Instant::now();
     let total = scene.equilibrate + scene.time;
-    let mut events = 0u64;
+    let mut events = ledger.events;
     // equilibration, in chunks for progress
     let chunks = 20;
     for k in 1..=chunks {
-        if scene.equilibrate <= 0.0 {
+        if scene.equilibrate <= 0.0 || resuming {
             break;
         }
         events += sys.run_until(scene.equilibrate * k as f64 / chunks as f64);
@@ -851,65 +1011,92 @@ pub fn run_scene<const D: usize>(
             });
         }
     }
-    sys.reset_counters();
-    let t0 = sys.time();
-    let mut drift: f64 = 0.0;
-    let mut write = |sys: &mut System<D>, drift: &mut f64| -> Result<(), EdmdError> {
-        let e = sys.kinetic_energy();
-        *drift = drift.max(((e - e0) / e0).abs());
-        if let Some(w) = xyz.as_mut() {
-            w.write(&frame(sys))?;
-        }
-        if let Some(c) = csv.as_mut() {
-            let dt = sys.time() - t0;
-            let (rate, mft, z, p) = if dt > 0.0 {
-                (
-                    sys.collision_rate(),
-                    sys.mean_free_time(),
-                    sys.compressibility(),
-                    sys.pressure(),
-                )
-            } else {
-                (f64::NAN, f64::NAN, f64::NAN, f64::NAN)
-            };
-            c.row(&[
-                sys.time(),
-                sys.counters().collisions as f64,
-                rate,
-                mft,
-                sys.temperature(),
-                e,
-                (e - e0) / e0,
-                z,
-                p,
-                sys.wall_pressure(),
-            ])?;
-        }
-        if scene.check_overlaps {
-            if let Some((i, j, gap)) = sys.find_overlap(1e-9) {
-                return Err(EdmdError::Invalid(format!(
+    let t0 = if resuming {
+        ledger.t0
+    } else {
+        sys.reset_counters();
+        sys.time()
+    };
+    let mut drift: f64 = ledger.drift;
+    // Times in the files are global: the clock offset of the last rebuild
+    // plus the system's own (the offset is 0 in a run without checkpoints).
+    let mut write =
+        |sys: &mut System<D>, drift: &mut f64, t_offset: f64| -> Result<(), EdmdError> {
+            let e = sys.kinetic_energy();
+            *drift = drift.max(((e - e0) / e0).abs());
+            if let Some(w) = xyz.as_mut() {
+                let mut f = frame(sys);
+                f.time = t_offset + sys.time();
+                w.write(&f)?;
+            }
+            if let Some(c) = csv.as_mut() {
+                let dt = t_offset + sys.time() - t0;
+                let (rate, mft, z, p) = if dt > 0.0 {
+                    (
+                        sys.collision_rate(),
+                        sys.mean_free_time(),
+                        sys.compressibility(),
+                        sys.pressure(),
+                    )
+                } else {
+                    (f64::NAN, f64::NAN, f64::NAN, f64::NAN)
+                };
+                c.row(&[
+                    t_offset + sys.time(),
+                    sys.counters().collisions as f64,
+                    rate,
+                    mft,
+                    sys.temperature(),
+                    e,
+                    (e - e0) / e0,
+                    z,
+                    p,
+                    sys.wall_pressure(),
+                ])?;
+            }
+            if scene.check_overlaps {
+                if let Some((i, j, gap)) = sys.find_overlap(1e-9) {
+                    return Err(EdmdError::Invalid(format!(
                     "overlap at t = {}: particles {i} and {j} (distance/contact − 1 = {gap:.3e})",
                     sys.time()
                 )));
+                }
             }
-        }
-        Ok(())
-    };
-    write(&mut sys, &mut drift)?;
-    let mut k = 1u64;
+            Ok(())
+        };
+    if !resuming {
+        write(&mut sys, &mut drift, t_offset)?;
+    }
+    let mut k = k_done + 1;
     loop {
         let target = (t0 + k as f64 * interval).min(t0 + scene.time);
-        events += sys.run_until(target);
-        write(&mut sys, &mut drift)?;
-        progress((sys.time()) / total.max(1e-300));
+        events += sys.run_until(target - t_offset);
+        write(&mut sys, &mut drift, t_offset)?;
+        progress((t_offset + sys.time()) / total.max(1e-300));
         if target >= t0 + scene.time {
             break;
         }
-        if let Some(signal) = mote_io::system::stop_requested() {
+        let signal = mote_io::system::stop_requested();
+        if let Some((every, path, template)) = &out.checkpoints {
+            if k % (*every).max(1) == 0 || signal.is_some() {
+                t_offset += sys.time();
+                sys = rebuild(&sys)?;
+                let ledger = Ledger {
+                    e0,
+                    p0,
+                    pscale,
+                    drift,
+                    events,
+                    t0,
+                };
+                write_checkpoint((path, template), &sys, t_offset, k, ledger)?;
+            }
+        }
+        if let Some(signal) = signal {
             // The writers flush as they drop.
             return Err(EdmdError::Interrupted {
                 signal,
-                time: sys.time(),
+                time: t_offset + sys.time(),
             });
         }
         k += 1;
@@ -980,7 +1167,9 @@ pub fn run_scene<const D: usize>(
         result.outputs.push(w.path().to_path_buf());
     }
     result.speeds = speeds;
-    result.final_frame = Some(frame(&sys));
+    let mut last = frame(&sys);
+    last.time = t_offset + sys.time();
+    result.final_frame = Some(last);
     if n <= 1000 {
         result.final_velocities = sys.velocities().iter().map(to3).collect();
     }

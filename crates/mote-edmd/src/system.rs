@@ -1477,6 +1477,11 @@ impl<const D: usize> System<D> {
         self.counters.wall_impulse_sum = 0.0;
     }
 
+    /// Replaces the counters (a resumed run continues its predecessor's).
+    pub fn set_counters(&mut self, counters: Counters) {
+        self.counters = counters;
+    }
+
     /// Shifts the clock back to zero (keeps numbers small in long runs):
     /// positions are synchronized and every event predicted again.
     pub fn rebase_time(&mut self) {

@@ -13,7 +13,7 @@ pub(crate) fn hex(x: f64) -> String {
     format!("{:016x}", x.to_bits())
 }
 
-fn unhex(s: &str) -> Result<f64, FrontError> {
+pub(crate) fn unhex(s: &str) -> Result<f64, FrontError> {
     u64::from_str_radix(s, 16)
         .map(f64::from_bits)
         .map_err(|_| FrontError::request("a checkpoint option is not a hexadecimal f64"))

@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 use mote_edmd::scene::{run_scene, Outputs};
 use mote_edmd::Scene;
 
+use mote_io::checkpoint::Checkpoint;
+
+use crate::checkpoints::{hex, trim_outputs, unhex};
 use crate::error::{refuse, FrontError};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
@@ -25,11 +28,53 @@ pub(crate) fn run(
     run_with(input, options, &EdmdWords::default(), monitor)
 }
 
+/// Continues the event-driven run a checkpoint came from, appending to its
+/// files: the same scene, seed, end time, output folder and checkpoint
+/// schedule.
+pub(crate) fn resume(
+    cp: &Checkpoint,
+    given: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    let get = |k: &str| cp.option(k).map(str::to_string);
+    let input = Input {
+        name: get("name").unwrap_or_else(|| "run".into()),
+        label: cp.input_label.clone(),
+        text: cp.input_text.clone(),
+        plist: false,
+    };
+    let options = RunOptions {
+        resume: given.resume.clone(),
+        checkpoint_every: get("checkpoint-every").and_then(|v| v.parse().ok()),
+        output: get("output").map(PathBuf::from),
+        picture: given.picture.clone(),
+        seed: Some(cp.seed),
+        threads: given.threads,
+        ..RunOptions::default()
+    };
+    // The measured time, bit for bit (not recomputed from an end time).
+    let words = EdmdWords {
+        time: get("time").map(|v| unhex(&v)).transpose()?,
+        no_output: false,
+    };
+    run_events(&input, &options, &words, Some(cp), monitor)
+}
+
 /// Runs an event-driven scene; `words` are the old command's options.
 pub fn run_with(
     input: &Input,
     options: &RunOptions,
     words: &EdmdWords,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    run_events(input, options, words, None, monitor)
+}
+
+fn run_events(
+    input: &Input,
+    options: &RunOptions,
+    words: &EdmdWords,
+    resumed: Option<&Checkpoint>,
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
     const WHY_NO_STEP: &str =
@@ -39,11 +84,6 @@ pub fn run_with(
         &[
             (options.dt.is_some(), "--dt", WHY_NO_STEP),
             (options.steps.is_some(), "--steps", WHY_NO_STEP),
-            (
-                options.checkpoint_every.is_some(),
-                "--checkpoint-every",
-                "event-driven runs do not write checkpoints yet",
-            ),
             (
                 options.solver.is_some(),
                 "--solver",
@@ -105,10 +145,35 @@ pub fn run_with(
         scene.equilibrate,
         crate::seed_phrase(seed, chosen),
     ));
+    let provenance = crate::provenance(&input.label, seed);
+    if let Some(cp) = resumed {
+        trim_outputs(&dir, cp.step, cp.time, &provenance)?;
+    }
+    // Checkpoints every N output intervals; the measured time is recorded
+    // so a resumed run ends where this one would have.
+    let checkpoints = options.checkpoint_every.map(|every| {
+        let template = Checkpoint {
+            program: provenance.program.clone(),
+            seed,
+            options: vec![
+                ("engine".into(), "event-driven".into()),
+                ("name".into(), input.name.clone()),
+                ("checkpoint-every".into(), every.to_string()),
+                ("time".into(), hex(scene.time)),
+                ("output".into(), dir.display().to_string()),
+            ],
+            input_label: input.label.clone(),
+            input_text: input.text.clone(),
+            ..Checkpoint::default()
+        };
+        (every, dir.join("checkpoint.mote"), template)
+    });
     let out = Outputs {
         base: dir.clone(),
         scene_dir,
-        provenance: crate::provenance(&input.label, seed),
+        provenance,
+        checkpoints,
+        resume: resumed.cloned(),
     };
     let cpu0 = crate::cpu::cpu_seconds();
     let progress = |f: f64| monitor.progress((f * 1000.0) as u64, 1000, "");

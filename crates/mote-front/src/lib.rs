@@ -140,11 +140,11 @@ pub struct Outcome {
 /// Runs what `options` describe with the engine its scene asks for.
 pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, FrontError> {
     if let Some(path) = &options.resume {
-        // Time-stepped runs write checkpoints: point particles, and rigid
-        // bodies (whose checkpoints say so).
+        // Checkpoints name their engine (point particles' older ones do not).
         let cp = mote_io::checkpoint::read(path)?;
         let result = match cp.option("engine") {
             Some("rigid") => rigid::resume(&cp, options, monitor),
+            Some("event-driven") => event_driven::resume(&cp, options, monitor),
             _ => particles::run(None, options, monitor),
         };
         monitor.finish();

@@ -53,11 +53,12 @@ enum Command {
     Edmd(cmd::edmd::EdmdArgs),
 }
 
-/// SIGINT and SIGTERM during `mote run` (and its alias `mote edmd`): the
-/// first asks the run to stop after its current step (files flushed, a
-/// last checkpoint where checkpoints are on; exit 128 + the signal's
-/// number); a second one ends the program at once. Other subcommands keep
-/// the default: a signal ends them at once.
+/// SIGINT and SIGTERM during `mote run` (and its alias `mote edmd`) and
+/// `mote pack`: the first asks the run to stop after its current step or
+/// window (files flushed, a last checkpoint where checkpoints are on, the
+/// packing so far written; exit 128 + the signal's number); a second one
+/// ends the program at once. Other subcommands keep the default: a signal
+/// ends them at once.
 fn stop_cleanly_on_signals() {
     use signal_hook::consts::{SIGINT, SIGTERM};
     use signal_hook::flag;
@@ -78,7 +79,10 @@ fn stop_cleanly_on_signals() {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    if matches!(cli.command, Command::Run(_) | Command::Edmd(_)) {
+    if matches!(
+        cli.command,
+        Command::Run(_) | Command::Edmd(_) | Command::Pack(_)
+    ) {
         stop_cleanly_on_signals();
     }
     let result = match cli.command {

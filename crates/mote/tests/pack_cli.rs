@@ -165,3 +165,37 @@ fn bad_input_is_a_clear_error() {
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("--rate"));
 }
+
+/// Ctrl-C during a packing stops it at the end of the current window and
+/// still writes the packing so far (exit 130), not jammed and saying so.
+#[test]
+fn sigint_writes_the_packing_so_far() {
+    let dir = tempfile::tempdir().unwrap();
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args([
+            "pack", "--n", "20000", "--rate", "0.0005", "--seed", "3", "-o", "p.xyz",
+        ])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let sent = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let out = child.wait_with_output().unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(130), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("interrupted by a signal (not jammed)"),
+        "{stdout}"
+    );
+    let frames = mote_io::xyz::read_frames(&dir.path().join("p.xyz")).unwrap();
+    assert_eq!(frames.last().unwrap().positions.len(), 20000);
+}

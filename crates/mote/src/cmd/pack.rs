@@ -322,6 +322,7 @@ fn pack_dim<const D: usize>(
             Stop::TargetPhi => "target packing fraction reached".to_string(),
             Stop::Collisions => "collision budget spent".to_string(),
             Stop::WallClock => "wall-clock limit reached".to_string(),
+            Stop::Interrupted => "run was interrupted by a signal (not jammed)".to_string(),
         };
         println!(
             "{} {}: phi = {:.6}, reduced pressure Z = {:.3e}, stopped because the {stop}.",
@@ -366,6 +367,11 @@ fn pack_dim<const D: usize>(
             "particles {i} and {j} overlap by {:.3e} of their contact distance",
             -g
         );
+    }
+    // A signal stopped it: the packing so far is written; exit 128 + signal.
+    if let (Stop::Interrupted, Some(signal)) = (out.stop, mote_io::system::stop_requested()) {
+        eprintln!("mote pack: interrupted by signal {signal}; the packing so far is written");
+        return Ok(ExitCode::from((128 + signal).clamp(0, 255) as u8));
     }
     Ok(ExitCode::SUCCESS)
 }
