@@ -123,6 +123,7 @@ fn run_events(
         .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
         .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
     std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
+    let _lock = crate::lock::FolderLock::take(&dir)?;
     let scene_dir = if input.label.starts_with("example:") {
         PathBuf::from(".")
     } else {

@@ -14,6 +14,7 @@ pub mod error;
 pub mod event_driven;
 pub mod examples;
 pub mod input;
+pub mod lock;
 mod particles;
 mod rigid;
 pub mod seed;

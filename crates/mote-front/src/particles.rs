@@ -192,6 +192,7 @@ pub(crate) fn run(
         .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
         .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
     std::fs::create_dir_all(&dir).map_err(|e| IoError::os(&dir, e))?;
+    let _lock = crate::lock::FolderLock::take(&dir)?;
     let total_steps = length.steps_from(built.simulation.system.time, built.simulation.dt);
     let append = resumed.is_some();
     if let Some(cp) = &resumed {

@@ -54,6 +54,8 @@ fn run_with(
         .clone()
         .or_else(|| scene.output.dir.as_ref().map(std::path::PathBuf::from))
         .unwrap_or_else(|| std::path::Path::new("out").join(&input.name));
+    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
+    let _lock = crate::lock::FolderLock::take(&dir)?;
     let provenance = crate::provenance(&input.label, seed);
     let checkpoints = options.checkpoint_every.map(|every| RigidCheckpoints {
         every: every.max(1),

@@ -572,3 +572,70 @@ fn killed_event_driven_run_resumes_bit_for_bit() {
         "observables differ after the resume (killed at output {at_kill})"
     );
 }
+
+/// Two runs writing into one folder: the second is refused while the first
+/// runs (its process named); the lock goes with the first run, also when a
+/// signal stops it, and a lock left by a killed run is taken over.
+#[test]
+fn a_second_run_into_a_busy_folder_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut first = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(["run", "example:eos", "--until", "400", "-q", "-o", "busy"])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let lock = dir.path().join("busy/.mote.lock");
+    let start = Instant::now();
+    while !lock.exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no lock appeared"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let o = mote(
+        &[
+            "run",
+            "example:sun-earth",
+            "--steps",
+            "5",
+            "-q",
+            "-o",
+            "busy",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "busy: another mote run (process {}) is writing into this folder",
+            first.id()
+        )),
+        "{err}"
+    );
+    Command::new("kill")
+        .args(["-TERM", &first.id().to_string()])
+        .status()
+        .unwrap();
+    assert_eq!(first.wait().unwrap().code(), Some(143));
+    assert!(!lock.exists(), "the lock outlived its run");
+
+    // A lock whose process is gone is taken over.
+    std::fs::write(&lock, "4000000000").unwrap();
+    let o = mote(
+        &[
+            "run",
+            "example:sun-earth",
+            "--steps",
+            "5",
+            "-q",
+            "-o",
+            "busy",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!lock.exists());
+}
