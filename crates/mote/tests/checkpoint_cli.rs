@@ -377,6 +377,16 @@ fn killed_rigid_run_resumes_bit_for_bit() {
     }
 }
 
+/// Sends signal `name` ("INT", "TERM") to process `pid` through the shell's
+/// built-in `kill` (a fresh Debian has `sh`, not always procps' `kill`).
+fn send_signal(pid: u32, name: &str) {
+    let sent = Command::new("sh")
+        .args(["-c", &format!("kill -{name} {pid}")])
+        .status()
+        .unwrap();
+    assert!(sent.success(), "could not send SIG{name} to {pid}");
+}
+
 /// Sends `signal` (by name, e.g. "INT") to a run once its checkpoint has
 /// reached `from_step`; returns the run's exit code.
 fn signal_when_checkpointed(
@@ -386,12 +396,7 @@ fn signal_when_checkpointed(
     signal: &str,
 ) -> Option<i32> {
     wait_for_checkpoint(checkpoint, from_step);
-    let pid = child.id().to_string();
-    let sent = Command::new("kill")
-        .args([&format!("-{signal}"), &pid])
-        .status()
-        .unwrap();
-    assert!(sent.success());
+    send_signal(child.id(), signal);
     child.wait().unwrap().code()
 }
 
@@ -508,10 +513,7 @@ fn sigterm_stops_rigid_and_event_driven_runs_cleanly() {
         );
         std::thread::sleep(Duration::from_millis(5));
     }
-    Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
+    send_signal(child.id(), "TERM");
     assert_eq!(child.wait().unwrap().code(), Some(143));
     let t = mote_io::csv::read_table(&csv).unwrap();
     assert!(
@@ -615,10 +617,7 @@ fn a_second_run_into_a_busy_folder_is_refused() {
         )),
         "{err}"
     );
-    Command::new("kill")
-        .args(["-TERM", &first.id().to_string()])
-        .status()
-        .unwrap();
+    send_signal(first.id(), "TERM");
     assert_eq!(first.wait().unwrap().code(), Some(143));
     assert!(!lock.exists(), "the lock outlived its run");
 
