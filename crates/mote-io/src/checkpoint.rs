@@ -3,7 +3,10 @@
 //! as the hexadecimal of its bits, so a resumed run continues bit for bit.
 //!
 //! Written atomically: to `FILE.tmp`, synced, then renamed over `FILE`, so a
-//! run killed at any moment leaves the previous checkpoint intact.
+//! run killed at any moment leaves the previous checkpoint intact. The last
+//! line is a checksum (64-bit FNV-1a) of everything before it, so a file
+//! truncated or changed afterwards is refused rather than resumed from
+//! (version 1 files, which have none, are still read).
 
 use std::fs::File;
 use std::io::Write;
@@ -54,7 +57,7 @@ fn hex(x: f64) -> String {
 /// Writes `cp` to `path` atomically.
 pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), IoError> {
     let mut text = String::new();
-    text.push_str("mote-checkpoint 1\n");
+    text.push_str("mote-checkpoint 2\n");
     text.push_str(&format!("program {}\n", cp.program));
     text.push_str(&format!("seed {}\n", cp.seed));
     for (k, v) in &cp.options {
@@ -96,6 +99,7 @@ pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), IoError> {
             text.push('\n');
         }
     }
+    text.push_str(&format!("checksum {:016x}\n", fnv1a(text.as_bytes())));
     let tmp = path.with_extension("tmp");
     let write = || -> std::io::Result<()> {
         let mut f = File::create(&tmp)?;
@@ -110,10 +114,34 @@ pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), IoError> {
 pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
     let text = std::fs::read_to_string(path).map_err(|e| IoError::os(path, e))?;
     let name = path.display().to_string();
-    let lines: Vec<&str> = text.split('\n').collect();
+    let mut lines: Vec<&str> = text.split('\n').collect();
     let err = |k: usize, m: &str| ParseError::new(&name, k + 1, m.to_string());
-    if lines.first() != Some(&"mote-checkpoint 1") {
-        return Err(err(0, "not a mote checkpoint (expected 'mote-checkpoint 1')").into());
+    match lines.first() {
+        Some(&"mote-checkpoint 1") => {}
+        Some(&"mote-checkpoint 2") => {
+            // The checksum line is the last non-empty one and covers all before it.
+            let last = lines.iter().rposition(|l| !l.is_empty()).unwrap_or(0);
+            let Some(sum) = lines[last].strip_prefix("checksum ") else {
+                return Err(ParseError::new(
+                    &name,
+                    0,
+                    "the checkpoint ends without its checksum line: it is truncated",
+                )
+                .into());
+            };
+            let covered: usize = lines[..last].iter().map(|l| l.len() + 1).sum();
+            if u64::from_str_radix(sum, 16).ok() != Some(fnv1a(&text.as_bytes()[..covered])) {
+                return Err(err(
+                    last,
+                    "the checksum does not match the contents: the checkpoint is corrupted",
+                )
+                .into());
+            }
+            lines.truncate(last);
+        }
+        _ => {
+            return Err(err(0, "not a mote checkpoint (expected 'mote-checkpoint 2')").into());
+        }
     }
     let mut cp = Checkpoint::default();
     let mut k = 1;
@@ -219,6 +247,13 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
     Ok(cp)
 }
 
+/// The 64-bit FNV-1a hash of `bytes` (Fowler–Noll–Vo): the checksum line.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
 /// The `count` rows of `width` hexadecimal f64 after the record at line k.
 fn table(
     lines: &[&str],
@@ -284,5 +319,49 @@ mod tests {
         assert!(!path.with_extension("tmp").exists());
         std::fs::write(&path, "mote-checkpoint 1\nparticles 1\n00 11\n").unwrap();
         assert!(read(&path).unwrap_err().to_string().contains("c.mote:3:"));
+    }
+
+    /// A checkpoint changed or cut after it was written is refused with
+    /// the reason, never resumed from: one digit of a velocity flipped to
+    /// another valid digit, the last rows cut off, the checksum gone.
+    #[test]
+    fn corrupted_or_truncated_checkpoints_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.mote");
+        let cp = Checkpoint {
+            program: "mote".into(),
+            input_text: "[run]\n".into(),
+            positions: vec![[1.0, 2.0, 3.0]; 4],
+            velocities: vec![[0.5, -0.5, 0.25]; 4],
+            ..Checkpoint::default()
+        };
+        write(&path, &cp).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines = text.lines().count();
+
+        let flipped = text.replacen("3fd0000000000000", "3fd0000000000001", 1);
+        assert_ne!(flipped, text);
+        std::fs::write(&path, &flipped).unwrap();
+        assert_eq!(
+            read(&path).unwrap_err().to_string(),
+            format!(
+                "{}:{lines}: the checksum does not match the contents: the checkpoint is corrupted",
+                path.display()
+            )
+        );
+
+        let cut: String = text
+            .lines()
+            .take(lines - 3)
+            .map(|l| format!("{l}\n"))
+            .collect();
+        std::fs::write(&path, cut).unwrap();
+        assert_eq!(
+            read(&path).unwrap_err().to_string(),
+            format!(
+                "{}: the checkpoint ends without its checksum line: it is truncated",
+                path.display()
+            )
+        );
     }
 }
