@@ -4,6 +4,8 @@
 //! velocity-dependent force included).
 
 use std::path::Path;
+
+use mote_io::checkpoint::Checkpoint;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -50,6 +52,61 @@ fn wait_for_checkpoint(path: &Path, step: u64) {
         );
         std::thread::sleep(Duration::from_millis(2));
     }
+}
+
+/// A run (`args` plus `-o whole`) to its end, the same run (`-o cut`)
+/// killed with SIGKILL once its checkpoint reached `kill_from`, then
+/// resumed: returns the whole run's last checkpoint, the killed run's
+/// checkpoint at the kill, and the resumed run's last checkpoint.
+fn whole_killed_resumed(
+    dir: &Path,
+    args: &[&str],
+    kill_from: u64,
+) -> (Checkpoint, Checkpoint, Checkpoint) {
+    let with_out = |out: &'static str| {
+        let mut v: Vec<&str> = args.to_vec();
+        v.extend(["-q", "-o", out]);
+        v
+    };
+    let o = mote(&with_out("whole"), dir);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let whole = mote_io::checkpoint::read(&dir.join("whole/checkpoint.mote")).unwrap();
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(with_out("cut"))
+        .current_dir(dir)
+        .spawn()
+        .unwrap();
+    let cp_path = dir.join("cut/checkpoint.mote");
+    wait_for_checkpoint(&cp_path, kill_from);
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    let at_kill = mote_io::checkpoint::read(&cp_path).unwrap();
+    assert!(
+        at_kill.step < whole.step,
+        "finished before it could be killed"
+    );
+
+    let o = mote(
+        &[
+            "run",
+            "--resume",
+            "cut/checkpoint.mote",
+            "--threads",
+            "1",
+            "-q",
+        ],
+        dir,
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let resumed = mote_io::checkpoint::read(&cp_path).unwrap();
+    (whole, at_kill, resumed)
+}
+
+/// Whether `file` is byte for byte the same in the whole and the resumed run.
+fn same_file(dir: &Path, file: &str) -> bool {
+    std::fs::read(dir.join("whole").join(file)).unwrap()
+        == std::fs::read(dir.join("cut").join(file)).unwrap()
 }
 
 fn state(path: &Path) -> (u64, Vec<[f64; 3]>, Vec<[f64; 3]>) {
@@ -180,54 +237,21 @@ trajectory_every = 0
 fn killed_granular_run_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("g.toml"), GRANULAR).unwrap();
-    let args = |out: &'static str| {
-        vec![
-            "run",
-            "g.toml",
-            "--threads",
-            "1",
-            "-q",
-            "-o",
-            out,
-            "--checkpoint-every",
-            "100",
-        ]
-    };
-    let o = mote(&args("whole"), dir.path());
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let whole = mote_io::checkpoint::read(&dir.path().join("whole/checkpoint.mote")).unwrap();
+    let args = [
+        "run",
+        "g.toml",
+        "--threads",
+        "1",
+        "--checkpoint-every",
+        "100",
+    ];
+    let (whole, at_kill, resumed) = whole_killed_resumed(dir.path(), &args, 1500);
     assert_eq!(whole.step, 4000);
     assert!(!whole.angular.is_empty() && !whole.carried.is_empty());
-
-    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
-        .args(args("cut"))
-        .current_dir(dir.path())
-        .spawn()
-        .unwrap();
-    let cp_path = dir.path().join("cut/checkpoint.mote");
-    wait_for_checkpoint(&cp_path, 1500);
-    child.kill().unwrap();
-    child.wait().unwrap();
-    let at_kill = mote_io::checkpoint::read(&cp_path).unwrap();
-    assert!(at_kill.step < 4000, "finished before it could be killed");
     assert!(
         at_kill.carried.iter().any(|(_, v)| v.len() > 1),
         "no contact history at the kill"
     );
-
-    let o = mote(
-        &[
-            "run",
-            "--resume",
-            "cut/checkpoint.mote",
-            "--threads",
-            "1",
-            "-q",
-        ],
-        dir.path(),
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let resumed = mote_io::checkpoint::read(&cp_path).unwrap();
     assert_eq!(resumed.step, 4000);
     let bits = |v: &[[f64; 3]]| {
         v.iter()
@@ -308,55 +332,22 @@ trajectory_every = 1000
 fn killed_rigid_run_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("r.toml"), RIGID).unwrap();
-    let args = |out: &'static str| {
-        vec![
-            "run",
-            "r.toml",
-            "--threads",
-            "1",
-            "-q",
-            "-o",
-            out,
-            "--checkpoint-every",
-            "100",
-        ]
-    };
-    let o = mote(&args("whole"), dir.path());
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let whole = mote_io::checkpoint::read(&dir.path().join("whole/checkpoint.mote")).unwrap();
+    let args = [
+        "run",
+        "r.toml",
+        "--threads",
+        "1",
+        "--checkpoint-every",
+        "100",
+    ];
+    let (whole, at_kill, resumed) = whole_killed_resumed(dir.path(), &args, 6000);
     assert_eq!(whole.step, 20000);
     assert_eq!(whole.option("engine"), Some("rigid"));
     assert_eq!(whole.positions.len(), 36);
-
-    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
-        .args(args("cut"))
-        .current_dir(dir.path())
-        .spawn()
-        .unwrap();
-    let cp_path = dir.path().join("cut/checkpoint.mote");
-    wait_for_checkpoint(&cp_path, 6000);
-    child.kill().unwrap(); // SIGKILL
-    child.wait().unwrap();
-    let at_kill = mote_io::checkpoint::read(&cp_path).unwrap();
-    assert!(at_kill.step < 20000, "finished before it could be killed");
     assert!(
         at_kill.carried.iter().any(|(_, v)| v.len() > 2),
         "no contact history at the kill"
     );
-
-    let o = mote(
-        &[
-            "run",
-            "--resume",
-            "cut/checkpoint.mote",
-            "--threads",
-            "1",
-            "-q",
-        ],
-        dir.path(),
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let resumed = mote_io::checkpoint::read(&cp_path).unwrap();
     assert_eq!(resumed.step, 20000);
     assert_eq!(
         resumed.positions, whole.positions,
@@ -367,10 +358,8 @@ fn killed_rigid_run_resumes_bit_for_bit() {
     assert_eq!(resumed.angular, whole.angular, "placements or spins differ");
     assert_eq!(resumed.carried, whole.carried, "contact histories differ");
     for file in ["observables.csv", "trajectory.xyz"] {
-        let a = std::fs::read(dir.path().join("whole").join(file)).unwrap();
-        let b = std::fs::read(dir.path().join("cut").join(file)).unwrap();
         assert!(
-            a == b,
+            same_file(dir.path(), file),
             "{file} differs after the resume (killed at {})",
             at_kill.step
         );
@@ -530,48 +519,22 @@ fn sigterm_stops_rigid_and_event_driven_runs_cleanly() {
 #[test]
 fn killed_event_driven_run_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
-    let args = |out: &'static str| {
-        vec![
-            "run",
-            "example:eos",
-            "--until",
-            "30",
-            "--seed",
-            "3",
-            "-q",
-            "-o",
-            out,
-            "--checkpoint-every",
-            "3",
-        ]
-    };
-    let o = mote(&args("whole"), dir.path());
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let whole = mote_io::checkpoint::read(&dir.path().join("whole/checkpoint.mote")).unwrap();
+    let args = [
+        "run",
+        "example:eos",
+        "--until",
+        "30",
+        "--seed",
+        "3",
+        "--checkpoint-every",
+        "3",
+    ];
+    let (whole, at_kill, _) = whole_killed_resumed(dir.path(), &args, 6);
     assert_eq!(whole.option("engine"), Some("event-driven"));
-
-    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
-        .args(args("cut"))
-        .current_dir(dir.path())
-        .spawn()
-        .unwrap();
-    let cp_path = dir.path().join("cut/checkpoint.mote");
-    wait_for_checkpoint(&cp_path, 6);
-    child.kill().unwrap(); // SIGKILL
-    child.wait().unwrap();
-    let at_kill = mote_io::checkpoint::read(&cp_path).unwrap().step;
-    assert!(at_kill < 24, "finished before it could be killed");
-
-    let o = mote(
-        &["run", "--resume", "cut/checkpoint.mote", "-q"],
-        dir.path(),
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let a = std::fs::read(dir.path().join("whole/observables.csv")).unwrap();
-    let b = std::fs::read(dir.path().join("cut/observables.csv")).unwrap();
     assert!(
-        a == b,
-        "observables differ after the resume (killed at output {at_kill})"
+        same_file(dir.path(), "observables.csv"),
+        "observables differ after the resume (killed at output {})",
+        at_kill.step
     );
 }
 

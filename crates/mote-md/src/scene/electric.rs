@@ -46,7 +46,7 @@ impl Section for CoulombSettings {
             Some(k) => positive(src, span.clone(), "[coulomb] k", k)?,
             None => return Err(err("[coulomb] needs k = 1/(4πε₀) in these units".into())),
         };
-        let charge = b.particles.charge.clone();
+        let charge = &b.particles.charge;
         if charge.iter().all(|q| *q == 0.0) {
             return Err(err(
                 "[coulomb] no particle has a charge: give the particles `charge = ...`".into(),
@@ -120,8 +120,7 @@ impl Section for CoulombSettings {
                     err("[coulomb] method = \"ewald\" needs accuracy = the RMS force error aimed at (force units)".into())
                 })?;
                 positive(src, span.clone(), "[coulomb] accuracy", accuracy)?;
-                b.forces
-                    .push(EwaldCoulomb::new(k, &charge, l, rc, accuracy));
+                b.forces.push(EwaldCoulomb::new(k, charge, l, rc, accuracy));
             }
             other => {
                 return Err(err(format!(

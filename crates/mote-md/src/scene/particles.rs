@@ -271,47 +271,24 @@ const BYTES_PER_PARTICLE: f64 = 450.0;
 /// and the table that makes the most, refused before anything is allocated
 /// when their arrays alone would not fit in the available memory.
 fn refuse_too_large(scene: &Scene, src: Source) -> Result<(), ParseError> {
-    let mut total = 0.0f64;
-    let mut largest: Option<(std::ops::Range<usize>, &str, f64)> = None;
-    let mut count = |span: std::ops::Range<usize>, table: &'static str, n: f64| {
-        total += n;
-        if largest.as_ref().is_none_or(|(_, _, m)| n > *m) {
-            largest = Some((span, table, n));
-        }
-    };
-    for spec in &scene.lattice {
-        let n = spec.get_ref().n;
-        count(
-            spec.span(),
-            "[[lattice]]",
-            n.iter().map(|&k| k as f64).product(),
-        );
+    fn each<'a, T>(
+        tables: &'a [toml::Spanned<T>],
+        name: &'static str,
+        n: impl Fn(&T) -> f64 + 'a,
+    ) -> impl Iterator<Item = (std::ops::Range<usize>, &'static str, f64)> + 'a {
+        tables.iter().map(move |t| (t.span(), name, n(t.get_ref())))
     }
-    for spec in &scene.fcc {
-        let c = spec.get_ref().cells;
-        count(
-            spec.span(),
-            "[[fcc]]",
-            4.0 * c.iter().map(|&k| k as f64).product::<f64>(),
-        );
-    }
-    for spec in &scene.ring {
-        count(spec.span(), "[[ring]]", spec.get_ref().n as f64);
-    }
-    for spec in &scene.annulus {
-        count(spec.span(), "[[annulus]]", spec.get_ref().n as f64);
-    }
-    for spec in &scene.random_box {
-        count(spec.span(), "[[random_box]]", spec.get_ref().n as f64);
-    }
-    for spec in &scene.cloud {
-        count(spec.span(), "[[cloud]]", spec.get_ref().n as f64);
-    }
-    for spec in &scene.plummer {
-        count(spec.span(), "[[plummer]]", spec.get_ref().n as f64);
-    }
-    total += scene.particle.len() as f64;
-    let Some((span, table, n)) = largest else {
+    let product = |n: &[usize; 3]| n.iter().map(|&k| k as f64).product::<f64>();
+    let counts: Vec<_> = each(&scene.lattice, "[[lattice]]", |s| product(&s.n))
+        .chain(each(&scene.fcc, "[[fcc]]", |s| 4.0 * product(&s.cells)))
+        .chain(each(&scene.ring, "[[ring]]", |s| s.n as f64))
+        .chain(each(&scene.annulus, "[[annulus]]", |s| s.n as f64))
+        .chain(each(&scene.random_box, "[[random_box]]", |s| s.n as f64))
+        .chain(each(&scene.cloud, "[[cloud]]", |s| s.n as f64))
+        .chain(each(&scene.plummer, "[[plummer]]", |s| s.n as f64))
+        .collect();
+    let total = scene.particle.len() as f64 + counts.iter().map(|c| c.2).sum::<f64>();
+    let Some((span, table, n)) = counts.into_iter().max_by(|a, b| a.2.total_cmp(&b.2)) else {
         return Ok(());
     };
     mote_io::system::check_fits(
