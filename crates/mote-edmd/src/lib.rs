@@ -17,6 +17,7 @@ mod avx512;
 pub mod init;
 pub mod pack;
 pub mod queue;
+pub mod run;
 pub mod scene;
 pub mod system;
 pub mod theory;

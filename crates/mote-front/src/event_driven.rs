@@ -167,7 +167,11 @@ fn run_events(
             input_text: input.text.clone(),
             ..Checkpoint::default()
         };
-        (every, dir.join("checkpoint.mote"), template)
+        mote_run::Checkpoints {
+            every: every.max(1),
+            path: dir.join("checkpoint.mote"),
+            template,
+        }
     });
     let out = Outputs {
         base: dir.clone(),

@@ -7,73 +7,12 @@ use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::IoError;
 use mote_md::output::{ObservablesCsv, TrajectoryXyz};
 use mote_md::scene::{PlistSystem, Scene};
-use mote_md::{MdError, Observables, Observer, RunLength, RunReport, System};
+use mote_md::{MdError, RunLength, RunReport, Simulation};
+use mote_run::{Checkpoints, Driver};
 
 use crate::checkpoints::{hex, restore, trim_outputs};
 use crate::error::{refuse, FrontError};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
-
-/// Writes DIR/checkpoint.mote on its schedule: the run's input and options
-/// (`template`) with the current state.
-struct CheckpointWriter {
-    path: PathBuf,
-    every: u64,
-    template: Checkpoint,
-    /// The interactions' carried state, taken just before `observe`.
-    carried: Vec<(usize, Vec<f64>)>,
-}
-
-impl Observer for CheckpointWriter {
-    fn every(&self) -> u64 {
-        self.every
-    }
-
-    fn observe_forces(&mut self, forces: &mote_md::ForceField) {
-        self.carried = forces
-            .interactions
-            .iter()
-            .enumerate()
-            .map(|(k, i)| (k, i.carried_state()))
-            .filter(|(_, v)| !v.is_empty())
-            .collect();
-    }
-
-    fn observe(&mut self, sys: &System, _obs: &Observables) -> Result<(), MdError> {
-        let p = &sys.particles;
-        let rotating = !sys.carried_angular_acceleration.is_empty();
-        let cp = Checkpoint {
-            angular: if rotating {
-                p.angular_velocity
-                    .iter()
-                    .zip(&sys.carried_angular_acceleration)
-                    .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
-                    .collect()
-            } else {
-                Vec::new()
-            },
-            carried: self.carried.clone(),
-            time: sys.time,
-            step: sys.step,
-            positions: p.position.iter().map(|r| r.to_array()).collect(),
-            velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
-            accelerations: sys
-                .carried_acceleration
-                .iter()
-                .map(|a| a.to_array())
-                .collect(),
-            ..self.template.clone()
-        };
-        Ok(checkpoint::write(&self.path, &cp)?)
-    }
-
-    fn files(&self) -> Vec<String> {
-        vec![self.path.display().to_string()]
-    }
-
-    fn at_interruption(&self) -> bool {
-        true
-    }
-}
 
 /// Puts the checkpoint's state into the freshly built simulation.
 fn resume_state(
@@ -123,7 +62,6 @@ fn resume_state(
             .restore_carried_state(values)
             .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
     }
-    sim.sample_at_start = false;
     Ok(())
 }
 
@@ -206,8 +144,10 @@ pub(crate) fn run(
     }
     let out = &scene.output;
     let sim = &mut built.simulation;
+    let mut driver = Driver::<Simulation>::new();
+    driver.sample_at_start = !append;
     if out.observables_every > 0 {
-        sim.observers.push(Box::new(ObservablesCsv::create(
+        driver.observers.push(Box::new(ObservablesCsv::create(
             &dir.join("observables.csv"),
             &provenance,
             scene.units,
@@ -229,7 +169,7 @@ pub(crate) fn run(
         )?));
     }
     if out.trajectory_every > 0 {
-        sim.observers.push(Box::new(TrajectoryXyz::create(
+        driver.observers.push(Box::new(TrajectoryXyz::create(
             &dir.join("trajectory.xyz"),
             provenance.clone(),
             out.trajectory_every,
@@ -252,7 +192,7 @@ pub(crate) fn run(
         if let Some(s) = &args.solver {
             options.push(("solver".to_string(), s.clone()));
         }
-        sim.observers.push(Box::new(CheckpointWriter {
+        driver.checkpoints = Some(Checkpoints {
             path: dir.join("checkpoint.mote"),
             every: every.max(1),
             template: Checkpoint {
@@ -263,11 +203,11 @@ pub(crate) fn run(
                 input_text: input.text.clone(),
                 ..Checkpoint::default()
             },
-            carried: Vec::new(),
-        }));
+        });
     }
 
     let steps = length.steps_from(sim.system.time, sim.dt);
+    let last_step = sim.system.step + steps;
     let propagator = if sim.brownian.is_some() {
         "Brownian dynamics".to_string()
     } else {
@@ -283,11 +223,16 @@ pub(crate) fn run(
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase(),
     ));
-    let result = sim.run(length, |sys| {
-        if sys.step % 16 == 0 {
-            monitor.progress(sys.step, steps, &format!("t = {:.6e}", sys.time));
-        }
-    });
+    let result = driver.run(
+        sim,
+        |_| last_step,
+        |sim| {
+            let sys = &sim.system;
+            if sys.step % 16 == 0 {
+                monitor.progress(sys.step, last_step, &format!("t = {:.6e}", sys.time));
+            }
+        },
+    );
     let mut outcome = Outcome {
         engine: Engine::Particles,
         seed,
@@ -297,9 +242,7 @@ pub(crate) fn run(
     };
     match result {
         Ok(report) => {
-            outcome
-                .summary
-                .push(summary(&report, &scene, &dir, sim.brownian.is_some()));
+            outcome.summary.push(summary(&report, sim, &scene, &dir));
             if let Some(png) = &args.picture {
                 let frame = mote_md::output::frame_of(&sim.system);
                 mote_render::frame::picture(&frame, png, 1920, 1080)?;
@@ -322,7 +265,7 @@ pub(crate) fn run(
 
 /// The paragraph that ends a run. Overdamped (Brownian) runs have no
 /// conserved energy, so they report the energies, not a drift.
-fn summary(report: &RunReport, scene: &Scene, dir: &Path, brownian: bool) -> String {
+fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> String {
     let secs = report.wall.as_secs_f64();
     let [_, t_unit, _, e_unit] = scene.units.labels();
     let files = if report.files.is_empty() {
@@ -330,7 +273,7 @@ fn summary(report: &RunReport, scene: &Scene, dir: &Path, brownian: bool) -> Str
     } else {
         report.files.join(", ")
     };
-    let energy = if brownian {
+    let energy = if sim.brownian.is_some() {
         format!(
             "Overdamped dynamics conserve no energy: potential energy went from {:.9e} to {:.9e} {}.",
             report.initial.potential, report.last.potential, e_unit
@@ -342,7 +285,7 @@ fn summary(report: &RunReport, scene: &Scene, dir: &Path, brownian: bool) -> Str
             report.last.total_energy(),
             e_unit,
             rel(report.last.total_energy(), report.initial.total_energy()),
-            report.max_energy_error,
+            sim.max_energy_error(),
         )
     };
     format!(

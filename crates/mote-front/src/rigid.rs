@@ -1,7 +1,7 @@
 //! Rigid clumps of spheres moved by the FRBI (`mote_md::rigid::scene`).
 
 use mote_io::checkpoint::Checkpoint;
-use mote_md::rigid::scene::{run_rigid_scene, RigidCheckpoints, RigidRun, RigidScene};
+use mote_md::rigid::scene::{run_rigid_scene, RigidRun, RigidScene};
 use mote_md::MdError;
 
 use crate::checkpoints::{restore, trim_outputs};
@@ -57,7 +57,7 @@ fn run_with(
     std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
     let _lock = crate::lock::FolderLock::take(&dir)?;
     let provenance = crate::provenance(&input.label, seed);
-    let checkpoints = options.checkpoint_every.map(|every| RigidCheckpoints {
+    let checkpoints = options.checkpoint_every.map(|every| mote_run::Checkpoints {
         every: every.max(1),
         path: dir.join("checkpoint.mote"),
         template: Checkpoint {

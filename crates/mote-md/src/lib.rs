@@ -33,7 +33,7 @@ pub use force::{ForceField, Interaction, State};
 pub use integrate::{Integrator, Stepper};
 pub use observe::Observables;
 pub use particles::{Particles, System};
-pub use simulation::{Observer, RunLength, RunReport, Simulation};
+pub use simulation::{RunLength, RunReport, Simulation};
 pub use units::UnitSystem;
 
 pub use glam::DVec3;

@@ -11,8 +11,9 @@ use mote_io::Provenance;
 use crate::error::MdError;
 use crate::observe::{Observables, Probe};
 use crate::particles::System;
-use crate::simulation::Observer;
+use crate::simulation::Simulation;
 use crate::units::UnitSystem;
+use mote_run::Observer;
 
 /// observables.csv: time, energies, momentum, angular momentum, step, k_B T,
 /// the pressure (only for a box periodic on every axis), probes, the total
@@ -103,12 +104,13 @@ impl ObservablesCsv {
     }
 }
 
-impl Observer for ObservablesCsv {
+impl Observer<Simulation> for ObservablesCsv {
     fn every(&self) -> u64 {
         self.every
     }
 
-    fn observe(&mut self, sys: &System, obs: &Observables) -> Result<(), MdError> {
+    fn observe(&mut self, sim: &Simulation, obs: &Observables) -> Result<(), MdError> {
+        let sys = &sim.system;
         let mut row: Vec<f64> = obs.values(sys.step).to_vec();
         if !self.pressure {
             row.pop();
@@ -181,13 +183,13 @@ pub fn frame_of(sys: &System) -> Frame {
     }
 }
 
-impl Observer for TrajectoryXyz {
+impl Observer<Simulation> for TrajectoryXyz {
     fn every(&self) -> u64 {
         self.every
     }
 
-    fn observe(&mut self, sys: &System, _obs: &Observables) -> Result<(), MdError> {
-        Ok(self.writer.write(&frame_of(sys))?)
+    fn observe(&mut self, sim: &Simulation, _obs: &Observables) -> Result<(), MdError> {
+        Ok(self.writer.write(&frame_of(&sim.system))?)
     }
 
     fn files(&self) -> Vec<String> {

@@ -1,6 +1,5 @@
-//! The single run loop of the time-stepped engine.
-
-use std::time::{Duration, Instant};
+//! The time-stepped propagator: fixed-step integrators, thermostats and
+//! Brownian dynamics, stepped by mote's one loop ([`mote_run::Driver`]).
 
 use crate::error::MdError;
 use crate::force::ForceField;
@@ -37,150 +36,61 @@ impl RunLength {
     }
 }
 
-/// Something that samples the run on a schedule (writers, recorders).
-pub trait Observer {
-    /// Sample when the step number is a multiple of this (≥ 1); the first
-    /// and the last step of a run are always sampled.
-    fn every(&self) -> u64;
-    /// Samples the state; `obs` holds the whole-system observables of this instant.
-    fn observe(&mut self, sys: &System, obs: &Observables) -> Result<(), MdError>;
-    /// Files this observer wrote, for the report.
-    fn files(&self) -> Vec<String> {
-        Vec::new()
-    }
-    /// Called just before [`Observer::observe`] with the force field, for
-    /// observers that record what interactions carry from step to step
-    /// (checkpoints of contact histories).
-    fn observe_forces(&mut self, forces: &ForceField) {
-        let _ = forces;
-    }
-    /// Whether to sample the step at which a signal stops the run (true
-    /// for checkpoints; false for tables and trajectories, whose files a
-    /// resumed run then continues as if never interrupted).
-    fn at_interruption(&self) -> bool {
-        false
-    }
-}
+/// What a time-stepped run did.
+pub type RunReport = mote_run::Report<Observables>;
 
-/// What a run did.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunReport {
-    pub steps: u64,
-    pub wall: Duration,
-    pub initial: Observables,
-    pub last: Observables,
-    /// max |E(t) − E(0)| / |E(0)| over the sampled instants.
-    pub max_energy_error: f64,
-    pub files: Vec<String>,
-}
-
-/// A run: the state, its forces, its integrator and its observers.
+/// The time-stepped propagator: the state, its forces, its integrator,
+/// the thermostat or Brownian dynamics; moved by [`mote_run::Driver`].
 pub struct Simulation {
     pub system: System,
     pub forces: ForceField,
     pub stepper: Stepper,
     pub dt: f64,
-    pub observers: Vec<Box<dyn Observer>>,
     /// Applied after every step (NVE when `None`).
     pub thermostat: Option<Thermostat>,
     /// The run's seed. Thermostat noise of step k comes from a generator
     /// seeded by (seed, k) ([`Simulation::noise`]), so a run resumed from a
     /// checkpoint draws exactly the numbers the uninterrupted run would.
     pub seed: u64,
-    /// Hand the starting state to the observers (false when resuming: the
-    /// interrupted run already wrote it).
-    pub sample_at_start: bool,
     /// Overdamped Brownian dynamics instead of the inertial `stepper`
     /// (004 Eqs. 14–16); its noise is counter-based like the thermostat's.
     pub brownian: Option<crate::brownian::BrownianStepper>,
+    /// Total energy at the first measurement of the current run and the
+    /// largest relative departure from it measured since.
+    energy_watch: Option<(f64, f64)>,
 }
 
 impl Simulation {
-    /// Runs for `length`, calling `progress(system)` after every step.
-    /// On a non-finite position or velocity the run stops with
-    /// [`MdError::Unstable`] naming the step and particle; what the observers
-    /// wrote until then stays on disk.
+    /// The simulation of `system` under `forces`, stepped by `stepper`.
+    pub fn new(system: System, forces: ForceField, stepper: Stepper, dt: f64, seed: u64) -> Self {
+        Simulation {
+            system,
+            forces,
+            stepper,
+            dt,
+            thermostat: None,
+            seed,
+            brownian: None,
+            energy_watch: None,
+        }
+    }
+
+    /// Runs for `length` without observers, calling `progress(system)`
+    /// after every step. On a non-finite position or velocity the run stops
+    /// with [`MdError::Unstable`] naming the step and particle.
     pub fn run(
         &mut self,
         length: RunLength,
         mut progress: impl FnMut(&System),
     ) -> Result<RunReport, MdError> {
-        let start = Instant::now();
-        let steps = length.steps_from(self.system.time, self.dt);
-        let first_step = self.system.step;
-        if self.brownian.is_none() {
-            self.stepper.prime(&mut self.system, &mut self.forces);
-        }
-        let initial = Observables::measure(&self.system, &mut self.forces);
-        let e0 = initial.total_energy();
-        let mut max_err: f64 = 0.0;
-        let mut last = initial.clone();
-        if self.sample_at_start {
-            self.sample(true, &initial)?;
-        }
-        for k in 1..=steps {
-            if let Some(bd) = &mut self.brownian {
-                let index = self.system.step + 1;
-                bd.step(
-                    &mut self.system,
-                    &mut self.forces,
-                    self.dt,
-                    index,
-                    self.seed,
-                );
-            } else {
-                self.stepper
-                    .step(&mut self.system, &mut self.forces, self.dt);
-            }
-            if let Some(t) = self.thermostat {
-                let mut rng = self.noise(self.system.step);
-                t.apply(&mut self.system, self.dt, &mut rng);
-            }
-            self.check_finite()?;
-            // Schedules count absolute steps, so a resumed run samples
-            // exactly where the uninterrupted one would.
-            let step = self.system.step;
-            let last_step = k == steps;
-            let due = last_step
-                || self
-                    .observers
-                    .iter()
-                    .any(|o| step.is_multiple_of(o.every().max(1)));
-            if due {
-                last = Observables::measure(&self.system, &mut self.forces);
-                let err = if e0 != 0.0 {
-                    (last.total_energy() - e0).abs() / e0.abs()
-                } else {
-                    (last.total_energy() - e0).abs()
-                };
-                max_err = max_err.max(err);
-                self.sample(last_step, &last)?;
-            }
-            progress(&self.system);
-            if let Some(signal) = mote_io::system::stop_requested() {
-                if !last_step {
-                    for o in &mut self.observers {
-                        if o.at_interruption() && !step.is_multiple_of(o.every().max(1)) {
-                            o.observe_forces(&self.forces);
-                            o.observe(&self.system, &last)?;
-                        }
-                    }
-                    return Err(MdError::Interrupted {
-                        signal,
-                        step,
-                        time: self.system.time,
-                    });
-                }
-            }
-        }
-        Ok(RunReport {
-            steps: self.system.step - first_step,
-            wall: start.elapsed(),
-            initial,
-            last,
-            max_energy_error: max_err,
-            files: self.observers.iter().flat_map(|o| o.files()).collect(),
-        })
+        let last = self.system.step + length.steps_from(self.system.time, self.dt);
+        mote_run::Driver::new().run(self, |_| last, |s| progress(&s.system))
+    }
+
+    /// max |E(t) − E(0)| / |E(0)| over the instants measured in the
+    /// current run (|E(t) − E(0)| when E(0) = 0).
+    pub fn max_energy_error(&self) -> f64 {
+        self.energy_watch.map_or(0.0, |w| w.1)
     }
 
     /// The random stream of step `step`: xoshiro256++ seeded (through
@@ -191,38 +101,126 @@ impl Simulation {
             self.seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(17),
         )
     }
+}
 
-    /// Hands the state to the observers due at this step (all of them when `always`).
-    fn sample(&mut self, always: bool, obs: &Observables) -> Result<(), MdError> {
-        let step = self.system.step;
-        for o in &mut self.observers {
-            if always || step.is_multiple_of(o.every().max(1)) {
-                o.observe_forces(&self.forces);
-                o.observe(&self.system, obs)?;
-            }
+impl mote_run::Propagator for Simulation {
+    type Sample = Observables;
+    type Error = MdError;
+
+    fn step(&self) -> u64 {
+        self.system.step
+    }
+
+    fn time(&self) -> f64 {
+        self.system.time
+    }
+
+    fn prime(&mut self, _progress: &mut dyn FnMut(&Self)) -> Result<(), MdError> {
+        if self.brownian.is_none() {
+            self.stepper.prime(&mut self.system, &mut self.forces);
+        }
+        self.energy_watch = None;
+        Ok(())
+    }
+
+    fn advance(&mut self) -> Result<(), MdError> {
+        if let Some(bd) = &mut self.brownian {
+            let index = self.system.step + 1;
+            bd.step(
+                &mut self.system,
+                &mut self.forces,
+                self.dt,
+                index,
+                self.seed,
+            );
+        } else {
+            self.stepper
+                .step(&mut self.system, &mut self.forces, self.dt);
+        }
+        if let Some(t) = self.thermostat {
+            let mut rng = self.noise(self.system.step);
+            t.apply(&mut self.system, self.dt, &mut rng);
         }
         Ok(())
     }
 
-    fn check_finite(&self) -> Result<(), MdError> {
+    fn unstable(&self) -> Option<(usize, String)> {
         let p = &self.system.particles;
-        for i in 0..p.len() {
-            let bad = if !p.position[i].is_finite() {
-                Some("a non-finite position")
+        (0..p.len()).find_map(|i| {
+            let what = if !p.position[i].is_finite() {
+                "a non-finite position"
             } else if !p.velocity[i].is_finite() {
-                Some("a non-finite velocity")
+                "a non-finite velocity"
             } else {
-                None
+                return None;
             };
-            if let Some(what) = bad {
-                return Err(MdError::Unstable {
-                    step: self.system.step,
-                    time: self.system.time,
-                    particle: i,
-                    what: format!("{what} ({} / {})", p.position[i], p.velocity[i]),
-                });
+            Some((i, format!("{what} ({} / {})", p.position[i], p.velocity[i])))
+        })
+    }
+
+    fn measure(&mut self) -> Observables {
+        let obs = Observables::measure(&self.system, &mut self.forces);
+        let e = obs.total_energy();
+        let (e0, worst) = self.energy_watch.unwrap_or((e, 0.0));
+        let err = if e0 != 0.0 {
+            (e - e0).abs() / e0.abs()
+        } else {
+            (e - e0).abs()
+        };
+        self.energy_watch = Some((e0, worst.max(err)));
+        obs
+    }
+
+    /// Positions, velocities, the accelerations leap-frog carries (and the
+    /// angular ones with ω when the particles turn), and what each
+    /// interaction carries (contact histories) under its index.
+    fn save(&mut self, cp: &mut mote_io::checkpoint::Checkpoint) -> Result<(), MdError> {
+        let sys = &self.system;
+        let p = &sys.particles;
+        cp.angular = p
+            .angular_velocity
+            .iter()
+            .zip(&sys.carried_angular_acceleration)
+            .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
+            .collect();
+        cp.carried = self
+            .forces
+            .interactions
+            .iter()
+            .enumerate()
+            .map(|(k, i)| (k, i.carried_state()))
+            .filter(|(_, v)| !v.is_empty())
+            .collect();
+        cp.time = sys.time;
+        cp.step = sys.step;
+        cp.positions = p.position.iter().map(|r| r.to_array()).collect();
+        cp.velocities = p.velocity.iter().map(|v| v.to_array()).collect();
+        cp.accelerations = sys
+            .carried_acceleration
+            .iter()
+            .map(|a| a.to_array())
+            .collect();
+        Ok(())
+    }
+}
+
+impl From<mote_run::Stopped> for MdError {
+    fn from(s: mote_run::Stopped) -> Self {
+        match s {
+            mote_run::Stopped::Unstable {
+                step,
+                time,
+                particle,
+                what,
+            } => MdError::Unstable {
+                step,
+                time,
+                particle,
+                what,
+            },
+            mote_run::Stopped::Interrupted { signal, step, time } => {
+                MdError::Interrupted { signal, step, time }
             }
         }
-        Ok(())
     }
 }

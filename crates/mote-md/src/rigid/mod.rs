@@ -22,6 +22,7 @@ pub mod bodies;
 pub mod contacts;
 pub mod frbi;
 pub mod interaction;
+pub mod run;
 pub mod scene;
 pub mod shapes;
 pub mod sources;

@@ -202,16 +202,11 @@ impl Scene {
             system.to_centre_of_mass_frame();
         }
         Ok(Built {
-            simulation: Simulation {
-                system,
-                forces: b.forces,
-                stepper: Stepper::new(integrator),
-                dt,
-                observers: Vec::new(),
-                thermostat,
-                seed,
-                sample_at_start: true,
-                brownian,
+            simulation: {
+                let mut sim = Simulation::new(system, b.forces, Stepper::new(integrator), dt, seed);
+                sim.thermostat = thermostat;
+                sim.brownian = brownian;
+                sim
             },
             length,
             probes,

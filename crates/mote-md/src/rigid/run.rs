@@ -1,0 +1,438 @@
+//! Rigid runs: the FRBI as a [`Propagator`] of mote's one loop, the
+//! observers that write a rigid run's files (observables.csv with
+//! translational and rotational energy apart and the force on each wall;
+//! the spheres as extended XYZ), checkpoints of bodies and contact
+//! histories, and [`run_rigid_scene`], which puts them together.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::DVec3;
+use mote_io::checkpoint::Checkpoint;
+use mote_io::csv::CsvWriter;
+use mote_io::xyz::{Frame, XyzWriter};
+use mote_io::{ParseError, Provenance};
+use mote_run::{Checkpoints, Driver, Observer, Propagator};
+
+use super::bodies::RigidBodies;
+use super::contacts::RigidContacts;
+use super::frbi::Frbi;
+use super::scene::RigidScene;
+use crate::error::MdError;
+
+/// What a caller changes about a rigid scene's run; `None` keeps the scene's.
+#[derive(Debug, Clone, Default)]
+pub struct RigidRun {
+    /// Replaces the scene's seed (the scene's, else 1, when absent).
+    pub seed: Option<u64>,
+    /// Replaces `[output] dir`.
+    pub out_dir: Option<PathBuf>,
+    /// Replaces `[run] dt`.
+    pub dt: Option<f64>,
+    /// Replaces the run length by a number of steps.
+    pub steps: Option<u64>,
+    /// Replaces the run length by an end time (steps = round(t/dt)).
+    pub until: Option<f64>,
+    /// Write checkpoints on this schedule (the template holds the run's
+    /// input and options; the time step and the run's length are added).
+    pub checkpoints: Option<Checkpoints>,
+    /// Continue this checkpoint's run (its scene, seed, dt and length must
+    /// be those given), appending to the files an earlier run wrote.
+    pub resume: Option<Checkpoint>,
+}
+
+/// Rigid bodies moved by the FRBI with a fixed step.
+pub struct RigidDynamics {
+    pub bodies: RigidBodies,
+    pub frbi: Frbi,
+    /// The contact model (shared with the integrator), for the wall forces.
+    pub contacts: Option<Arc<RigidContacts>>,
+    pub dt: f64,
+    /// Steps taken since the bodies were placed.
+    pub step: u64,
+    /// The last step of the run (recorded in checkpoints).
+    pub last_step: u64,
+}
+
+/// The observables of the bodies at one instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidSample {
+    pub time: f64,
+    pub translational_energy: f64,
+    pub rotational_energy: f64,
+    pub potential_energy: f64,
+    pub linear_momentum: DVec3,
+    pub angular_momentum: DVec3,
+    /// The force on each wall, F = −Σ (contact forces of the spheres on it).
+    pub wall_forces: Vec<(String, DVec3)>,
+}
+
+impl RigidSample {
+    pub fn kinetic_energy(&self) -> f64 {
+        self.translational_energy + self.rotational_energy
+    }
+}
+
+impl Propagator for RigidDynamics {
+    type Sample = RigidSample;
+    type Error = MdError;
+
+    fn step(&self) -> u64 {
+        self.step
+    }
+
+    fn time(&self) -> f64 {
+        self.bodies.time
+    }
+
+    fn advance(&mut self) -> Result<(), MdError> {
+        self.frbi.step(&mut self.bodies, self.dt);
+        self.step += 1;
+        Ok(())
+    }
+
+    fn unstable(&self) -> Option<(usize, String)> {
+        let b = &self.bodies;
+        (0..b.len()).find_map(|i| {
+            let what = if !b.position[i].is_finite() {
+                "a non-finite position"
+            } else if !b.velocity[i].is_finite() || !b.omega[i].is_finite() {
+                "a non-finite velocity"
+            } else {
+                return None;
+            };
+            Some((
+                i,
+                format!(
+                    "{what} (x {}, v {}, ω {})",
+                    b.position[i], b.velocity[i], b.omega[i]
+                ),
+            ))
+        })
+    }
+
+    fn measure(&mut self) -> RigidSample {
+        let e = self.frbi.energies(&self.bodies);
+        let o = self.bodies.observables();
+        RigidSample {
+            time: self.bodies.time,
+            translational_energy: o.translational_energy,
+            rotational_energy: o.rotational_energy,
+            potential_energy: e.potential,
+            linear_momentum: o.linear_momentum,
+            angular_momentum: o.angular_momentum,
+            wall_forces: self
+                .contacts
+                .as_ref()
+                .map(|c| c.wall_forces())
+                .unwrap_or_default(),
+        }
+    }
+
+    /// The bodies (the angular table holds the rotation vector r and ω),
+    /// the contact histories, and the resolved `dt` and `total-steps`.
+    fn save(&mut self, cp: &mut Checkpoint) -> Result<(), MdError> {
+        let b = &self.bodies;
+        cp.options.retain(|(k, _)| k != "dt" && k != "total-steps");
+        cp.options
+            .push(("dt".into(), format!("{:016x}", self.dt.to_bits())));
+        cp.options
+            .push(("total-steps".into(), self.last_step.to_string()));
+        cp.time = b.time;
+        cp.step = self.step;
+        cp.positions = b.position.iter().map(|x| x.to_array()).collect();
+        cp.velocities = b.velocity.iter().map(|v| v.to_array()).collect();
+        cp.angular = b
+            .rotation
+            .iter()
+            .zip(&b.omega)
+            .map(|(r, w)| [r.x, r.y, r.z, w.x, w.y, w.z])
+            .collect();
+        cp.carried = self.frbi.carried_state();
+        Ok(())
+    }
+}
+
+impl RigidDynamics {
+    /// Puts a checkpoint's state into freshly built bodies and integrator.
+    fn resume(&mut self, cp: &Checkpoint, label: &str) -> Result<(), MdError> {
+        let b = &mut self.bodies;
+        let n = b.len();
+        if cp.positions.len() != n || cp.velocities.len() != n || cp.angular.len() != n {
+            return Err(ParseError::new(
+                label,
+                0,
+                format!(
+                    "the checkpoint holds {} bodies, the scene makes {n}",
+                    cp.positions.len()
+                ),
+            )
+            .into());
+        }
+        for i in 0..n {
+            b.position[i] = DVec3::from(cp.positions[i]);
+            b.velocity[i] = DVec3::from(cp.velocities[i]);
+            let a = cp.angular[i];
+            b.rotation[i] = DVec3::new(a[0], a[1], a[2]);
+            b.omega[i] = DVec3::new(a[3], a[4], a[5]);
+        }
+        b.time = cp.time;
+        self.step = cp.step;
+        self.frbi
+            .restore_carried_state(&cp.carried)
+            .map_err(|m| ParseError::new(label, 0, format!("checkpoint: {m}")))?;
+        Ok(())
+    }
+}
+
+/// observables.csv of a rigid run: time, kinetic (translational +
+/// rotational), translational, rotational, potential and total energy,
+/// momentum, angular momentum, the force on each wall.
+pub struct RigidCsv {
+    writer: CsvWriter,
+    every: u64,
+}
+
+impl RigidCsv {
+    pub fn create(
+        path: &std::path::Path,
+        provenance: &Provenance,
+        walls: &[String],
+        every: u64,
+        append: bool,
+    ) -> Result<Self, MdError> {
+        let mut columns: Vec<String> = [
+            "time",
+            "kinetic_energy",
+            "translational_energy",
+            "rotational_energy",
+            "potential_energy",
+            "total_energy",
+            "px",
+            "py",
+            "pz",
+            "lx",
+            "ly",
+            "lz",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        for w in walls {
+            for a in ["x", "y", "z"] {
+                columns.push(format!("{w}.f{a}"));
+            }
+        }
+        let writer = if append {
+            CsvWriter::append(path, columns.len())?
+        } else {
+            CsvWriter::create(path, provenance, &columns, &[])?
+        };
+        Ok(RigidCsv { writer, every })
+    }
+}
+
+impl Observer<RigidDynamics> for RigidCsv {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, _: &RigidDynamics, s: &RigidSample) -> Result<(), MdError> {
+        let mut row = vec![
+            s.time,
+            s.kinetic_energy(),
+            s.translational_energy,
+            s.rotational_energy,
+            s.potential_energy,
+            s.kinetic_energy() + s.potential_energy,
+        ];
+        row.extend(s.linear_momentum.to_array());
+        row.extend(s.angular_momentum.to_array());
+        for (_, f) in &s.wall_forces {
+            row.extend(f.to_array());
+        }
+        Ok(self.writer.row(&row)?)
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.writer.path().display().to_string()]
+    }
+}
+
+/// trajectory.xyz of a rigid run: the spheres of every body.
+pub struct SphereTrajectory {
+    writer: XyzWriter,
+    every: u64,
+}
+
+impl Observer<RigidDynamics> for SphereTrajectory {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, d: &RigidDynamics, _: &RigidSample) -> Result<(), MdError> {
+        Ok(self.writer.write(&sphere_frame(&d.bodies))?)
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.writer.path().display().to_string()]
+    }
+}
+
+/// The spheres of every body as an extended-XYZ frame: world positions,
+/// velocities v + ω × (c − x), radii; species `B<kind>`.
+pub fn sphere_frame(b: &RigidBodies) -> Frame {
+    let mut world = super::interaction::WorldFrame::default();
+    world.update(b);
+    let positions: Vec<[f64; 3]> = world.sphere_centre.iter().map(|c| c.to_array()).collect();
+    let velocities: Vec<[f64; 3]> = world
+        .sphere_centre
+        .iter()
+        .zip(&world.sphere_body)
+        .map(|(c, &k)| {
+            let k = k as usize;
+            (b.velocity[k] + b.omega[k].cross(*c - b.position[k])).to_array()
+        })
+        .collect();
+    let (cell, origin) = Frame::bounding_cell(&positions, &world.sphere_radius, 1.0);
+    Frame {
+        time: b.time,
+        cell,
+        origin,
+        pbc: [false; 3],
+        species: world
+            .sphere_body
+            .iter()
+            .map(|k| format!("B{}", b.kind[*k as usize]))
+            .collect(),
+        positions,
+        velocities,
+        radii: world.sphere_radius.clone(),
+    }
+}
+
+/// What a rigid run did.
+#[derive(Debug, Clone)]
+pub struct Report {
+    pub bodies: usize,
+    pub spheres: usize,
+    pub steps: u64,
+    pub time: f64,
+    pub wall_seconds: f64,
+    pub kinetic_energy: f64,
+    pub potential_energy: f64,
+    pub linear_momentum: DVec3,
+    pub angular_momentum: DVec3,
+    /// The force on each wall at the last step.
+    pub wall_forces: Vec<(String, DVec3)>,
+    pub files: Vec<PathBuf>,
+    pub seed: u64,
+    pub dt: f64,
+    /// The spheres at the end (for a picture).
+    pub final_frame: Frame,
+}
+
+/// Runs a rigid scene: `text` is the TOML, `file_label` locates errors and
+/// goes into the provenance headers, `options` replace the scene's seed,
+/// output folder, time step or run length. Writes `observables.csv` and,
+/// with `trajectory_every` > 0, `trajectory.xyz` (the spheres). Calls
+/// `progress(step, last step, time)` after every step.
+pub fn run_rigid_scene(
+    text: &str,
+    file_label: &str,
+    options: &RigidRun,
+    mut progress: impl FnMut(u64, u64, f64),
+) -> Result<Report, MdError> {
+    let scene = RigidScene::parse(text, file_label)?;
+    let mut built = scene.build(text, file_label, options.seed)?;
+    if let Some(dt) = options.dt {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(
+                ParseError::new(file_label, 0, format!("time step {dt}: must be > 0")).into(),
+            );
+        }
+        built.steps = match scene.run.get_ref().until {
+            Some(t) => (t / dt).round() as u64,
+            None => built.steps,
+        };
+        built.dt = dt;
+    }
+    if let Some(n) = options.steps {
+        built.steps = n;
+    } else if let Some(t) = options.until {
+        built.steps = (t / built.dt).round() as u64;
+    }
+    let dir = options
+        .out_dir
+        .clone()
+        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("out"));
+    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
+    let provenance = Provenance {
+        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
+        scene: file_label.to_string(),
+        seed: built.seed,
+    };
+    let walls: Vec<String> = built
+        .contacts
+        .as_ref()
+        .map(|c| c.walls.iter().map(|w| w.name.clone()).collect())
+        .unwrap_or_default();
+    let append = options.resume.is_some();
+    let mut driver = Driver::new();
+    driver.observers.push(Box::new(RigidCsv::create(
+        &dir.join("observables.csv"),
+        &provenance,
+        &walls,
+        scene.output.observables_every.max(1),
+        append,
+    )?));
+    if scene.output.trajectory_every > 0 {
+        let p = dir.join("trajectory.xyz");
+        driver.observers.push(Box::new(SphereTrajectory {
+            writer: if append {
+                XyzWriter::append(&p, provenance.clone())?
+            } else {
+                XyzWriter::create(&p, provenance.clone())?
+            },
+            every: scene.output.trajectory_every,
+        }));
+    }
+    driver.checkpoints = options.checkpoints.clone();
+    driver.sample_at_start = !append;
+    let mut dynamics = RigidDynamics {
+        bodies: built.bodies,
+        frbi: built.frbi,
+        contacts: built.contacts,
+        dt: built.dt,
+        step: 0,
+        last_step: built.steps,
+    };
+    if let Some(cp) = &options.resume {
+        dynamics.resume(cp, file_label)?;
+    }
+    let last_step = built.steps;
+    let report = driver.run(
+        &mut dynamics,
+        |_| last_step,
+        |d| progress(d.step, last_step, d.bodies.time),
+    )?;
+    let b = &dynamics.bodies;
+    let last = report.last;
+    Ok(Report {
+        bodies: b.len(),
+        spheres: (0..b.len()).map(|i| b.template(i).sphere_count()).sum(),
+        steps: last_step,
+        time: b.time,
+        wall_seconds: report.wall.as_secs_f64(),
+        kinetic_energy: last.kinetic_energy(),
+        potential_energy: last.potential_energy,
+        linear_momentum: last.linear_momentum,
+        angular_momentum: last.angular_momentum,
+        wall_forces: last.wall_forces,
+        files: report.files.iter().map(PathBuf::from).collect(),
+        seed: built.seed,
+        dt: built.dt,
+        final_frame: sphere_frame(b),
+    })
+}

@@ -1,0 +1,358 @@
+//! mote's one run loop.
+//!
+//! Every engine moves its state through a [`Propagator`]: the fixed-step
+//! integrators and Brownian dynamics of point particles, the FRBI of rigid
+//! clumps, and the event-driven engine (whose step is one output interval:
+//! it jumps from collision to collision in between). A [`Driver`] steps a
+//! propagator to its last step and owns what every run needs the same way:
+//! the observers that sample it on their schedules, checkpoints, the
+//! detection of a non-finite state, progress, a clean stop on a signal, and
+//! the report the summary is made from.
+//!
+//! The order within a step is fixed, so that a run resumed from a
+//! checkpoint writes exactly what the uninterrupted run would:
+//! advance → check the state → sample the observers due → write the
+//! checkpoint due → progress → stop if a signal asked for it (after writing
+//! a checkpoint of this step when checkpoints are on).
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use mote_io::checkpoint::{self, Checkpoint};
+
+/// Something that moves a state forward step by step.
+pub trait Propagator {
+    /// Whole-system observables of one instant, handed to the observers.
+    type Sample: Clone;
+    /// The engine's error; the driver's own ends come in as [`Stopped`],
+    /// file errors as [`mote_io::IoError`].
+    type Error: From<Stopped> + From<mote_io::IoError>;
+
+    /// Steps done since the state was made (absolute: a resumed run goes
+    /// on counting where its checkpoint stopped, so schedules line up).
+    fn step(&self) -> u64;
+    /// The simulated time.
+    fn time(&self) -> f64;
+    /// Makes ready to step: leap-frog's first forces, the event-driven
+    /// engine's equilibration. `progress` may be called meanwhile.
+    fn prime(&mut self, progress: &mut dyn FnMut(&Self)) -> Result<(), Self::Error> {
+        let _ = progress;
+        Ok(())
+    }
+    /// Advances one step.
+    fn advance(&mut self) -> Result<(), Self::Error>;
+    /// The first particle (index, what is wrong) whose state is not a
+    /// finite number, if any.
+    fn unstable(&self) -> Option<(usize, String)>;
+    /// Measures the observables of now.
+    fn measure(&mut self) -> Self::Sample;
+    /// Puts the state (time, step, tables, what interactions carry) into a
+    /// checkpoint that already holds the run's input and options.
+    fn save(&mut self, cp: &mut Checkpoint) -> Result<(), Self::Error>;
+}
+
+/// Something that samples a run on a schedule (tables, trajectories).
+pub trait Observer<P: Propagator> {
+    /// Sample when the step number is a multiple of this (≥ 1); the first
+    /// and the last step of a run are always sampled.
+    fn every(&self) -> u64;
+    /// Samples the state; `sample` holds the observables of this instant.
+    fn observe(&mut self, state: &P, sample: &P::Sample) -> Result<(), P::Error>;
+    /// Files this observer writes, for the report.
+    fn files(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// Where and how often a run writes its checkpoint.
+#[derive(Debug, Clone)]
+pub struct Checkpoints {
+    /// Steps between checkpoints (≥ 1); one is also written at the last
+    /// step and, when a signal stops the run, at the step it stopped.
+    pub every: u64,
+    pub path: PathBuf,
+    /// The run's input, seed and options; the propagator adds its state.
+    pub template: Checkpoint,
+}
+
+/// How a run ended before its last step.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stopped {
+    /// A position or velocity became a non-finite number; what the
+    /// observers wrote until then stays on disk.
+    Unstable {
+        step: u64,
+        time: f64,
+        particle: usize,
+        what: String,
+    },
+    /// A signal asked the run to stop; it stopped after a whole step.
+    Interrupted { signal: i32, step: u64, time: f64 },
+}
+
+/// What a run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Report<S> {
+    /// Steps taken in this run (not counting those before a resume).
+    pub steps: u64,
+    pub wall: Duration,
+    /// The observables after priming and at the last step.
+    pub initial: S,
+    pub last: S,
+    /// The files the observers and checkpoints wrote.
+    pub files: Vec<String>,
+}
+
+/// The one run loop: observers, checkpoints, interruption, progress.
+pub struct Driver<P: Propagator> {
+    pub observers: Vec<Box<dyn Observer<P>>>,
+    pub checkpoints: Option<Checkpoints>,
+    /// Hand the starting state to the observers (false when resuming: the
+    /// interrupted run already wrote it).
+    pub sample_at_start: bool,
+}
+
+impl<P: Propagator> Default for Driver<P> {
+    fn default() -> Self {
+        Driver {
+            observers: Vec::new(),
+            checkpoints: None,
+            sample_at_start: true,
+        }
+    }
+}
+
+impl<P: Propagator> Driver<P> {
+    /// A run without observers or checkpoints.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Primes `state`, then steps it until step `last_step(state)` (asked
+    /// after priming), calling `progress` after every step.
+    pub fn run(
+        &mut self,
+        state: &mut P,
+        last_step: impl FnOnce(&P) -> u64,
+        mut progress: impl FnMut(&P),
+    ) -> Result<Report<P::Sample>, P::Error> {
+        let start = Instant::now();
+        state.prime(&mut progress)?;
+        let first = state.step();
+        let last_step = last_step(state);
+        let initial = state.measure();
+        if self.sample_at_start {
+            for o in &mut self.observers {
+                o.observe(state, &initial)?;
+            }
+        }
+        let mut last = None;
+        while state.step() < last_step {
+            state.advance()?;
+            let step = state.step();
+            if let Some((particle, what)) = state.unstable() {
+                return Err(Stopped::Unstable {
+                    step,
+                    time: state.time(),
+                    particle,
+                    what,
+                }
+                .into());
+            }
+            let end = step >= last_step;
+            let due = |o: &dyn Observer<P>| end || step.is_multiple_of(o.every().max(1));
+            if self.observers.iter().any(|o| due(o.as_ref())) {
+                let sample = state.measure();
+                for o in &mut self.observers {
+                    if due(o.as_ref()) {
+                        o.observe(state, &sample)?;
+                    }
+                }
+                last = Some(sample);
+            }
+            let saved = match &self.checkpoints {
+                Some(c) if end || step.is_multiple_of(c.every.max(1)) => {
+                    Self::save(c, state)?;
+                    true
+                }
+                _ => false,
+            };
+            progress(state);
+            if let Some(signal) = mote_io::system::stop_requested() {
+                if !end {
+                    if let Some(c) = self.checkpoints.as_ref().filter(|_| !saved) {
+                        Self::save(c, state)?;
+                    }
+                    return Err(Stopped::Interrupted {
+                        signal,
+                        step,
+                        time: state.time(),
+                    }
+                    .into());
+                }
+            }
+        }
+        let last = match last {
+            Some(s) => s,
+            None => initial.clone(),
+        };
+        let mut files: Vec<String> = self.observers.iter().flat_map(|o| o.files()).collect();
+        if let Some(c) = &self.checkpoints {
+            files.push(c.path.display().to_string());
+        }
+        Ok(Report {
+            steps: state.step() - first,
+            wall: start.elapsed(),
+            initial,
+            last,
+            files,
+        })
+    }
+
+    fn save(c: &Checkpoints, state: &mut P) -> Result<(), P::Error> {
+        let mut cp = c.template.clone();
+        state.save(&mut cp)?;
+        Ok(checkpoint::write(&c.path, &cp)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// x' = −x by explicit Euler: x_{k+1} = (1 − h) x_k.
+    struct Decay {
+        x: f64,
+        h: f64,
+        step: u64,
+    }
+
+    #[derive(Debug)]
+    #[allow(dead_code)] // read through Debug when a test fails
+    enum DecayError {
+        Stopped(Stopped),
+        Io(mote_io::IoError),
+    }
+    impl From<Stopped> for DecayError {
+        fn from(s: Stopped) -> Self {
+            DecayError::Stopped(s)
+        }
+    }
+    impl From<mote_io::IoError> for DecayError {
+        fn from(e: mote_io::IoError) -> Self {
+            DecayError::Io(e)
+        }
+    }
+
+    impl Propagator for Decay {
+        type Sample = f64;
+        type Error = DecayError;
+        fn step(&self) -> u64 {
+            self.step
+        }
+        fn time(&self) -> f64 {
+            self.step as f64 * self.h
+        }
+        fn advance(&mut self) -> Result<(), DecayError> {
+            self.x *= 1.0 - self.h;
+            self.step += 1;
+            Ok(())
+        }
+        fn unstable(&self) -> Option<(usize, String)> {
+            (!self.x.is_finite()).then(|| (0, format!("x = {}", self.x)))
+        }
+        fn measure(&mut self) -> f64 {
+            self.x
+        }
+        fn save(&mut self, cp: &mut Checkpoint) -> Result<(), DecayError> {
+            cp.step = self.step;
+            cp.time = self.time();
+            cp.positions = vec![[self.x, 0.0, 0.0]];
+            cp.velocities = vec![[-self.x, 0.0, 0.0]];
+            Ok(())
+        }
+    }
+
+    /// Records the steps it saw.
+    struct Steps(u64, std::rc::Rc<std::cell::RefCell<Vec<u64>>>);
+    impl Observer<Decay> for Steps {
+        fn every(&self) -> u64 {
+            self.0
+        }
+        fn observe(&mut self, s: &Decay, _: &f64) -> Result<(), DecayError> {
+            self.1.borrow_mut().push(s.step);
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn observers_see_the_start_their_schedule_and_the_last_step() {
+        let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let mut d = Driver::new();
+        d.observers.push(Box::new(Steps(4, seen.clone())));
+        let mut p = Decay {
+            x: 1.0,
+            h: 0.1,
+            step: 0,
+        };
+        let r = d.run(&mut p, |_| 10, |_| {}).unwrap();
+        assert_eq!(*seen.borrow(), vec![0, 4, 8, 10]);
+        assert_eq!(r.steps, 10);
+        assert_eq!(r.initial, 1.0);
+        assert_eq!(r.last, (0..10).fold(1.0, |x, _| x * 0.9));
+    }
+
+    #[test]
+    fn a_non_finite_state_stops_the_run_at_its_step() {
+        let mut p = Decay {
+            x: 1.0,
+            h: f64::INFINITY,
+            step: 0,
+        };
+        let e = Driver::new().run(&mut p, |_| 10, |_| {}).unwrap_err();
+        match e {
+            DecayError::Stopped(Stopped::Unstable { step, particle, .. }) => {
+                assert_eq!((step, particle), (1, 0))
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn checkpoints_follow_their_schedule_and_the_last_step() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.mote");
+        let mut d = Driver::<Decay>::new();
+        d.checkpoints = Some(Checkpoints {
+            every: 3,
+            path: path.clone(),
+            template: Checkpoint {
+                seed: 9,
+                ..Checkpoint::default()
+            },
+        });
+        let mut p = Decay {
+            x: 1.0,
+            h: 0.5,
+            step: 0,
+        };
+        let mut written = Vec::new();
+        d.run(
+            &mut p,
+            |_| 7,
+            |s| {
+                if path.exists() {
+                    let cp = checkpoint::read(&path).unwrap();
+                    written.push((s.step, cp.step));
+                }
+            },
+        )
+        .unwrap();
+        assert_eq!(written, vec![(3, 3), (4, 3), (5, 3), (6, 6), (7, 7)]);
+        let cp = checkpoint::read(&path).unwrap();
+        assert_eq!(
+            (cp.step, cp.seed, cp.positions[0][0]),
+            (7, 9, 0.5f64.powi(7))
+        );
+    }
+}
