@@ -118,9 +118,7 @@ impl BrownianStepper {
             angular_velocity: &p.angular_velocity,
             dipole: &p.dipole,
         };
-        for interaction in &mut ff.interactions {
-            interaction.add_forces_and_torques(&state, &spin, &mut self.force, &mut self.torque);
-        }
+        ff.add_forces_and_torques(&state, &spin, &mut self.force, &mut self.torque);
     }
 
     /// Advances the system by one step h (004 Eqs. 15–16 with noise).

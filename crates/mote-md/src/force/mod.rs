@@ -23,6 +23,7 @@ pub use uniform::UniformField;
 use glam::DVec3;
 
 use crate::boundary::Boundary;
+use crate::neighbor::VerletList;
 use crate::particles::System;
 
 /// The per-step context of every interaction: a read-only view of the
@@ -42,6 +43,10 @@ pub struct State<'a> {
     pub charge: &'a [f64],
     /// The simulation box.
     pub boundary: &'a Boundary,
+    /// The force field's shared half neighbour list, up to date for
+    /// `position` ([`ForceField`] sets it; `None` from the constructors:
+    /// an interaction then uses a list of its own).
+    pub neighbours: Option<&'a VerletList>,
 }
 
 /// The box of a state given without one.
@@ -63,6 +68,7 @@ impl<'a> State<'a> {
             radius: &[],
             charge: &[],
             boundary: &OPEN_SPACE,
+            neighbours: None,
         }
     }
 
@@ -78,6 +84,7 @@ impl<'a> State<'a> {
             radius: &p.radius,
             charge: &p.charge,
             boundary: &sys.boundary,
+            neighbours: None,
         }
     }
 
@@ -168,6 +175,11 @@ pub trait Interaction: Send {
     fn virial(&self) -> f64 {
         0.0
     }
+    /// The (cut-off, skin) of the pairs this interaction reads from the
+    /// shared neighbour list ([`State::neighbours`]); `None` if it reads none.
+    fn neighbour_reach(&self) -> Option<(f64, f64)> {
+        None
+    }
 }
 
 /// (force, torque) buffers of the parallel blocks of a half-list pair loop.
@@ -193,12 +205,23 @@ pub(crate) fn add_block_buffers(force: &mut [DVec3], torque: &mut [DVec3], buffe
         });
 }
 
-/// All interactions of a run.
+/// `state` with the shared list.
+fn sharing<'a>(state: &State<'a>, neighbours: &'a Option<(VerletList, usize)>) -> State<'a> {
+    State {
+        neighbours: neighbours.as_ref().map(|n| &n.0),
+        ..*state
+    }
+}
+
+/// All interactions of a run, and the one neighbour list the short-range
+/// ones share.
 #[derive(Default)]
 pub struct ForceField {
     pub interactions: Vec<Box<dyn Interaction>>,
     force: Vec<DVec3>,
     torque: Vec<DVec3>,
+    /// The shared half list and the number of interactions it was made for.
+    neighbours: Option<(VerletList, usize)>,
 }
 
 impl ForceField {
@@ -219,9 +242,47 @@ impl ForceField {
         self.interactions.is_empty()
     }
 
+    /// Brings the shared neighbour list up to date at `state`, making it
+    /// first from the interactions' reaches (c_k, s_k): it holds the pairs
+    /// within R = max(c_k + s_k) and is rebuilt when a particle has moved
+    /// half of R − max c_k, so every interaction sees all its pairs. One
+    /// build and one displacement check per evaluation, however many
+    /// interactions read it.
+    fn refresh_neighbours(&mut self, state: &State) {
+        let count = self.interactions.len();
+        if self
+            .neighbours
+            .as_ref()
+            .is_none_or(|(_, made_for)| *made_for != count)
+        {
+            let reaches: Vec<(f64, f64)> = self
+                .interactions
+                .iter()
+                .filter_map(|i| i.neighbour_reach())
+                .collect();
+            self.neighbours = if reaches.is_empty() {
+                None
+            } else {
+                let cutoff = reaches.iter().map(|r| r.0).fold(0.0, f64::max);
+                let reach = reaches.iter().map(|r| r.0 + r.1).fold(0.0, f64::max);
+                Some((VerletList::half(cutoff, reach - cutoff), count))
+            };
+        }
+        if let Some((list, _)) = &mut self.neighbours {
+            list.update(state.position, state.boundary);
+        }
+    }
+
+    /// The shared neighbour list as of the last evaluation, if any.
+    pub fn neighbours(&self) -> Option<&VerletList> {
+        self.neighbours.as_ref().map(|n| &n.0)
+    }
+
     /// Accelerations a_i = F_i / m_i, zero along fixed axes (`mobility`).
     pub fn accelerations(&mut self, state: &State, mobility: &[DVec3], acc: &mut [DVec3]) {
         let n = state.position.len();
+        self.refresh_neighbours(state);
+        let state = &sharing(state, &self.neighbours);
         self.force.clear();
         self.force.resize(n, DVec3::ZERO);
         for interaction in &mut self.interactions {
@@ -250,13 +311,16 @@ impl ForceField {
         alpha: &mut [DVec3],
     ) {
         let n = state.position.len();
-        self.force.clear();
-        self.force.resize(n, DVec3::ZERO);
-        self.torque.clear();
-        self.torque.resize(n, DVec3::ZERO);
-        for interaction in &mut self.interactions {
-            interaction.add_forces_and_torques(state, spin, &mut self.force, &mut self.torque);
-        }
+        let (mut force, mut torque) = (
+            std::mem::take(&mut self.force),
+            std::mem::take(&mut self.torque),
+        );
+        force.clear();
+        force.resize(n, DVec3::ZERO);
+        torque.clear();
+        torque.resize(n, DVec3::ZERO);
+        self.add_forces_and_torques(state, spin, &mut force, &mut torque);
+        (self.force, self.torque) = (force, torque);
         for i in 0..n {
             acc[i] = self.force[i] / state.mass[i] * particles.mobility[i];
             alpha[i] = if particles.rotates(i) {
@@ -267,6 +331,22 @@ impl ForceField {
         }
     }
 
+    /// Adds every interaction's forces and torques at `state` to `force`
+    /// and `torque` (through the shared neighbour list).
+    pub fn add_forces_and_torques(
+        &mut self,
+        state: &State,
+        spin: &Spin,
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+    ) {
+        self.refresh_neighbours(state);
+        let state = &sharing(state, &self.neighbours);
+        for interaction in &mut self.interactions {
+            interaction.add_forces_and_torques(state, spin, force, torque);
+        }
+    }
+
     /// Total virial of the last force evaluation.
     pub fn virial(&self) -> f64 {
         self.interactions.iter().map(|i| i.virial()).sum()
@@ -274,6 +354,8 @@ impl ForceField {
 
     /// Total potential energy, and its parts by interaction name.
     pub fn potential_energy(&mut self, state: &State) -> (f64, Vec<(&'static str, f64)>) {
+        self.refresh_neighbours(state);
+        let state = &sharing(state, &self.neighbours);
         let parts: Vec<(&'static str, f64)> = self
             .interactions
             .iter_mut()

@@ -366,9 +366,29 @@ impl DipoleDipole {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) -> f64 {
+        self.forces_through(pos, dipoles, None, force, torque)
+    }
+
+    /// The force field's shared list, when the state brings one made in
+    /// this interaction's box; `None`: the own list.
+    fn shared<'a>(&self, state: &State<'a>) -> Option<&'a VerletList> {
+        state
+            .neighbours
+            .filter(|_| *state.boundary == self.boundary)
+    }
+
+    /// [`Self::forces_and_torques`] through `shared` (cut-off mode) or the own list.
+    fn forces_through(
+        &mut self,
+        pos: &[DVec3],
+        dipoles: &[DVec3],
+        shared: Option<&VerletList>,
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+    ) -> f64 {
         assert_eq!(pos.len(), dipoles.len(), "one dipole per particle");
         self.virial = if self.cutoff.is_finite() {
-            self.cut_off_forces(pos, dipoles, force, torque)
+            self.cut_off_forces(pos, dipoles, shared, force, torque)
         } else {
             self.all_pairs_forces(pos, dipoles, force, torque)
         };
@@ -377,6 +397,15 @@ impl DipoleDipole {
 
     /// The potential energy at positions `pos` with moments `dipoles`.
     pub fn energy(&mut self, pos: &[DVec3], dipoles: &[DVec3]) -> f64 {
+        self.energy_through(pos, dipoles, None)
+    }
+
+    fn energy_through(
+        &mut self,
+        pos: &[DVec3],
+        dipoles: &[DVec3],
+        shared: Option<&VerletList>,
+    ) -> f64 {
         assert_eq!(pos.len(), dipoles.len(), "one dipole per particle");
         let kern = self.kernel();
         let n = pos.len();
@@ -398,10 +427,12 @@ impl DipoleDipole {
                 .collect();
             return per_i.iter().sum();
         }
-        self.list.update(pos, &self.boundary);
+        if shared.is_none() {
+            self.list.update(pos, &self.boundary);
+        }
         let image = self.boundary.image();
         let reach2 = kern.reach2();
-        let list = &self.list;
+        let list = shared.unwrap_or(&self.list);
         let per_i: Vec<f64> = (0..n)
             .into_par_iter()
             .with_min_len(512)
@@ -427,11 +458,14 @@ impl DipoleDipole {
         &mut self,
         pos: &[DVec3],
         dipoles: &[DVec3],
+        shared: Option<&VerletList>,
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) -> f64 {
         let n = pos.len();
-        self.list.update(pos, &self.boundary);
+        if shared.is_none() {
+            self.list.update(pos, &self.boundary);
+        }
         let kern = self.kernel();
         let reach2 = kern.reach2();
         let image = self.boundary.image();
@@ -439,7 +473,7 @@ impl DipoleDipole {
         let per_block = n.div_ceil(blocks);
         self.buffers.resize_with(blocks, Default::default);
         let mut buffers = std::mem::take(&mut self.buffers);
-        let list = &self.list;
+        let list = shared.unwrap_or(&self.list);
         let virials: Vec<f64> = buffers
             .par_iter_mut()
             .enumerate()
@@ -658,7 +692,8 @@ impl Interaction for DipoleDipole {
         let dipoles = std::mem::take(&mut self.dipoles);
         if dipoles.len() == state.position.len() {
             let mut torque = vec![DVec3::ZERO; dipoles.len()];
-            self.forces_and_torques(state.position, &dipoles, force, &mut torque);
+            let shared = self.shared(state);
+            self.forces_through(state.position, &dipoles, shared, force, &mut torque);
         }
         self.dipoles = dipoles;
     }
@@ -675,14 +710,16 @@ impl Interaction for DipoleDipole {
         torque: &mut [DVec3],
     ) {
         self.set_dipoles(spin.dipole);
-        self.forces_and_torques(state.position, spin.dipole, force, torque);
+        let shared = self.shared(state);
+        self.forces_through(state.position, spin.dipole, shared, force, torque);
     }
 
     /// Σ_{i<j} U_ij with the dipoles of the last force evaluation (0 before the first).
     fn potential_energy(&mut self, state: &State) -> f64 {
         let dipoles = std::mem::take(&mut self.dipoles);
         let u = if dipoles.len() == state.position.len() {
-            self.energy(state.position, &dipoles)
+            let shared = self.shared(state);
+            self.energy_through(state.position, &dipoles, shared)
         } else {
             0.0
         };
@@ -692,6 +729,12 @@ impl Interaction for DipoleDipole {
 
     fn virial(&self) -> f64 {
         self.virial
+    }
+
+    fn neighbour_reach(&self) -> Option<(f64, f64)> {
+        self.cutoff
+            .is_finite()
+            .then_some((self.list.cutoff, self.list.skin))
     }
 }
 

@@ -1,12 +1,13 @@
 //! Contacts between spheres, through a half Verlet list whose every entry
-//! carries the history of that pair's contact.
+//! carries the history of that pair's contact. The list is the force
+//! field's shared one when the step's [`State`] brings it (every run built
+//! from a scene), else the interaction's own.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::history::PairHistories;
 use super::law::{ContactLaw, History};
-use crate::boundary::Boundary;
 use crate::force::{add_block_buffers, BlockBuffers, Interaction, Spin, State};
 use crate::neighbor::VerletList;
 
@@ -18,8 +19,11 @@ use crate::neighbor::VerletList;
 #[derive(Debug, Clone)]
 pub struct GranularContacts {
     pub law: ContactLaw,
+    /// The list used when the state brings none (direct callers).
     pub list: VerletList,
     pairs: PairHistories,
+    /// The build of the list the histories were last carried to.
+    carried_to_build: u64,
     last_time: Option<f64>,
     /// One (force, torque) buffer per extra block of particles.
     buffers: BlockBuffers,
@@ -35,6 +39,7 @@ impl GranularContacts {
             law,
             list: VerletList::half(2.0 * r_max, skin),
             pairs: PairHistories::default(),
+            carried_to_build: 0,
             last_time: None,
             buffers: Vec::new(),
             contacts: 0,
@@ -52,10 +57,18 @@ impl GranularContacts {
         self.pairs.get(i, j)
     }
 
-    /// Refreshes the list; after a rebuild the histories move with it.
-    fn refresh(&mut self, pos: &[DVec3], boundary: &Boundary) {
-        if self.list.update(pos, boundary) || self.pairs.len() != self.list.neighbors.len() {
-            self.pairs.carry_to(&self.list.start, &self.list.neighbors);
+    /// Brings the own list up to date when the state brings no shared one.
+    fn refresh_own(&mut self, state: &State) {
+        if state.neighbours.is_none() {
+            self.list.update(state.position, state.boundary);
+        }
+    }
+
+    /// After a rebuild of `list` the histories move with it.
+    fn follow(pairs: &mut PairHistories, carried_to_build: &mut u64, list: &VerletList) {
+        if list.builds != *carried_to_build || pairs.len() != list.neighbors.len() {
+            pairs.carry_to(&list.start, &list.neighbors);
+            *carried_to_build = list.builds;
         }
     }
 
@@ -66,9 +79,10 @@ impl GranularContacts {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        let pos = state.position;
-        let n = pos.len();
-        self.refresh(pos, state.boundary);
+        let n = state.position.len();
+        self.refresh_own(state);
+        let list = state.neighbours.unwrap_or(&self.list);
+        Self::follow(&mut self.pairs, &mut self.carried_to_build, list);
         let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
         self.last_time = Some(state.time);
 
@@ -88,7 +102,7 @@ impl GranularContacts {
             let mut taken = 0usize;
             for b in 0..blocks {
                 let end_i = ((b + 1) * per_block).min(n);
-                let end = self.list.start[end_i] as usize;
+                let end = list.start[end_i] as usize;
                 let (head, tail) = rest.split_at_mut(end - taken);
                 let (head_touch, tail_touch) = rest_touch.split_at_mut(end - taken);
                 history_blocks.push((head, head_touch));
@@ -115,7 +129,7 @@ impl GranularContacts {
             .map(|(b, ((f, t), (hist, touch)))| {
                 let first = (b * per_block).min(n);
                 let last = ((b + 1) * per_block).min(n);
-                this.block(state, omega, first..last, dt, f, t, hist, touch)
+                this.block(state, list, omega, first..last, dt, f, t, hist, touch)
             })
             .collect();
 
@@ -133,6 +147,7 @@ impl GranularContacts {
     fn block(
         &self,
         state: &State,
+        list: &VerletList,
         omega: &[DVec3],
         range: std::ops::Range<usize>,
         dt: f64,
@@ -146,14 +161,14 @@ impl GranularContacts {
         let mass = state.mass;
         let radius = state.radius;
         let image = state.boundary.image();
-        let offset = self.list.start[range.start] as usize;
+        let offset = list.start[range.start] as usize;
         let mut contacts = 0usize;
         let mut virial = 0.0;
         for i in range {
             let (ri, vi, wi, radi, mi) = (pos[i], vel[i], omega[i], radius[i], mass[i]);
             let (mut fi, mut ti) = (DVec3::ZERO, DVec3::ZERO);
-            let lo = self.list.start[i] as usize;
-            for (k, &j) in self.list.of(i).iter().enumerate() {
+            let lo = list.start[i] as usize;
+            for (k, &j) in list.of(i).iter().enumerate() {
                 let j = j as usize;
                 let slot = lo + k - offset;
                 let d = image.apply(ri - pos[j]);
@@ -249,12 +264,13 @@ impl Interaction for GranularContacts {
     /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}.
     fn potential_energy(&mut self, state: &State) -> f64 {
         let pos = state.position;
-        self.refresh(pos, state.boundary);
+        self.refresh_own(state);
+        let list = state.neighbours.unwrap_or(&self.list);
         let image = state.boundary.image();
         let radius = state.radius;
         let mut u = 0.0;
         for i in 0..pos.len() {
-            for &j in self.list.of(i) {
+            for &j in list.of(i) {
                 let j = j as usize;
                 let reach = radius[i] + radius[j];
                 let r = image.apply(pos[i] - pos[j]).length();
@@ -270,5 +286,9 @@ impl Interaction for GranularContacts {
 
     fn virial(&self) -> f64 {
         self.virial
+    }
+
+    fn neighbour_reach(&self) -> Option<(f64, f64)> {
+        Some((self.list.cutoff, self.list.skin))
     }
 }
