@@ -7,6 +7,7 @@ use crate::integrate::Stepper;
 use crate::observe::Observables;
 use crate::particles::System;
 use crate::thermostat::Thermostat;
+use glam::DVec3;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 /// How long to run.
@@ -146,16 +147,9 @@ impl mote_run::Propagator for Simulation {
 
     fn unstable(&self) -> Option<(usize, String)> {
         let p = &self.system.particles;
-        (0..p.len()).find_map(|i| {
-            let what = if !p.position[i].is_finite() {
-                "a non-finite position"
-            } else if !p.velocity[i].is_finite() {
-                "a non-finite velocity"
-            } else {
-                return None;
-            };
-            Some((i, format!("{what} ({} / {})", p.position[i], p.velocity[i])))
-        })
+        let (column, i) = first_non_finite(&[&p.position, &p.velocity])?;
+        let what = ["a non-finite position", "a non-finite velocity"][column];
+        Some((i, format!("{what} ({} / {})", p.position[i], p.velocity[i])))
     }
 
     fn measure(&mut self) -> Observables {
@@ -204,6 +198,24 @@ impl mote_run::Propagator for Simulation {
     }
 }
 
+/// The first (column, particle) whose vector is not finite. A branch-free
+/// pass first (x·0 is 0 for finite x and NaN otherwise, so the sum is NaN
+/// exactly when some component is not finite), the search only then: the
+/// check costs one streaming read per step.
+pub(crate) fn first_non_finite(columns: &[&[DVec3]]) -> Option<(usize, usize)> {
+    let poisoned = columns
+        .iter()
+        .flat_map(|c| c.iter())
+        .fold(DVec3::ZERO, |acc, v| acc + *v * 0.0);
+    if poisoned.is_finite() {
+        return None;
+    }
+    columns
+        .iter()
+        .enumerate()
+        .find_map(|(k, c)| c.iter().position(|v| !v.is_finite()).map(|i| (k, i)))
+}
+
 impl From<mote_run::Stopped> for MdError {
     fn from(s: mote_run::Stopped) -> Self {
         match s {
@@ -222,5 +234,23 @@ impl From<mote_run::Stopped> for MdError {
                 MdError::Interrupted { signal, step, time }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn finds_the_first_non_finite_component_of_any_column() {
+        let a = vec![DVec3::ONE; 5];
+        let mut b = vec![DVec3::splat(1e308); 5];
+        assert_eq!(first_non_finite(&[&a, &b]), None);
+        b[3].y = f64::NAN;
+        b[4].z = f64::INFINITY;
+        assert_eq!(first_non_finite(&[&a, &b]), Some((1, 3)));
+        let mut c = a.clone();
+        c[2].x = f64::NEG_INFINITY;
+        assert_eq!(first_non_finite(&[&c, &b]), Some((0, 2)));
     }
 }

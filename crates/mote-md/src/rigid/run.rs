@@ -93,22 +93,20 @@ impl Propagator for RigidDynamics {
 
     fn unstable(&self) -> Option<(usize, String)> {
         let b = &self.bodies;
-        (0..b.len()).find_map(|i| {
-            let what = if !b.position[i].is_finite() {
-                "a non-finite position"
-            } else if !b.velocity[i].is_finite() || !b.omega[i].is_finite() {
-                "a non-finite velocity"
-            } else {
-                return None;
-            };
-            Some((
-                i,
-                format!(
-                    "{what} (x {}, v {}, ω {})",
-                    b.position[i], b.velocity[i], b.omega[i]
-                ),
-            ))
-        })
+        let (column, i) =
+            crate::simulation::first_non_finite(&[&b.position, &b.velocity, &b.omega])?;
+        let what = [
+            "a non-finite position",
+            "a non-finite velocity",
+            "a non-finite spin",
+        ][column];
+        Some((
+            i,
+            format!(
+                "{what} (x {}, v {}, ω {})",
+                b.position[i], b.velocity[i], b.omega[i]
+            ),
+        ))
     }
 
     fn measure(&mut self) -> RigidSample {
