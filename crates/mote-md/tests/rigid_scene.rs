@@ -59,7 +59,7 @@ fn magnet_example_runs() {
     let table = mote_io::csv::read_table(&dir.path().join("observables.csv")).unwrap();
     let e = table.column("total_energy").unwrap();
     let px = table.column("px").unwrap();
-    let ly = table.column("ly").unwrap();
+    let ly = table.column("Ly").unwrap();
     let spread = |v: &[f64]| {
         v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)
     };

@@ -185,7 +185,8 @@ impl RigidDynamics {
 
 /// observables.csv of a rigid run: time, kinetic (translational +
 /// rotational), translational, rotational, potential and total energy,
-/// momentum, angular momentum, the force on each wall.
+/// momentum, angular momentum (the first twelve of the point-particle
+/// engine's columns, by the same names), the force on each wall.
 pub struct RigidCsv {
     writer: CsvWriter,
     every: u64,
@@ -199,23 +200,11 @@ impl RigidCsv {
         every: u64,
         append: bool,
     ) -> Result<Self, MdError> {
-        let mut columns: Vec<String> = [
-            "time",
-            "kinetic_energy",
-            "translational_energy",
-            "rotational_energy",
-            "potential_energy",
-            "total_energy",
-            "px",
-            "py",
-            "pz",
-            "lx",
-            "ly",
-            "lz",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+        // The point-particle engine's words for the same quantities.
+        let mut columns: Vec<String> = crate::Observables::COLUMNS[..12]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         for w in walls {
             for a in ["x", "y", "z"] {
                 columns.push(format!("{w}.f{a}"));
