@@ -197,6 +197,98 @@ impl Default for OutputSection {
     }
 }
 
+/// The keys of `[event_driven]`: what the hard spheres or disks are and
+/// how they start. Everything else a scene says is shared by every engine.
+pub const EVENT_DRIVEN_KEYS: &[&str] = &[
+    "dimension",
+    "n",
+    "packing_fraction",
+    "box",
+    "boundary",
+    "radius",
+    "mass",
+    "large_fraction",
+    "size_ratio",
+    "placement",
+    "temperature",
+    "speed",
+    "particles",
+    "file",
+    "check_overlaps",
+];
+
+/// Where a scene gave its hard-sphere keys.
+enum Hoisted {
+    /// In `[event_driven]` (or nowhere).
+    Table,
+    /// At the top level, as the first scene format did (deprecated).
+    TopLevel(Vec<String>),
+}
+
+/// Lifts the keys of `[event_driven]` to the top level, where [`Scene`]
+/// reads them; the items keep their spans, so errors still name the line
+/// in the file. Top-level hard-sphere keys beside an `[event_driven]`
+/// table, and keys the table does not know, are refused at their line.
+fn hoist_event_driven(
+    root: &mut toml_edit::Table,
+    source: &mote_io::Source,
+) -> Result<Hoisted, EdmdError> {
+    let refuse = |item: &toml_edit::Item, key: &toml_edit::Key, message: String| {
+        let span = key.span().or_else(|| item.span());
+        EdmdError::Scene {
+            file: source.file.to_string(),
+            line: span.map_or(1, |s| source.line_of(s.start)),
+            message,
+        }
+    };
+    let top_level: Vec<String> = EVENT_DRIVEN_KEYS
+        .iter()
+        .filter(|k| root.contains_key(k))
+        .map(|k| k.to_string())
+        .collect();
+    let Some(item) = root.remove("event_driven") else {
+        return Ok(if top_level.is_empty() {
+            Hoisted::Table
+        } else {
+            Hoisted::TopLevel(top_level)
+        });
+    };
+    if let Some(k) = top_level.first() {
+        let (key, item) = root.get_key_value(k).expect("listed above");
+        return Err(refuse(
+            item,
+            key,
+            format!("`{k}` belongs in [event_driven], which this scene also has: move it there"),
+        ));
+    }
+    let Some(table) = item.into_table().ok() else {
+        return Err(EdmdError::Scene {
+            file: source.file.to_string(),
+            line: 1,
+            message: "`event_driven` must be a table: [event_driven]".into(),
+        });
+    };
+    for (key, item) in table.iter() {
+        if !EVENT_DRIVEN_KEYS.contains(&key) {
+            let k = table.key(key).expect("iterated");
+            let shared = ["title", "seed", "run", "output"].contains(&key);
+            let hint = if shared {
+                format!("`{key}` is shared by every engine: give it at the top level, outside [event_driven]")
+            } else {
+                format!(
+                    "unknown key `{key}` in [event_driven]; it takes {}",
+                    EVENT_DRIVEN_KEYS.join(", ")
+                )
+            };
+            return Err(refuse(item, k, hint));
+        }
+    }
+    for (key, item) in table {
+        root.insert(&key, item);
+    }
+    Ok(Hoisted::Table)
+}
+
 /// Measured time of a scene that gives no length.
 const DEFAULT_TIME: f64 = 10.0;
 
@@ -254,14 +346,23 @@ pub fn example(name: &str) -> Option<&'static str> {
 impl Scene {
     /// Parses a scene; `file` names it in error messages.
     pub fn parse(text: &str, file: &str) -> Result<Self, EdmdError> {
-        let scene: Scene = toml::from_str(text).map_err(|e| EdmdError::Scene {
+        let source = mote_io::Source::new(file, text);
+        let at = |span: Option<std::ops::Range<usize>>, message: &str| EdmdError::Scene {
             file: file.to_string(),
-            line: e
-                .span()
-                .map_or(1, |s| mote_io::Source::new(file, text).line_of(s.start)),
-            message: e.message().trim().to_string(),
-        })?;
-        let mut scene = scene;
+            line: span.map_or(1, |s| source.line_of(s.start)),
+            message: message.trim().to_string(),
+        };
+        let document = toml_edit::ImDocument::parse(text).map_err(|e| at(e.span(), e.message()))?;
+        let mut root = document.into_table();
+        let hoisted = hoist_event_driven(&mut root, &source)?;
+        let mut scene: Scene = toml_edit::de::from_document(toml_edit::DocumentMut::from(root))
+            .map_err(|e| at(e.span(), e.message()))?;
+        if let Hoisted::TopLevel(keys) = hoisted {
+            scene.notes.push(format!(
+                "note: the hard-sphere keys at the top level (`{}`) are deprecated and go in one release: move them into [event_driven] (see docs/edmd.md)",
+                keys.join("`, `")
+            ));
+        }
         scene.resolve(text, file)?;
         scene.validate(text, file)?;
         Ok(scene)
@@ -726,7 +827,8 @@ pub use crate::run::{frame, run_scene, Outputs, Run};
 mod tests {
     use super::*;
 
-    const SYSTEM: &str = "dimension = 3\nn = 500\npacking_fraction = 0.2\n";
+    const SYSTEM: &str = "[event_driven]\ndimension = 3\nn = 500\npacking_fraction = 0.2\n";
+    const TOP_LEVEL: &str = "dimension = 3\nn = 500\npacking_fraction = 0.2\n";
 
     /// The shared `[run]`/`[output]` sections and the first format's
     /// top-level keys describe the same run; only the old keys carry notes.
@@ -738,7 +840,7 @@ mod tests {
         )
         .unwrap();
         let old = Scene::parse(
-            &format!("{SYSTEM}equilibrate = 2.0\ntime = 4.0\noutput_interval = 0.5\nobservables = \"observables.csv\"\n"),
+            &format!("{TOP_LEVEL}equilibrate = 2.0\ntime = 4.0\noutput_interval = 0.5\nobservables = \"observables.csv\"\n"),
             "old.toml",
         )
         .unwrap();
@@ -752,8 +854,45 @@ mod tests {
             );
         }
         assert!(new.notes.is_empty());
-        assert_eq!(old.notes.len(), 2, "{:?}", old.notes);
-        assert!(old.notes[0].contains("[run] until = 6, equilibrate = 2"));
+        assert_eq!(old.notes.len(), 3, "{:?}", old.notes);
+        assert!(old.notes[0].contains("(`dimension`, `n`, `packing_fraction`)"));
+        assert!(old.notes[1].contains("[run] until = 6, equilibrate = 2"));
+    }
+
+    /// `[event_driven]` and the first format's top-level keys describe the
+    /// same spheres; errors inside the table name their line in the file.
+    #[test]
+    fn event_driven_table_and_top_level_keys_give_the_same_spheres() {
+        let table = Scene::parse(SYSTEM, "table.toml").unwrap();
+        let top = Scene::parse(TOP_LEVEL, "top.toml").unwrap();
+        for s in [&table, &top] {
+            assert_eq!(
+                (s.dimension, s.n, s.packing_fraction),
+                (3, Some(500), Some(0.2))
+            );
+        }
+        assert!(table.notes.is_empty());
+        assert_eq!(top.notes.len(), 1);
+        let e = |text: &str| Scene::parse(text, "bad.toml").unwrap_err().to_string();
+        assert_eq!(
+            e(&format!("{SYSTEM}placement = \"hexagonal\"\n")),
+            "bad.toml:5: unknown variant `hexagonal`, expected one of `fcc`, `cubic`, `random`"
+        );
+        assert_eq!(
+            e(&format!("seed = 3\nn = 10\n{SYSTEM}")),
+            "bad.toml:2: `n` belongs in [event_driven], which this scene also has: move it there"
+        );
+        assert_eq!(
+            e(&format!("{SYSTEM}seed = 3\n")),
+            "bad.toml:5: `seed` is shared by every engine: give it at the top level, outside [event_driven]"
+        );
+        assert!(e(&format!("{SYSTEM}\ndensity = 3\n")).starts_with(
+            "bad.toml:6: unknown key `density` in [event_driven]; it takes dimension, n,"
+        ));
+        assert_eq!(
+            e("event_driven = 3\n"),
+            "bad.toml:1: `event_driven` must be a table: [event_driven]"
+        );
     }
 
     #[test]
@@ -770,7 +909,7 @@ mod tests {
 
     #[test]
     fn mixing_old_keys_and_shared_sections_is_refused_at_the_old_key() {
-        let text = format!("{SYSTEM}time = 4.0\n[run]\nuntil = 5.0\n");
+        let text = format!("{TOP_LEVEL}time = 4.0\n[run]\nuntil = 5.0\n");
         let e = Scene::parse(&text, "mixed.toml").unwrap_err().to_string();
         assert_eq!(
             e,
@@ -780,13 +919,13 @@ mod tests {
         let e = Scene::parse(&text, "stepped.toml").unwrap_err().to_string();
         assert_eq!(
             e,
-            "stepped.toml:5: `dt` is for time-stepped engines; event-driven dynamics jumps from collision to collision, with no time step: give [run] until = (end time)"
+            "stepped.toml:6: `dt` is for time-stepped engines; event-driven dynamics jumps from collision to collision, with no time step: give [run] until = (end time)"
         );
         let text = format!("{SYSTEM}[run]\nuntil = 1.0\nequilibrate = 2.0\n");
         let e = Scene::parse(&text, "early.toml").unwrap_err().to_string();
         assert_eq!(
             e,
-            "early.toml:5: [run] until = 1 must be a time at or after equilibrate = 2"
+            "early.toml:6: [run] until = 1 must be a time at or after equilibrate = 2"
         );
     }
 }

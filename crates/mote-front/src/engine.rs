@@ -12,25 +12,16 @@ pub enum Engine {
     EventDriven,
 }
 
-/// Top-level keys only an event-driven scene has.
-const EVENT_DRIVEN_KEYS: &[&str] = &[
-    "event_driven",
-    "dimension",
-    "n",
-    "packing_fraction",
-    "placement",
+/// Top-level keys of the first event-driven scene format, beside the
+/// hard-sphere keys `[event_driven]` now holds
+/// ([`mote_edmd::scene::EVENT_DRIVEN_KEYS`]).
+const EVENT_DRIVEN_LEGACY_KEYS: &[&str] = &[
     "output_interval",
     "time",
     "equilibrate",
     "histogram",
     "trajectory",
     "observables",
-    "check_overlaps",
-    "speed",
-    "temperature",
-    "large_fraction",
-    "size_ratio",
-    "particles",
 ];
 
 impl Engine {
@@ -45,7 +36,11 @@ impl Engine {
         };
         if table.contains_key("rigid") {
             Engine::Rigid
-        } else if EVENT_DRIVEN_KEYS.iter().any(|k| table.contains_key(*k))
+        } else if table.contains_key("event_driven")
+            || mote_edmd::scene::EVENT_DRIVEN_KEYS
+                .iter()
+                .chain(EVENT_DRIVEN_LEGACY_KEYS)
+                .any(|k| *k != "box" && table.contains_key(*k))
             || table.get("box").is_some_and(|b| b.is_array())
         {
             Engine::EventDriven
