@@ -105,15 +105,16 @@ impl BrownianStepper {
         }
     }
 
-    /// The forces and torques of every interaction at the current state.
-    fn forces_and_torques(&mut self, sys: &System, ff: &mut ForceField) {
+    /// The forces and torques of every interaction at the current state,
+    /// one step `h` after the previous evaluation.
+    fn forces_and_torques(&mut self, sys: &System, ff: &mut ForceField, h: f64) {
         let p = &sys.particles;
         let n = p.len();
         self.force.clear();
         self.force.resize(n, DVec3::ZERO);
         self.torque.clear();
         self.torque.resize(n, DVec3::ZERO);
-        let state = State::of(sys, &p.position, &p.velocity, sys.time);
+        let state = State::of(sys, &p.position, &p.velocity, sys.time, h);
         let spin = Spin {
             angular_velocity: &p.angular_velocity,
             dipole: &p.dipole,
@@ -135,7 +136,7 @@ impl BrownianStepper {
         step_index: u64,
         seed: u64,
     ) {
-        self.forces_and_torques(sys, ff);
+        self.forces_and_torques(sys, ff, h);
         let (kt, friction, turn) = (self.kt, self.friction, self.rotate);
         let (force, torque) = (&self.force, &self.torque);
         let p = &mut sys.particles;

@@ -116,26 +116,28 @@ impl Stepper {
         x: &[DVec3],
         v: &[DVec3],
         t: f64,
+        dt: f64,
         acc: &mut Vec<DVec3>,
     ) {
         acc.resize(x.len(), DVec3::ZERO);
-        let state = State::of(sys, x, v, t);
+        let state = State::of(sys, x, v, t, dt);
         ff.accelerations(&state, &sys.particles.mobility, acc);
     }
 
     /// Accelerations and angular accelerations at the system's own positions
-    /// and velocities.
+    /// and velocities, `dt` after the previous evaluation.
     fn eval_rotating(
         ff: &mut ForceField,
         sys: &System,
         t: f64,
+        dt: f64,
         acc: &mut Vec<DVec3>,
         alpha: &mut Vec<DVec3>,
     ) {
         let p = &sys.particles;
         acc.resize(p.len(), DVec3::ZERO);
         alpha.resize(p.len(), DVec3::ZERO);
-        let state = State::of(sys, &p.position, &p.velocity, t);
+        let state = State::of(sys, &p.position, &p.velocity, t, dt);
         let spin = Spin {
             angular_velocity: &p.angular_velocity,
             dipole: &p.dipole,
@@ -150,7 +152,7 @@ impl Stepper {
         let mut alpha = std::mem::take(&mut sys.carried_angular_acceleration);
         let n = sys.particles.len();
         if acc.len() != n || alpha.len() != n {
-            Self::eval_rotating(ff, sys, t, &mut acc, &mut alpha);
+            Self::eval_rotating(ff, sys, t, 0.0, &mut acc, &mut alpha);
         }
         let half = 0.5 * h;
         {
@@ -164,7 +166,7 @@ impl Stepper {
                 }
             }
         }
-        Self::eval_rotating(ff, sys, t + h, &mut acc, &mut alpha);
+        Self::eval_rotating(ff, sys, t + h, h, &mut acc, &mut alpha);
         let p = &mut sys.particles;
         for i in 0..n {
             p.velocity[i] += acc[i] * half;
@@ -190,7 +192,7 @@ impl Stepper {
         let mut acc = std::mem::take(&mut sys.carried_acceleration);
         if ff.exerts_torques() {
             let mut alpha = std::mem::take(&mut sys.carried_angular_acceleration);
-            Self::eval_rotating(ff, sys, t, &mut acc, &mut alpha);
+            Self::eval_rotating(ff, sys, t, 0.0, &mut acc, &mut alpha);
             sys.carried_angular_acceleration = alpha;
         } else {
             Self::eval(
@@ -199,6 +201,7 @@ impl Stepper {
                 &sys.particles.position,
                 &sys.particles.velocity,
                 t,
+                0.0,
                 &mut acc,
             );
         }
@@ -217,6 +220,7 @@ impl Stepper {
                     &sys.particles.position,
                     &sys.particles.velocity,
                     t,
+                    h,
                     &mut acc,
                 );
                 let explicit = self.scheme == Integrator::Euler;
@@ -242,6 +246,7 @@ impl Stepper {
                         &sys.particles.position,
                         &sys.particles.velocity,
                         t,
+                        0.0,
                         &mut acc,
                     );
                 }
@@ -259,6 +264,7 @@ impl Stepper {
                     &sys.particles.position,
                     &sys.particles.velocity,
                     t + h,
+                    h,
                     &mut acc,
                 );
                 let p = &mut sys.particles;
@@ -293,8 +299,11 @@ impl Stepper {
             .into_iter()
             .enumerate()
         {
+            // Each stage is ts − (previous stage's time) after the last
+            // evaluation: 0, h/2, 0, h/2, so histories advance h a step.
             let ts = t + h * [0.0, 0.5, 0.5, 1.0][stage];
-            Self::eval(ff, sys, &self.xs, &self.vs, ts, &mut acc);
+            let dt = h * [0.0, 0.5, 0.0, 0.5][stage];
+            Self::eval(ff, sys, &self.xs, &self.vs, ts, dt, &mut acc);
             for i in 0..n {
                 let kx = self.vs[i];
                 let kv = acc[i];

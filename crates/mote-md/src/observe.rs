@@ -55,7 +55,7 @@ impl Observables {
         }
         let translational = kinetic;
         kinetic += rotational;
-        let state = State::of(sys, &p.position, &p.velocity, sys.time);
+        let state = State::of(sys, &p.position, &p.velocity, sys.time, 0.0);
         let (potential, _) = ff.potential_energy(&state);
         let nf = sys.degrees_of_freedom();
         let volume = sys.boundary.volume();

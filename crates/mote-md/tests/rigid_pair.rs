@@ -59,7 +59,7 @@ fn frbi(spin: SpinUpdate) -> Frbi {
 fn wrenches_balance() {
     let b = pair();
     let mut f = frbi(SpinUpdate::Seed);
-    let w = f.wrenches(&b, 0.0).to_vec();
+    let w = f.wrenches(&b, 0.0, 0.0).to_vec();
     let force = w[0].v + w[1].v;
     let torque =
         w[0].omega + w[1].omega + b.position[0].cross(w[0].v) + b.position[1].cross(w[1].v);
@@ -75,7 +75,7 @@ fn wrenches_balance() {
 fn force_is_gradient_of_energy() {
     let mut b = pair();
     let mut f = frbi(SpinUpdate::Seed);
-    let w = f.wrenches(&b, 0.0)[0];
+    let w = f.wrenches(&b, 0.0, 0.0)[0];
     let h = 1e-5;
     for k in 0..3 {
         let x0 = b.position[0];

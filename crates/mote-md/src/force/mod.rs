@@ -37,6 +37,12 @@ pub struct State<'a> {
     pub velocity: &'a [DVec3],
     pub mass: &'a [f64],
     pub time: f64,
+    /// The time since the previous force evaluation of the run, by which
+    /// history-dependent forces advance (the tangential springs of
+    /// granular contacts, ξ += v_t dt): the step h after a step, 0 where an
+    /// evaluation repeats or only measures a state (the first evaluation
+    /// of a leap-frog run, observables). Set by the integrator.
+    pub dt: f64,
     /// Radius of each particle (empty when the caller gives none).
     pub radius: &'a [f64],
     /// Charge of each particle (empty when the caller gives none).
@@ -65,6 +71,7 @@ impl<'a> State<'a> {
             velocity,
             mass,
             time,
+            dt: 0.0,
             radius: &[],
             charge: &[],
             boundary: &OPEN_SPACE,
@@ -73,14 +80,22 @@ impl<'a> State<'a> {
     }
 
     /// The system's particles at an integrator stage (`position`,
-    /// `velocity`, `time`), with their radii, charges and box.
-    pub fn of(sys: &'a System, position: &'a [DVec3], velocity: &'a [DVec3], time: f64) -> Self {
+    /// `velocity`, `time`), `dt` after the previous evaluation, with their
+    /// radii, charges and box.
+    pub fn of(
+        sys: &'a System,
+        position: &'a [DVec3],
+        velocity: &'a [DVec3],
+        time: f64,
+        dt: f64,
+    ) -> Self {
         let p = &sys.particles;
         Self {
             position,
             velocity,
             mass: &p.mass,
             time,
+            dt,
             radius: &p.radius,
             charge: &p.charge,
             boundary: &sys.boundary,
@@ -107,6 +122,11 @@ impl<'a> State<'a> {
     /// The same state with these radii.
     pub fn with_radii(self, radius: &'a [f64]) -> Self {
         Self { radius, ..self }
+    }
+
+    /// The same state, `dt` after the previous evaluation.
+    pub fn after(self, dt: f64) -> Self {
+        Self { dt, ..self }
     }
 
     /// The same state in this box.

@@ -66,7 +66,6 @@ struct ContactState {
     wall_history: Vec<History>,
     wall_touching: Vec<bool>,
     wall_force: Vec<DVec3>,
-    last_time: Option<f64>,
     contacts: usize,
     wall_contacts: usize,
     /// Sphere–wall histories of a resumed run, put in place at the next evaluation.
@@ -176,8 +175,7 @@ impl BodyInteraction for RigidContacts {
         let mut guard = self.state.lock().unwrap();
         let st = &mut *guard;
         st.refresh(centres, body, r_max, &self.boundary);
-        let dt = st.last_time.map_or(0.0, |t0| t - t0);
-        st.last_time = Some(t);
+        let dt = view.dt;
         let image = self.boundary.image();
         let periodic = self.boundary.is_periodic();
         let pos: &[DVec3] = if periodic { &st.wrapped } else { centres };
@@ -316,7 +314,8 @@ impl BodyInteraction for RigidContacts {
         }
     }
 
-    /// [time of the last evaluation (NaN if none), number of pair rows,
+    /// [NaN (the time of the last evaluation before dt came with the view;
+    /// kept so earlier checkpoints load), number of pair rows,
     /// pair rows (a, b, shear, roll) of touching sphere pairs, wall rows
     /// (slot, shear, roll) of touching sphere–wall contacts]. Pairs that
     /// do not touch carry the zero history, so these rows are the whole state.
@@ -324,10 +323,7 @@ impl BodyInteraction for RigidContacts {
         let s = self.state.lock().unwrap();
         let mut pairs = Vec::new();
         s.pairs.write_rows(&mut pairs);
-        let mut out = vec![
-            s.last_time.unwrap_or(f64::NAN),
-            (pairs.len() / PAIR_ROW) as f64,
-        ];
+        let mut out = vec![f64::NAN, (pairs.len() / PAIR_ROW) as f64];
         out.extend(pairs);
         for (slot, h) in s.wall_history.iter().enumerate() {
             if s.wall_touching[slot] {
@@ -341,7 +337,7 @@ impl BodyInteraction for RigidContacts {
 
     fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
         let bad = || "rigid contact history: malformed carried state".to_string();
-        let [t, pairs, rows @ ..] = state else {
+        let [_, pairs, rows @ ..] = state else {
             return if state.is_empty() { Ok(()) } else { Err(bad()) };
         };
         let n_pairs = *pairs as usize;
@@ -352,7 +348,6 @@ impl BodyInteraction for RigidContacts {
         }
         let (pair_rows, wall_rows) = rows.split_at(n_pairs * PAIR_ROW);
         let mut s = self.state.lock().unwrap();
-        s.last_time = (!t.is_nan()).then_some(*t);
         // The sphere count is known at the next evaluation; rows naming
         // spheres beyond it are never listed, so never placed.
         s.pairs

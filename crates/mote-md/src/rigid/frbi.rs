@@ -241,14 +241,16 @@ impl Frbi {
     }
 
     /// The wrenches `dE(T, F)` of all interactions on all bodies at time
-    /// `t` (also refreshes the world frame).
-    pub fn wrenches(&mut self, b: &RigidBodies, t: f64) -> &[DE] {
+    /// `t`, `dt` after the previous evaluation (also refreshes the world
+    /// frame).
+    pub fn wrenches(&mut self, b: &RigidBodies, t: f64, dt: f64) -> &[DE] {
         self.world.update(b);
         self.wrench.clear();
         self.wrench.resize(b.len(), DE::ZERO);
         let view = BodyView {
             bodies: b,
             world: &self.world,
+            dt,
         };
         for it in &self.interactions {
             it.add_wrenches(&view, t, &mut self.wrench);
@@ -261,7 +263,7 @@ impl Frbi {
     pub fn step(&mut self, b: &mut RigidBodies, dt: f64) {
         self.free_all(b, 0.5 * dt);
         let t_mid = b.time + 0.5 * dt;
-        self.wrenches(b, t_mid);
+        self.wrenches(b, t_mid, dt);
         let wrench = &self.wrench;
         let templates = &b.templates;
         let kind = &b.kind;
@@ -318,6 +320,7 @@ impl Frbi {
         let view = BodyView {
             bodies: b,
             world: &self.world,
+            dt: 0.0,
         };
         let potential = self
             .interactions

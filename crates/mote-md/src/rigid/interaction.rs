@@ -125,6 +125,10 @@ impl WorldFrame {
 pub struct BodyView<'a> {
     pub bodies: &'a RigidBodies,
     pub world: &'a WorldFrame,
+    /// The time since the previous evaluation of the run, by which contact
+    /// histories advance (ξ += v_t dt): the step length within a step, 0
+    /// where a state is only measured.
+    pub dt: f64,
 }
 
 impl BodyView<'_> {

@@ -24,7 +24,6 @@ pub struct GranularContacts {
     pairs: PairHistories,
     /// The build of the list the histories were last carried to.
     carried_to_build: u64,
-    last_time: Option<f64>,
     /// One (force, torque) buffer per extra block of particles.
     buffers: BlockBuffers,
     contacts: usize,
@@ -40,7 +39,6 @@ impl GranularContacts {
             list: VerletList::half(2.0 * r_max, skin),
             pairs: PairHistories::default(),
             carried_to_build: 0,
-            last_time: None,
             buffers: Vec::new(),
             contacts: 0,
             virial: 0.0,
@@ -83,8 +81,7 @@ impl GranularContacts {
         self.refresh_own(state);
         let list = state.neighbours.unwrap_or(&self.list);
         Self::follow(&mut self.pairs, &mut self.carried_to_build, list);
-        let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
-        self.last_time = Some(state.time);
+        let dt = state.dt;
 
         let blocks = rayon::current_num_threads().clamp(1, n.max(1));
         let per_block = n.div_ceil(blocks.max(1)).max(1);
@@ -243,19 +240,19 @@ impl Interaction for GranularContacts {
         self.evaluate(state, spin.angular_velocity, force, torque);
     }
 
-    /// [time of the last evaluation (NaN: none), then per touching pair
+    /// [NaN (the time of the last evaluation before dt came with the
+    /// state; kept so earlier checkpoints load), then per touching pair
     /// i, j, ξ (3), ψ (3)].
     fn carried_state(&self) -> Vec<f64> {
-        let mut out = vec![self.last_time.unwrap_or(f64::NAN)];
+        let mut out = vec![f64::NAN];
         self.pairs.write_rows(&mut out);
         out
     }
 
     fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
-        let Some((&t, rows)) = state.split_first() else {
+        let Some((_, rows)) = state.split_first() else {
             return Ok(());
         };
-        self.last_time = (!t.is_nan()).then_some(t);
         self.pairs
             .restore_rows(rows, usize::MAX)
             .map_err(|m| format!("granular {m}"))

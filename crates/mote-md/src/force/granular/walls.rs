@@ -126,7 +126,6 @@ pub struct GranularWalls {
     touching: Vec<bool>,
     /// The force the particles exert on each wall at the last evaluation.
     wall_force: Vec<DVec3>,
-    last_time: Option<f64>,
 }
 
 impl GranularWalls {
@@ -138,7 +137,6 @@ impl GranularWalls {
             touching: vec![false; n * walls.len()],
             wall_force: vec![DVec3::ZERO; walls.len()],
             walls,
-            last_time: None,
         }
     }
 
@@ -153,8 +151,7 @@ impl GranularWalls {
         torque: &mut [DVec3],
     ) {
         const CHUNK: usize = 1024;
-        let dt = self.last_time.map_or(0.0, |t0| state.time - t0);
-        self.last_time = Some(state.time);
+        let dt = state.dt;
         let t = state.time;
         let law = self.law;
         let walls = &self.walls;
@@ -268,10 +265,11 @@ impl Interaction for GranularWalls {
         self.evaluate(state, spin.angular_velocity, force, torque);
     }
 
-    /// [time of the last evaluation (NaN: none), then per touching
+    /// [NaN (the time of the last evaluation before dt came with the
+    /// state; kept so earlier checkpoints load), then per touching
     /// (particle, wall) slot: slot, ξ (3), ψ (3)].
     fn carried_state(&self) -> Vec<f64> {
-        let mut out = vec![self.last_time.unwrap_or(f64::NAN)];
+        let mut out = vec![f64::NAN];
         for (k, h) in self.history.iter().enumerate() {
             if self.touching[k] {
                 out.push(k as f64);
@@ -283,13 +281,12 @@ impl Interaction for GranularWalls {
     }
 
     fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
-        let Some((&t, rows)) = state.split_first() else {
+        let Some((_, rows)) = state.split_first() else {
             return Ok(());
         };
         if rows.len() % 7 != 0 {
             return Err("wall contact history: rows of 7 numbers expected".into());
         }
-        self.last_time = (!t.is_nan()).then_some(t);
         self.touching.iter_mut().for_each(|x| *x = false);
         for r in rows.chunks(7) {
             let k = r[0] as usize;
