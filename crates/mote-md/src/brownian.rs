@@ -117,7 +117,6 @@ impl BrownianStepper {
         let state = State::of(sys, &p.position, &p.velocity, sys.time, h);
         let spin = Spin {
             angular_velocity: &p.angular_velocity,
-            dipole: &p.dipole,
         };
         ff.add_forces_and_torques(&state, &spin, &mut self.force, &mut self.torque);
     }

@@ -140,7 +140,6 @@ impl Stepper {
         let state = State::of(sys, &p.position, &p.velocity, t, dt);
         let spin = Spin {
             angular_velocity: &p.angular_velocity,
-            dipole: &p.dipole,
         };
         ff.accelerations_and_angular(&state, &spin, p, acc, alpha);
     }

@@ -51,7 +51,6 @@ fn granular_and_dipoles_share_one_list_with_the_same_forces() {
     let boundary = Boundary::periodic(DVec3::ZERO, DVec3::splat(L));
     let spin = Spin {
         angular_velocity: &omega,
-        dipole: &dipole,
     };
     let granular = || GranularContacts::new(law(), 0.55, 0.2);
     let dipoles = || DipoleDipole::cut_off(1.0, 2.5, 0.3, boundary).unwrap();
@@ -59,6 +58,7 @@ fn granular_and_dipoles_share_one_list_with_the_same_forces() {
     // Each interaction through its own list (no list in the state).
     let state = State::new(&pos, &vel, &mass, 0.0)
         .with_radii(&radius)
+        .with_dipoles(&dipole)
         .in_box(&boundary);
     let (mut f_own, mut t_own) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
     let (mut g, mut d) = (granular(), dipoles());

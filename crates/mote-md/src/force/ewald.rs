@@ -468,14 +468,14 @@ pub struct EwaldDipoles {
     pub ewald: Ewald,
     /// μ₀/4π (or 1 in reduced units).
     pub k: f64,
-    /// The dipoles of the last evaluation.
-    pub dipole: Vec<DVec3>,
 }
 
 impl EwaldDipoles {
-    pub fn new(k: f64, dipole: Vec<DVec3>, box_length: f64, r_cut: f64, accuracy: f64) -> Self {
-        let ewald = Ewald::for_dipoles(box_length, r_cut, accuracy / k.abs(), &dipole);
-        Self { ewald, k, dipole }
+    /// Parameters tuned for `dipole` (the initial moments; the sums read
+    /// the moments of each evaluation from [`State::dipole`]).
+    pub fn new(k: f64, dipole: &[DVec3], box_length: f64, r_cut: f64, accuracy: f64) -> Self {
+        let ewald = Ewald::for_dipoles(box_length, r_cut, accuracy / k.abs(), dipole);
+        Self { ewald, k }
     }
 }
 
@@ -486,9 +486,12 @@ impl Interaction for EwaldDipoles {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let n = force.len();
+        if state.dipole.len() != n {
+            return;
+        }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
         self.ewald
-            .dipoles(state.position, &self.dipole, &mut f, &mut h);
+            .dipoles(state.position, state.dipole, &mut f, &mut h);
         for (a, b) in force.iter_mut().zip(&f) {
             *a += *b * self.k;
         }
@@ -505,25 +508,30 @@ impl Interaction for EwaldDipoles {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        self.dipole.clear();
-        self.dipole.extend_from_slice(spin.dipole);
+        let _ = spin;
         let n = force.len();
+        if state.dipole.len() != n {
+            return;
+        }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
         self.ewald
-            .dipoles(state.position, &self.dipole, &mut f, &mut h);
+            .dipoles(state.position, state.dipole, &mut f, &mut h);
         for i in 0..n {
             force[i] += f[i] * self.k;
-            torque[i] += self.dipole[i].cross(h[i]) * self.k;
+            torque[i] += state.dipole[i].cross(h[i]) * self.k;
         }
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
         let n = state.position.len();
+        if state.dipole.len() != n {
+            return 0.0;
+        }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
         self.k
             * self
                 .ewald
-                .dipoles(state.position, &self.dipole, &mut f, &mut h)
+                .dipoles(state.position, state.dipole, &mut f, &mut h)
     }
 }
 

@@ -47,6 +47,9 @@ pub struct State<'a> {
     pub radius: &'a [f64],
     /// Charge of each particle (empty when the caller gives none).
     pub charge: &'a [f64],
+    /// Magnetic dipole moment m of each particle (empty when the caller
+    /// gives none; zero for particles without one).
+    pub dipole: &'a [DVec3],
     /// The simulation box.
     pub boundary: &'a Boundary,
     /// The force field's shared half neighbour list, up to date for
@@ -74,6 +77,7 @@ impl<'a> State<'a> {
             dt: 0.0,
             radius: &[],
             charge: &[],
+            dipole: &[],
             boundary: &OPEN_SPACE,
             neighbours: None,
         }
@@ -81,7 +85,7 @@ impl<'a> State<'a> {
 
     /// The system's particles at an integrator stage (`position`,
     /// `velocity`, `time`), `dt` after the previous evaluation, with their
-    /// radii, charges and box.
+    /// radii, charges, dipoles and box.
     pub fn of(
         sys: &'a System,
         position: &'a [DVec3],
@@ -98,6 +102,7 @@ impl<'a> State<'a> {
             dt,
             radius: &p.radius,
             charge: &p.charge,
+            dipole: &p.dipole,
             boundary: &sys.boundary,
             neighbours: None,
         }
@@ -117,6 +122,11 @@ impl<'a> State<'a> {
     /// The same state with these charges.
     pub fn with_charges(self, charge: &'a [f64]) -> Self {
         Self { charge, ..self }
+    }
+
+    /// The same state with these dipoles.
+    pub fn with_dipoles(self, dipole: &'a [DVec3]) -> Self {
+        Self { dipole, ..self }
     }
 
     /// The same state with these radii.
@@ -140,8 +150,6 @@ impl<'a> State<'a> {
 pub struct Spin<'a> {
     /// Angular velocity ω of each particle.
     pub angular_velocity: &'a [DVec3],
-    /// Magnetic dipole moment m of each particle (zero if none).
-    pub dipole: &'a [DVec3],
 }
 
 /// Something that exerts forces.

@@ -130,9 +130,8 @@ impl Section for DipolarSettings {
                     ));
                 }
                 let k = mu0 / (4.0 * std::f64::consts::PI);
-                let dipoles = b.particles.dipole.clone();
-                b.forces
-                    .push(EwaldDipoles::new(k, dipoles, l, rc, accuracy));
+                let ewald = EwaldDipoles::new(k, &b.particles.dipole, l, rc, accuracy);
+                b.forces.push(ewald);
                 return Ok(());
             }
             other => {

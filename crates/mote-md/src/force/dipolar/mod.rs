@@ -47,10 +47,9 @@
 //! ESPResSo): the coupling constant is then λ = m²/(σ³ k_BT) and a field
 //! "B" = μ₀H enters as U = −m·B.
 //!
-//! The trait [`Interaction::potential_energy`] receives no dipoles; the
-//! interactions here use the dipoles of their last force evaluation (or
-//! those given with `set_dipoles`). [`DipoleDipole::energy`] and
-//! [`Zeeman::energy`] take them explicitly.
+//! The trait methods read the dipoles from [`State::dipole`] (the system's,
+//! rotated with the particles); a state without dipoles gives no force.
+//! [`DipoleDipole::energy`] and [`Zeeman::energy`] take them explicitly.
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -227,7 +226,6 @@ pub struct DipoleDipole {
     pub boundary: Boundary,
     /// Half Verlet list (cut-off mode only).
     pub list: VerletList,
-    dipoles: Vec<DVec3>,
     virial: f64,
     /// Per-block force and torque buffers (cut-off mode).
     buffers: BlockBuffers,
@@ -256,7 +254,6 @@ impl DipoleDipole {
             repulsion: None,
             boundary: Boundary::open(),
             list: VerletList::half(0.0, 0.0),
-            dipoles: Vec::new(),
             virial: 0.0,
             buffers: Vec::new(),
             soa: Soa::default(),
@@ -316,12 +313,6 @@ impl DipoleDipole {
             return Err(DipolarError::PeriodicWithoutCutoff);
         }
         Ok(())
-    }
-
-    /// The dipoles the trait methods without a [`Spin`] use.
-    pub fn set_dipoles(&mut self, dipoles: &[DVec3]) {
-        self.dipoles.clear();
-        self.dipoles.extend_from_slice(dipoles);
     }
 
     fn kernel(&self) -> Kernel {
@@ -685,17 +676,14 @@ impl Interaction for DipoleDipole {
         "dipole_dipole"
     }
 
-    /// Forces with the dipoles of the last evaluation with a [`Spin`] (or
-    /// of `set_dipoles`); integrators that rotate call
-    /// `add_forces_and_torques` instead.
+    /// Forces alone (the torques are dropped); integrators that rotate
+    /// call `add_forces_and_torques` instead.
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
-        let dipoles = std::mem::take(&mut self.dipoles);
-        if dipoles.len() == state.position.len() {
-            let mut torque = vec![DVec3::ZERO; dipoles.len()];
+        if state.dipole.len() == state.position.len() {
+            let mut torque = vec![DVec3::ZERO; force.len()];
             let shared = self.shared(state);
-            self.forces_through(state.position, &dipoles, shared, force, &mut torque);
+            self.forces_through(state.position, state.dipole, shared, force, &mut torque);
         }
-        self.dipoles = dipoles;
     }
 
     fn exerts_torques(&self) -> bool {
@@ -709,22 +697,21 @@ impl Interaction for DipoleDipole {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        self.set_dipoles(spin.dipole);
-        let shared = self.shared(state);
-        self.forces_through(state.position, spin.dipole, shared, force, torque);
+        let _ = spin;
+        if state.dipole.len() == state.position.len() {
+            let shared = self.shared(state);
+            self.forces_through(state.position, state.dipole, shared, force, torque);
+        }
     }
 
-    /// Σ_{i<j} U_ij with the dipoles of the last force evaluation (0 before the first).
+    /// Σ_{i<j} U_ij (0 for a state without dipoles).
     fn potential_energy(&mut self, state: &State) -> f64 {
-        let dipoles = std::mem::take(&mut self.dipoles);
-        let u = if dipoles.len() == state.position.len() {
+        if state.dipole.len() == state.position.len() {
             let shared = self.shared(state);
-            self.energy_through(state.position, &dipoles, shared)
+            self.energy_through(state.position, state.dipole, shared)
         } else {
             0.0
-        };
-        self.dipoles = dipoles;
-        u
+        }
     }
 
     fn virial(&self) -> f64 {
@@ -861,27 +848,16 @@ fn rotation_plane(axis: DVec3) -> (DVec3, DVec3) {
 pub struct Zeeman {
     pub mu0: f64,
     pub field: AppliedField,
-    dipoles: Vec<DVec3>,
 }
 
 impl Zeeman {
     pub fn new(mu0: f64, field: AppliedField) -> Self {
-        Self {
-            mu0,
-            field,
-            dipoles: Vec::new(),
-        }
+        Self { mu0, field }
     }
 
     /// A uniform constant field H.
     pub fn uniform(mu0: f64, h: DVec3) -> Self {
         Self::new(mu0, AppliedField::Uniform(h))
-    }
-
-    /// The dipoles the trait methods without a [`Spin`] use.
-    pub fn set_dipoles(&mut self, dipoles: &[DVec3]) {
-        self.dipoles.clear();
-        self.dipoles.extend_from_slice(dipoles);
     }
 
     /// Adds forces and torques at time t.
@@ -926,17 +902,11 @@ impl Interaction for Zeeman {
         "zeeman"
     }
 
-    /// The gradient force with the dipoles of the last evaluation with a [`Spin`].
+    /// The gradient force alone (none in a uniform field).
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
-        if !self.field.is_uniform() && self.dipoles.len() == state.position.len() {
+        if !self.field.is_uniform() && state.dipole.len() == state.position.len() {
             let mut torque = vec![DVec3::ZERO; force.len()];
-            self.forces_and_torques(
-                state.position,
-                &self.dipoles,
-                state.time,
-                force,
-                &mut torque,
-            );
+            self.forces_and_torques(state.position, state.dipole, state.time, force, &mut torque);
         }
     }
 
@@ -951,14 +921,16 @@ impl Interaction for Zeeman {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        self.set_dipoles(spin.dipole);
-        self.forces_and_torques(state.position, spin.dipole, state.time, force, torque);
+        let _ = spin;
+        if state.dipole.len() == state.position.len() {
+            self.forces_and_torques(state.position, state.dipole, state.time, force, torque);
+        }
     }
 
-    /// With the dipoles of the last force evaluation (0 before the first).
+    /// Σ_i −μ₀ m_i·H(r_i, t) (0 for a state without dipoles).
     fn potential_energy(&mut self, state: &State) -> f64 {
-        if self.dipoles.len() == state.position.len() {
-            self.energy(state.position, &self.dipoles, state.time)
+        if state.dipole.len() == state.position.len() {
+            self.energy(state.position, state.dipole, state.time)
         } else {
             0.0
         }
