@@ -301,18 +301,7 @@ fn yes() -> bool {
 
 /// Line where `key = ` is first set, or 1.
 fn key_line(text: &str, key: &str) -> usize {
-    for (k, l) in text.lines().enumerate() {
-        let t = l.trim_start();
-        if let Some(rest) = t.strip_prefix(key) {
-            if rest.trim_start().starts_with('=') {
-                return k + 1;
-            }
-        }
-        if t.starts_with("[[") && t.contains(key) {
-            return k + 1;
-        }
-    }
-    1
+    mote_io::Source::new("", text).key_line(key)
 }
 
 /// The built-in examples: name → scene text (the files under examples/edmd/).

@@ -10,6 +10,8 @@ pub enum Engine {
     Rigid,
     /// Event-driven hard spheres and disks (mote-edmd).
     EventDriven,
+    /// Packings by growing hard spheres (`[packing]`, Lubachevsky–Stillinger).
+    Packing,
 }
 
 /// Top-level keys of the first event-driven scene format, beside the
@@ -25,7 +27,16 @@ const EVENT_DRIVEN_LEGACY_KEYS: &[&str] = &[
 ];
 
 impl Engine {
-    /// The engine of a TOML scene: `[rigid]` means rigid bodies; the keys
+    /// Every engine, in the order `mote examples` lists them.
+    pub const ALL: [Engine; 4] = [
+        Engine::Particles,
+        Engine::Rigid,
+        Engine::EventDriven,
+        Engine::Packing,
+    ];
+
+    /// The engine of a TOML scene: `[rigid]` means rigid bodies,
+    /// `[packing]` a packing by growth; the keys
     /// of an event-driven scene (or a `box` given as a list of lengths)
     /// mean hard spheres; anything else is a point-particle scene. A text
     /// that is not TOML is left to the point-particle parser, whose error
@@ -36,6 +47,8 @@ impl Engine {
         };
         if table.contains_key("rigid") {
             Engine::Rigid
+        } else if table.contains_key("packing") {
+            Engine::Packing
         } else if table.contains_key("event_driven")
             || mote_edmd::scene::EVENT_DRIVEN_KEYS
                 .iter()
@@ -55,6 +68,7 @@ impl Engine {
             Engine::Particles => "point particles (fixed-step integrators, Brownian dynamics)",
             Engine::Rigid => "rigid clumps of spheres (Fast Rigid Bodies Integrator)",
             Engine::EventDriven => "hard spheres and disks (event-driven)",
+            Engine::Packing => "packings by growing spheres (Lubachevsky–Stillinger)",
         }
     }
 }

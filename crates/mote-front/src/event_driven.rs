@@ -1,6 +1,6 @@
 //! Event-driven hard spheres and disks (`mote_edmd::scene::run_scene`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use mote_edmd::scene::{run_scene, Outputs};
 use mote_edmd::Scene;
@@ -84,16 +84,8 @@ fn run_events(
         &[
             (options.dt.is_some(), "--dt", WHY_NO_STEP),
             (options.steps.is_some(), "--steps", WHY_NO_STEP),
-            (
-                options.solver.is_some(),
-                "--solver",
-                "collisions are predicted exactly; there is no integrator to choose",
-            ),
-            (
-                options.system.is_some(),
-                "--system",
-                "it chooses the model of an MPPphys particle file",
-            ),
+            (options.solver.is_some(), "--solver", crate::WHY_NO_SOLVER),
+            (options.system.is_some(), "--system", crate::WHY_NO_SYSTEM),
         ],
     )?;
     let mut scene = Scene::parse(&input.text, &input.label)?;
@@ -117,22 +109,10 @@ fn run_events(
         scene.observables = None;
         scene.histogram = None;
     }
-    let dir = options
-        .output
-        .clone()
-        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
-        .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
+    let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
     std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
     let _lock = crate::lock::FolderLock::take(&dir)?;
-    let scene_dir = if input.label.starts_with("example:") {
-        PathBuf::from(".")
-    } else {
-        Path::new(&input.label)
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| PathBuf::from("."))
-    };
+    let scene_dir = input.folder();
     let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
     monitor.start(&format!(
         "mote run {}: event-driven hard {}, simulated time {} after {} of equilibration, {}",

@@ -1,5 +1,5 @@
 //! The built-in examples of every engine: scene files compiled in from
-//! examples/ (point particles at the top, rigid/ and edmd/ below).
+//! examples/ (point particles at the top, rigid/, edmd/ and packing/ below).
 
 use crate::engine::Engine;
 
@@ -39,6 +39,8 @@ const RIGID: &[(&str, &str)] = &[
     scene!("chains-rotating-field", "rigid/chains-rotating-field.toml"),
 ];
 
+const PACKING: &[(&str, &str)] = &[scene!("rcp", "packing/rcp.toml")];
+
 /// All examples, grouped by engine, in the order `mote examples` lists them.
 pub fn all() -> Vec<Example> {
     let make = |engine: Engine, (name, text): (&str, &str)| Example {
@@ -69,6 +71,7 @@ pub fn all() -> Vec<Example> {
             .iter()
             .map(|s| make(Engine::EventDriven, *s)),
     );
+    list.extend(PACKING.iter().map(|s| make(Engine::Packing, *s)));
     list
 }
 

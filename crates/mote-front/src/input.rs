@@ -1,7 +1,7 @@
 //! What `mote run` was given: a scene file, an MPPphys particle file, a
 //! built-in example, or a scene text handed over by the Python API.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::engine::Engine;
 use crate::error::{refuse, FrontError};
@@ -61,6 +61,28 @@ impl Input {
             text: text.to_string(),
             plist: false,
         }
+    }
+
+    /// The folder relative file names in the scene resolve against: the
+    /// scene file's, or the working folder for examples and texts.
+    pub fn folder(&self) -> PathBuf {
+        if self.label.starts_with("example:") {
+            return PathBuf::from(".");
+        }
+        Path::new(&self.label)
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."))
+    }
+
+    /// The output folder: `-o`, else the scene's `[output] dir`, else
+    /// `out/<name>`.
+    pub fn output_dir(&self, option: Option<&PathBuf>, scene: Option<&String>) -> PathBuf {
+        option
+            .cloned()
+            .or_else(|| scene.map(PathBuf::from))
+            .unwrap_or_else(|| PathBuf::from("out").join(&self.name))
     }
 
     /// The engine that runs this input.

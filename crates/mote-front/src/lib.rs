@@ -15,6 +15,7 @@ pub mod event_driven;
 pub mod examples;
 pub mod input;
 pub mod lock;
+pub mod packing;
 mod particles;
 mod rigid;
 pub mod seed;
@@ -169,10 +170,16 @@ pub fn run_input(
         Engine::Particles => particles::run(Some(input.clone()), options, monitor),
         Engine::Rigid => rigid::run(input, options, monitor),
         Engine::EventDriven => event_driven::run(input, options, monitor),
+        Engine::Packing => packing::run(input, options, monitor),
     };
     monitor.finish();
     result
 }
+
+/// Why `--solver` means nothing to the event-driven engines.
+const WHY_NO_SOLVER: &str = "collisions are predicted exactly; there is no integrator to choose";
+/// Why `--system` means nothing to a TOML scene.
+const WHY_NO_SYSTEM: &str = "it chooses the model of an MPPphys particle file";
 
 /// "1 thread" / "2 threads".
 fn threads_phrase() -> String {

@@ -1,7 +1,7 @@
 //! Point-particle runs: fixed-step integrators and Brownian dynamics
 //! (`mote_md::Simulation`), from a scene, a particle file or a checkpoint.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::IoError;
@@ -124,11 +124,7 @@ pub(crate) fn run(
         ),
     };
 
-    let dir = args
-        .output
-        .clone()
-        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
-        .unwrap_or_else(|| PathBuf::from("out").join(&input.name));
+    let dir = input.output_dir(args.output.as_ref(), scene.output.dir.as_ref());
     std::fs::create_dir_all(&dir).map_err(|e| IoError::os(&dir, e))?;
     let _lock = crate::lock::FolderLock::take(&dir)?;
     let total_steps = length.steps_from(built.simulation.system.time, built.simulation.dt);

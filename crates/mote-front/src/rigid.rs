@@ -40,11 +40,7 @@ fn run_with(
                 "--solver",
                 "rigid bodies are moved by the FRBI only",
             ),
-            (
-                options.system.is_some(),
-                "--system",
-                "it chooses the model of an MPPphys particle file",
-            ),
+            (options.system.is_some(), "--system", crate::WHY_NO_SYSTEM),
         ],
     )?;
     let scene = RigidScene::parse(&input.text, &input.label)?;

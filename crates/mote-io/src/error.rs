@@ -60,6 +60,24 @@ impl<'a> Source<'a> {
             + 1
     }
 
+    /// One-based line where `key = ` is first set (or an array of tables
+    /// `[[...key...]]` starts); 1 if nowhere. For messages about a value
+    /// found only after parsing.
+    pub fn key_line(&self, key: &str) -> usize {
+        for (k, l) in self.text.lines().enumerate() {
+            let t = l.trim_start();
+            if let Some(rest) = t.strip_prefix(key) {
+                if rest.trim_start().starts_with('=') {
+                    return k + 1;
+                }
+            }
+            if t.starts_with("[[") && t.contains(key) {
+                return k + 1;
+            }
+        }
+        1
+    }
+
     /// `file:line: message` at the start of `span`; an empty span at offset 0
     /// (a default value, not written in the file) gives the whole file
     /// (`file: message`).

@@ -200,3 +200,95 @@ fn sigint_writes_the_packing_so_far() {
     let frames = mote_io::xyz::read_frames(&dir.path().join("p.xyz")).unwrap();
     assert_eq!(frames.last().unwrap().positions.len(), 20000);
 }
+
+/// A `[packing]` scene under `mote run` is the same run as `mote pack` with
+/// the same settings spelled as options: the same packing, bit for bit, in
+/// DIR/packing.xyz with its CSV and POV-Ray scene beside it; bad keys are
+/// named at their line, and options without meaning for a packing refused.
+#[test]
+fn a_packing_scene_runs_through_mote_run_as_mote_pack_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("p.toml");
+    std::fs::write(
+        &scene,
+        "title = \"test packing\"\nseed = 4\n\n[packing]\nn = 200\ndimension = 2\ndist = \"bi:1.4:0.5\"\nrate = 0.3\nmax_pressure = 1e8\n",
+    )
+    .unwrap();
+    let run = mote()
+        .arg("run")
+        .arg(&scene)
+        .arg("-o")
+        .arg(dir.path().join("run"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(text.contains("200 disks: phi = 0.8"), "{text}");
+    for f in ["packing.xyz", "packing.csv", "packing.pov"] {
+        assert!(dir.path().join("run").join(f).exists(), "{f}");
+    }
+    let pack = mote()
+        .args([
+            "pack",
+            "--n",
+            "200",
+            "--dim",
+            "2",
+            "--dist",
+            "bi:1.4:0.5",
+            "--rate",
+            "0.3",
+            "--max-pressure",
+            "1e8",
+            "--seed",
+            "4",
+            "-o",
+        ])
+        .arg(dir.path().join("pack/packing.xyz"))
+        .output()
+        .unwrap();
+    assert!(pack.status.success());
+    let frame = |sub: &str| {
+        let frames = mote_io::xyz::read_frames(&dir.path().join(sub).join("packing.xyz")).unwrap();
+        let f = frames.last().unwrap().clone();
+        let bits: Vec<u64> = f
+            .positions
+            .iter()
+            .flatten()
+            .chain(&f.radii)
+            .map(|x| x.to_bits())
+            .collect();
+        bits
+    };
+    assert_eq!(frame("run"), frame("pack"), "the two ways in differ");
+
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[packing]\nn = 100\ndimension = 4\n").unwrap();
+    let out = mote().arg("run").arg(&bad).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("bad.toml:3: [packing] dimension = 4: must be 2 or 3"),
+        "{err}"
+    );
+    std::fs::write(&bad, "[packing]\nn = 100\nrat = 1\n").unwrap();
+    let out = mote().arg("run").arg(&bad).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.toml:3: unknown field `rat`"), "{err}");
+    let out = mote()
+        .arg("run")
+        .arg(&scene)
+        .args(["--steps", "10"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("option not available for packings: --steps (a packing grows until it jams"),
+        "{err}"
+    );
+}

@@ -30,7 +30,7 @@ pub fn run(global: &super::GlobalOpts, args: ExamplesArgs) -> anyhow::Result<Exi
         return Ok(ExitCode::SUCCESS);
     }
     let width = all.iter().map(|e| e.name.len()).max().unwrap_or(0);
-    for engine in [Engine::Particles, Engine::Rigid, Engine::EventDriven] {
+    for engine in Engine::ALL {
         println!("{}:", engine.title());
         for e in all.iter().filter(|e| e.engine == engine) {
             println!("  {:width$}  {}", e.name, e.description);

@@ -7,14 +7,15 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Duration;
 
 use anyhow::Context;
 use mote_edmd::analyse::{bond_order, contacts, deepest_overlap, pair_correlation};
-use mote_edmd::pack::{Finish, PackSettings, Packer, SizeSpec, Stop};
 use mote_edmd::{Boundary, SimBox};
+use mote_front::packing::{Naming, PackFiles, PackingSpec};
+use mote_front::{Ending, Monitor};
 
 use super::GlobalOpts;
+use crate::progress::Terminal;
 
 /// The words of `mote pack` (its help text is the `Pack` variant's in main.rs).
 #[derive(clap::Args, Debug)]
@@ -120,90 +121,37 @@ pub fn run(global: &GlobalOpts, args: PackArgs) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// Reads one radius per line (`#` starts a comment); errors as `file:line: ...`.
-fn read_radii(path: &Path) -> anyhow::Result<Vec<f64>> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read the radii file", path.display()))?;
-    let mut radii = Vec::new();
-    for (k, line) in text.lines().enumerate() {
-        let body = line.split('#').next().unwrap_or("").trim();
-        if body.is_empty() {
-            continue;
+impl PackArgs {
+    /// The packing these options ask for, in the keys a `[packing]` scene uses.
+    fn spec(&self) -> PackingSpec {
+        PackingSpec {
+            n: self.n,
+            dimension: self.dim,
+            dist: self.dist.clone(),
+            rate: self.rate,
+            max_pressure: self.max_pressure,
+            phi: self.phi,
+            max_collisions: self.max_collisions,
+            time_limit: self.time_limit,
+            walls: self.walls.clone(),
+            rescale_every: self.rescale_every,
+            jam: !self.no_jam,
+            jam_start: self.jam_start,
+            jam_step: self.jam_step,
+            jam_relax: self.jam_relax,
+            phi_start: self.phi_start,
+            tol: self.tol,
         }
-        let r: f64 = body.parse().map_err(|_| {
-            anyhow::anyhow!(
-                "{}:{}: `{body}` is not a number (one radius per line)",
-                path.display(),
-                k + 1
-            )
-        })?;
-        anyhow::ensure!(
-            r > 0.0 && r.is_finite(),
-            "{}:{}: radius {r} must be positive and finite",
-            path.display(),
-            k + 1
-        );
-        radii.push(r);
     }
-    anyhow::ensure!(
-        radii.len() >= 2,
-        "{}: needs at least 2 radii, found {}",
-        path.display(),
-        radii.len()
-    );
-    Ok(radii)
 }
 
+/// `mote pack [options]`: the same packing run as a `[packing]` scene under
+/// `mote run` (`mote_front::packing`), spelled as options.
 fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     let quiet = global.quiet;
-    anyhow::ensure!(a.dim == 2 || a.dim == 3, "--dim {}: must be 2 or 3", a.dim);
-    // Positions, velocities, radii, times, event, cell and neighbour entries:
-    // at least 300 bytes a sphere.
-    mote_io::system::check_fits(&format!("--n {}: the packing", a.n), a.n as f64 * 300.0)
-        .map_err(anyhow::Error::msg)?;
-    let sizes = match a.dist.strip_prefix("file:") {
-        Some(p) => SizeSpec::Radii(read_radii(Path::new(p))?),
-        None => SizeSpec::parse(&a.dist).map_err(|e| anyhow::anyhow!("--dist: {e}"))?,
-    };
-    let axes = &"xyz"[..a.dim];
-    let mut walls = vec![false; a.dim];
-    for c in a.walls.chars() {
-        let k = axes
-            .find(c)
-            .with_context(|| format!("--walls {}: `{c}` is not an axis of {axes}", a.walls))?;
-        walls[k] = true;
-    }
-    if let Some(t) = a.time_limit {
-        anyhow::ensure!(
-            t > 0.0 && t.is_finite(),
-            "--time-limit {t}: must be a positive number of seconds"
-        );
-    }
-    if let Some(t) = a.tol {
-        anyhow::ensure!(
-            t >= 0.0 && t.is_finite(),
-            "--tol {t}: must be a non-negative number"
-        );
-    }
+    let spec = a.spec();
     let (seed, chosen) = mote_front::seed::resolve(global.seed, None);
-    let settings = PackSettings {
-        n: a.n,
-        sizes,
-        rate: a.rate,
-        phi_start: a.phi_start,
-        walls,
-        max_pressure: a.max_pressure,
-        target_phi: a.phi,
-        max_collisions: a.max_collisions,
-        wall_clock: a.time_limit.map(Duration::from_secs_f64),
-        rescale_every: a.rescale_every,
-        finish: (!a.no_jam).then_some(Finish {
-            start_pressure: a.jam_start,
-            relax_windows: a.jam_relax,
-            step: a.jam_step,
-        }),
-        seed,
-    };
+    let settings = spec.settings(seed, Naming::Options, Path::new("."))?;
     let label = format!(
         "mote pack --dim {} --n {} --dist {} --rate {} --max-pressure {:e}{}",
         a.dim,
@@ -213,185 +161,39 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         a.max_pressure,
         if a.no_jam { " --no-jam" } else { "" }
     );
-    if !quiet {
-        eprintln!(
-            "mote pack: {label}, seed {seed}{}",
-            if chosen { " (chosen)" } else { "" }
-        );
-    }
+    let mut terminal = Terminal::new(quiet);
+    terminal.start(&format!(
+        "mote pack: {label}, seed {seed}{}",
+        if chosen { " (chosen)" } else { "" }
+    ));
     let provenance = mote_io::Provenance {
         program: format!("mote {}", env!("CARGO_PKG_VERSION")),
         scene: label,
         seed,
     };
-    match a.dim {
-        2 => pack_dim::<2>(settings, a, &provenance, quiet),
-        _ => pack_dim::<3>(settings, a, &provenance, quiet),
-    }
-}
-
-fn pack_dim<const D: usize>(
-    settings: PackSettings,
-    a: &PackArgs,
-    provenance: &mote_io::Provenance,
-    quiet: bool,
-) -> anyhow::Result<ExitCode> {
-    let max_pressure = settings.max_pressure;
-    let mut packer = Packer::<D>::new(settings).context("mote pack")?;
-    let stem = a.output.as_ref().map(|p| p.with_extension(""));
-    if let Some(dir) = a.output.as_ref().and_then(|p| p.parent()) {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("cannot create the folder {}", dir.display()))?;
-        }
-    }
-    let mut csv = match &stem {
-        Some(s) => {
-            let path = s.with_extension("csv");
-            Some(mote_io::csv::CsvWriter::create(
-                &path,
-                provenance,
-                &["collisions", "time", "phi", "pressure"].map(String::from),
-                &["", "", "", ""].map(String::from),
-            )?)
-        }
-        None => None,
+    let files = PackFiles {
+        xyz: a.output.clone(),
+        picture: a.picture.clone(),
     };
-    let bar = if quiet {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let b = indicatif::ProgressBar::new(1000);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} {elapsed_precise} {bar:30} {msg}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        // drawn only after a second, so short runs stay silent
-        b.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-        b
-    };
-    let t0 = std::time::Instant::now();
-    let cpu0 = mote_front::cpu::cpu_seconds();
-    let mut csv_err = None;
-    let result = packer.run(|s| {
-        if let Some(w) = csv.as_mut() {
-            if let Err(e) = w.row(&[s.collisions as f64, s.time, s.phi, s.pressure]) {
-                csv_err.get_or_insert(e);
-            }
-        }
-        if !quiet {
-            if t0.elapsed().as_secs_f64() > 1.0 && bar.is_hidden() {
-                bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            }
-            // progress: log10 of the pressure towards the threshold
-            let f = (s.pressure.max(1.0).log10() / max_pressure.log10()).clamp(0.0, 1.0);
-            bar.set_position((f * 1000.0) as u64);
-            bar.set_message(format!(
-                "phi {:.5}  Z {:.3e}  {} collisions",
-                s.phi, s.pressure, s.collisions
-            ));
-        }
-    });
-    bar.finish_and_clear();
-    let out = result.context("mote pack: run stopped")?;
-    if let Some(e) = csv_err {
-        return Err(e.into());
-    }
-    let cpu = mote_front::cpu::cpu_seconds() - cpu0;
-    let sys = packer.system();
-    let simbox = *sys.simbox();
-    let pos = sys.positions();
-    let radii = sys.radii();
-    let overlap = deepest_overlap(&simbox, &pos, &radii);
-    let frame = mote_edmd::scene::frame(sys);
-    if let Some(s) = &stem {
-        let path = a.output.clone().unwrap_or_else(|| s.with_extension("xyz"));
-        let mut w = mote_io::xyz::XyzWriter::create(&path, provenance.clone())?.exact();
-        w.write(&frame)?;
-        write_pov(&frame, &s.with_extension("pov"))?;
-    }
-    if let Some(p) = &a.picture {
-        mote_render::frame::picture(&frame, p, 800, 800)
-            .with_context(|| format!("{}: cannot render the picture", p.display()))?;
-    }
+    let packed = mote_front::packing::pack(
+        spec.dimension,
+        settings,
+        spec.tol,
+        &files,
+        &provenance,
+        &mut terminal,
+    )?;
     if !quiet {
-        let tol = a.tol.unwrap_or(1e3 / max_pressure);
-        let c = contacts(&simbox, &pos, &radii, tol);
-        let (q, _) = bond_order(&simbox, &pos, &radii, 1.2);
-        let stop = match out.stop {
-            Stop::Pressure => format!("reduced pressure passed {max_pressure:e} (jammed)"),
-            Stop::TargetPhi => "target packing fraction reached".to_string(),
-            Stop::Collisions => "collision budget spent".to_string(),
-            Stop::WallClock => "wall-clock limit reached".to_string(),
-            Stop::Interrupted => "run was interrupted by a signal (not jammed)".to_string(),
-        };
-        println!(
-            "{} {}: phi = {:.6}, reduced pressure Z = {:.3e}, stopped because the {stop}.",
-            sys.len(),
-            if D == 2 { "disks" } else { "spheres" },
-            out.phi,
-            out.pressure
-        );
-        println!(
-            "{} collisions in {:.2} s CPU ({:.3e} per CPU-second), {} growth epochs.",
-            out.collisions,
-            cpu,
-            out.collisions as f64 / cpu.max(1e-9),
-            out.epochs
-        );
-        println!(
-            "Contacts at relative gap {:e}: {} rattlers (< {} contacts), backbone mean contact number {:.4} (isostatic {}); {} = {:.4}.",
-            tol,
-            c.rattlers(),
-            D + 1,
-            c.backbone_z,
-            2 * D,
-            if D == 2 { "|psi6|" } else { "Q6" },
-            q
-        );
-        match overlap {
-            None => println!("No overlaps (exact check over all pairs that can touch)."),
-            Some((_, _, g)) if g > -1e-12 => println!(
-                "No overlaps beyond round-off (exact check over all pairs that can touch; deepest |r|/sigma - 1 = {g:.1e})."
-            ),
-            Some((i, j, g)) => println!(
-                "OVERLAP: particles {i} and {j}, |r|/sigma - 1 = {g:.3e}."
-            ),
+        for line in &packed.summary {
+            println!("{line}");
         }
-        if let Some(o) = &a.output {
-            println!("Wrote {} (+ .csv, .pov).", o.display());
-        }
-    }
-    if let Some((i, j, g)) = overlap {
-        anyhow::ensure!(
-            g > -1e-9,
-            "particles {i} and {j} overlap by {:.3e} of their contact distance",
-            -g
-        );
     }
     // A signal stopped it: the packing so far is written; exit 128 + signal.
-    if let (Stop::Interrupted, Some(signal)) = (out.stop, mote_io::system::stop_requested()) {
-        eprintln!("mote pack: interrupted by signal {signal}; the packing so far is written");
+    if let Ending::Interrupted { signal, message } = &packed.ending {
+        eprintln!("mote pack: {message}");
         return Ok(ExitCode::from((128 + signal).clamp(0, 255) as u8));
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn write_pov(frame: &mote_io::xyz::Frame, path: &Path) -> anyhow::Result<()> {
-    use mote_render::frame::{default_radius, scene_from_frame, ColorBy};
-    let (scene, _) = scene_from_frame(
-        frame,
-        &ColorBy::Species,
-        mote_render::ColorMap::Viridis,
-        default_radius(frame),
-    )?;
-    let (lo, hi) = scene.bounds().context("nothing to draw")?;
-    let cam = mote_render::Camera::frame(lo, hi, mote_render::camera::DEFAULT_VIEW, 30.0, 800, 800);
-    let opts = mote_render::RenderOptions {
-        shadows: true,
-        ..mote_render::RenderOptions::default()
-    };
-    mote_render::pov::write_pov(path, &scene, &cam, &opts)?;
-    Ok(())
 }
 
 fn analyse_cmd(global: &GlobalOpts, a: &AnalyseArgs) -> anyhow::Result<ExitCode> {

@@ -1,0 +1,496 @@
+//! Packings by growing spheres (Lubachevsky–Stillinger on the event-driven
+//! engine, `mote_edmd::pack`): one run for both ways in, the options of
+//! `mote pack` and a scene's `[packing]` table under `mote run`.
+//!
+//! The packing is written as extended XYZ with every number exact
+//! (`packing.xyz`), with φ and the reduced pressure per growth window
+//! (`packing.csv`) and a POV-Ray scene (`packing.pov`) beside it.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use mote_edmd::analyse::{bond_order, contacts, deepest_overlap};
+use mote_edmd::pack::{Finish, PackSettings, Packer, SizeSpec, Stop};
+use serde::Deserialize;
+
+use crate::error::{refuse, FrontError};
+use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
+
+/// What a packing is asked for, by either way in. The keys of a scene's
+/// `[packing]` table; `mote pack` spells them as options (`--dim` for
+/// `dimension`, `--no-jam` for `jam = false`, `-` for `_`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PackingSpec {
+    /// Number of particles (ignored with `dist = "file:PATH"`).
+    pub n: usize,
+    /// 3 (spheres) or 2 (disks).
+    pub dimension: usize,
+    /// `mono`, `bi:RATIO:FRACTION`, `lognormal:SIGMA` or `file:PATH` (one
+    /// radius per line, relative to the scene's folder).
+    pub dist: String,
+    /// Growth rate Γ = (1/v_th) d⟨d⟩/dt.
+    pub rate: f64,
+    /// Stop when the reduced pressure PV/(NkT) passes this.
+    pub max_pressure: f64,
+    /// Stop at this packing fraction.
+    pub phi: Option<f64>,
+    /// Stop after this many pair collisions.
+    pub max_collisions: Option<u64>,
+    /// Stop after this many seconds of wall-clock time.
+    pub time_limit: Option<f64>,
+    /// Hard walls on these axes (`"z"`, `"xyz"`); periodic elsewhere.
+    pub walls: String,
+    /// Collisions per particle between rescalings and pressure windows.
+    pub rescale_every: f64,
+    /// The quasi-static finish that jams the packing (false: grow at Γ to
+    /// the pressure threshold, spheropack's `Pressure` criterion).
+    pub jam: bool,
+    /// The finish starts when the pressure passes this.
+    pub jam_start: f64,
+    /// Fraction of the estimated gap to jamming closed per finishing step.
+    pub jam_step: f64,
+    /// Relaxation windows at fixed size between finishing steps.
+    pub jam_relax: usize,
+    /// Packing fraction of the random start.
+    pub phi_start: f64,
+    /// Relative gap tolerance of contacts in the summary (default
+    /// 1000/max_pressure).
+    pub tol: Option<f64>,
+}
+
+impl Default for PackingSpec {
+    fn default() -> Self {
+        Self {
+            n: 1000,
+            dimension: 3,
+            dist: "mono".into(),
+            rate: 0.01,
+            max_pressure: 1e12,
+            phi: None,
+            max_collisions: None,
+            time_limit: None,
+            walls: String::new(),
+            rescale_every: 10.0,
+            jam: true,
+            jam_start: 1e3,
+            jam_step: 0.2,
+            jam_relax: 4,
+            phi_start: 0.1,
+            tol: None,
+        }
+    }
+}
+
+/// How a request names a key in its messages: as `mote pack` options or
+/// as `[packing]` keys of a scene (with the line they are on).
+#[derive(Debug, Clone, Copy)]
+pub enum Naming<'a> {
+    Options,
+    Scene(mote_io::Source<'a>),
+}
+
+impl Naming<'_> {
+    /// `--dim 4` or `file.toml:3: [packing] dimension = 4`; `quoted` for
+    /// a string value (`walls = "q"` in a scene).
+    fn said(&self, key: &str, value: impl std::fmt::Display, quoted: bool) -> String {
+        match self {
+            Naming::Options => {
+                let option = match key {
+                    "dimension" => "dim".to_string(),
+                    k => k.replace('_', "-"),
+                };
+                format!("--{option} {value}")
+            }
+            Naming::Scene(src) => {
+                let q = if quoted { "\"" } else { "" };
+                format!(
+                    "{}:{}: [packing] {key} = {q}{value}{q}",
+                    src.file,
+                    src.key_line(key)
+                )
+            }
+        }
+    }
+}
+
+impl PackingSpec {
+    /// The engine's settings, or a message naming the bad key as the
+    /// request spelled it. Relative radii files resolve against `base`.
+    pub fn settings(
+        &self,
+        seed: u64,
+        naming: Naming,
+        base: &Path,
+    ) -> Result<PackSettings, FrontError> {
+        let said = |key: &str, value: &dyn std::fmt::Display| {
+            naming.said(key, value, matches!(key, "dist" | "walls"))
+        };
+        if self.dimension != 2 && self.dimension != 3 {
+            refuse!("{}: must be 2 or 3", said("dimension", &self.dimension));
+        }
+        // Positions, velocities, radii, times, event, cell and neighbour
+        // entries: at least 300 bytes a sphere.
+        mote_io::system::check_fits(
+            &format!("{}: the packing", said("n", &self.n)),
+            self.n as f64 * 300.0,
+        )
+        .map_err(FrontError::request)?;
+        let sizes = match self.dist.strip_prefix("file:") {
+            Some(p) => SizeSpec::Radii(read_radii(&base.join(p))?),
+            None => SizeSpec::parse(&self.dist)
+                .map_err(|e| FrontError::request(format!("{}: {e}", said("dist", &self.dist))))?,
+        };
+        let axes = &"xyz"[..self.dimension];
+        let mut walls = vec![false; self.dimension];
+        for c in self.walls.chars() {
+            let Some(k) = axes.find(c) else {
+                refuse!(
+                    "{}: `{c}` is not an axis of {axes}",
+                    said("walls", &self.walls)
+                );
+            };
+            walls[k] = true;
+        }
+        if let Some(t) = self.time_limit {
+            if !(t > 0.0 && t.is_finite()) {
+                refuse!(
+                    "{}: must be a positive number of seconds",
+                    said("time_limit", &t)
+                );
+            }
+        }
+        if let Some(t) = self.tol {
+            if !(t >= 0.0 && t.is_finite()) {
+                refuse!("{}: must be a non-negative number", said("tol", &t));
+            }
+        }
+        Ok(PackSettings {
+            n: self.n,
+            sizes,
+            rate: self.rate,
+            phi_start: self.phi_start,
+            walls,
+            max_pressure: self.max_pressure,
+            target_phi: self.phi,
+            max_collisions: self.max_collisions,
+            wall_clock: self.time_limit.map(Duration::from_secs_f64),
+            rescale_every: self.rescale_every,
+            finish: self.jam.then_some(Finish {
+                start_pressure: self.jam_start,
+                relax_windows: self.jam_relax,
+                step: self.jam_step,
+            }),
+            seed,
+        })
+    }
+}
+
+/// Reads one radius per line (`#` starts a comment); errors as `file:line: ...`.
+fn read_radii(path: &Path) -> Result<Vec<f64>, FrontError> {
+    let text = std::fs::read_to_string(path).map_err(|e| mote_io::IoError::os(path, e))?;
+    let at = |line: usize, message: String| {
+        FrontError::request(format!("{}:{line}: {message}", path.display()))
+    };
+    let mut radii = Vec::new();
+    for (k, line) in text.lines().enumerate() {
+        let body = line.split('#').next().unwrap_or("").trim();
+        if body.is_empty() {
+            continue;
+        }
+        let r: f64 = body.parse().map_err(|_| {
+            at(
+                k + 1,
+                format!("`{body}` is not a number (one radius per line)"),
+            )
+        })?;
+        if !(r > 0.0 && r.is_finite()) {
+            return Err(at(k + 1, format!("radius {r} must be positive and finite")));
+        }
+        radii.push(r);
+    }
+    if radii.len() < 2 {
+        refuse!(
+            "{}: needs at least 2 radii, found {}",
+            path.display(),
+            radii.len()
+        );
+    }
+    Ok(radii)
+}
+
+/// Where a packing goes: the XYZ file (the CSV and POV-Ray scene go beside
+/// it, same stem) and a picture.
+#[derive(Debug, Clone, Default)]
+pub struct PackFiles {
+    pub xyz: Option<PathBuf>,
+    pub picture: Option<PathBuf>,
+}
+
+/// What a packing run did: the summary lines and how it ended.
+#[derive(Debug, Clone)]
+pub struct Packed {
+    pub summary: Vec<String>,
+    pub ending: Ending,
+}
+
+/// Grows the packing `settings` describe, writes `files` and says what it
+/// found (φ, pressure, why it stopped, contacts, order, overlaps). A
+/// signal stops it at the end of the current window with the packing so
+/// far written; an overlap beyond round-off is an error.
+pub fn pack(
+    dimension: usize,
+    settings: PackSettings,
+    tol: Option<f64>,
+    files: &PackFiles,
+    provenance: &mote_io::Provenance,
+    monitor: &mut dyn Monitor,
+) -> Result<Packed, FrontError> {
+    match dimension {
+        2 => pack_dim::<2>(settings, tol, files, provenance, monitor),
+        _ => pack_dim::<3>(settings, tol, files, provenance, monitor),
+    }
+}
+
+fn pack_dim<const D: usize>(
+    settings: PackSettings,
+    tol: Option<f64>,
+    files: &PackFiles,
+    provenance: &mote_io::Provenance,
+    monitor: &mut dyn Monitor,
+) -> Result<Packed, FrontError> {
+    let max_pressure = settings.max_pressure;
+    let mut packer = Packer::<D>::new(settings)?;
+    let stem = files.xyz.as_ref().map(|p| p.with_extension(""));
+    if let Some(dir) = files.xyz.as_ref().and_then(|p| p.parent()) {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
+        }
+    }
+    let mut csv = match &stem {
+        Some(s) => Some(mote_io::csv::CsvWriter::create(
+            &s.with_extension("csv"),
+            provenance,
+            &["collisions", "time", "phi", "pressure"].map(String::from),
+            &["", "", "", ""].map(String::from),
+        )?),
+        None => None,
+    };
+    let cpu0 = crate::cpu::cpu_seconds();
+    let mut csv_err = None;
+    let outcome = packer.run(|s| {
+        if let Some(w) = csv.as_mut() {
+            if let Err(e) = w.row(&[s.collisions as f64, s.time, s.phi, s.pressure]) {
+                csv_err.get_or_insert(e);
+            }
+        }
+        // Progress: log10 of the pressure towards the threshold.
+        let f = (s.pressure.max(1.0).log10() / max_pressure.log10()).clamp(0.0, 1.0);
+        monitor.progress(
+            (f * 1000.0) as u64,
+            1000,
+            &format!(
+                "phi {:.5}  Z {:.3e}  {} collisions",
+                s.phi, s.pressure, s.collisions
+            ),
+        );
+    })?;
+    monitor.finish();
+    if let Some(e) = csv_err {
+        return Err(e.into());
+    }
+    let cpu = crate::cpu::cpu_seconds() - cpu0;
+    let sys = packer.system();
+    let simbox = *sys.simbox();
+    let (pos, radii) = (sys.positions(), sys.radii());
+    let overlap = deepest_overlap(&simbox, &pos, &radii);
+    let frame = mote_edmd::scene::frame(sys);
+    if let (Some(path), Some(s)) = (&files.xyz, &stem) {
+        let mut w = mote_io::xyz::XyzWriter::create(path, provenance.clone())?.exact();
+        w.write(&frame)?;
+        write_pov(&frame, &s.with_extension("pov"))?;
+    }
+    if let Some(p) = &files.picture {
+        mote_render::frame::picture(&frame, p, 800, 800)?;
+    }
+    let tol = tol.unwrap_or(1e3 / max_pressure);
+    let c = contacts(&simbox, &pos, &radii, tol);
+    let (q, _) = bond_order(&simbox, &pos, &radii, 1.2);
+    let stop = match outcome.stop {
+        Stop::Pressure => format!("reduced pressure passed {max_pressure:e} (jammed)"),
+        Stop::TargetPhi => "target packing fraction reached".to_string(),
+        Stop::Collisions => "collision budget spent".to_string(),
+        Stop::WallClock => "wall-clock limit reached".to_string(),
+        Stop::Interrupted => "run was interrupted by a signal (not jammed)".to_string(),
+    };
+    let mut summary = vec![
+        format!(
+            "{} {}: phi = {:.6}, reduced pressure Z = {:.3e}, stopped because the {stop}.",
+            sys.len(),
+            if D == 2 { "disks" } else { "spheres" },
+            outcome.phi,
+            outcome.pressure
+        ),
+        format!(
+            "{} collisions in {:.2} s CPU ({:.3e} per CPU-second), {} growth epochs.",
+            outcome.collisions,
+            cpu,
+            outcome.collisions as f64 / cpu.max(1e-9),
+            outcome.epochs
+        ),
+        format!(
+            "Contacts at relative gap {:e}: {} rattlers (< {} contacts), backbone mean contact number {:.4} (isostatic {}); {} = {:.4}.",
+            tol,
+            c.rattlers(),
+            D + 1,
+            c.backbone_z,
+            2 * D,
+            if D == 2 { "|psi6|" } else { "Q6" },
+            q
+        ),
+        match overlap {
+            None => "No overlaps (exact check over all pairs that can touch).".to_string(),
+            Some((_, _, g)) if g > -1e-12 => format!(
+                "No overlaps beyond round-off (exact check over all pairs that can touch; deepest |r|/sigma - 1 = {g:.1e})."
+            ),
+            Some((i, j, g)) => format!("OVERLAP: particles {i} and {j}, |r|/sigma - 1 = {g:.3e}."),
+        },
+    ];
+    if let Some(o) = &files.xyz {
+        summary.push(format!("Wrote {} (+ .csv, .pov).", o.display()));
+    }
+    if let Some((i, j, g)) = overlap {
+        if g <= -1e-9 {
+            refuse!(
+                "particles {i} and {j} overlap by {:.3e} of their contact distance",
+                -g
+            );
+        }
+    }
+    let ending = match (outcome.stop, mote_io::system::stop_requested()) {
+        (Stop::Interrupted, Some(signal)) => Ending::Interrupted {
+            signal,
+            message: format!("interrupted by signal {signal}; the packing so far is written"),
+        },
+        _ => Ending::Finished,
+    };
+    Ok(Packed { summary, ending })
+}
+
+/// The POV-Ray scene of a packing, framed and lit as the pictures are.
+fn write_pov(frame: &mote_io::xyz::Frame, path: &Path) -> Result<(), FrontError> {
+    use mote_render::frame::{default_radius, scene_from_frame, ColorBy};
+    let (scene, _) = scene_from_frame(
+        frame,
+        &ColorBy::Species,
+        mote_render::ColorMap::Viridis,
+        default_radius(frame),
+    )?;
+    let Some((lo, hi)) = scene.bounds() else {
+        refuse!("{}: nothing to draw", path.display());
+    };
+    let cam = mote_render::Camera::frame(lo, hi, mote_render::camera::DEFAULT_VIEW, 30.0, 800, 800);
+    let opts = mote_render::RenderOptions {
+        shadows: true,
+        ..mote_render::RenderOptions::default()
+    };
+    mote_render::pov::write_pov(path, &scene, &cam, &opts)?;
+    Ok(())
+}
+
+/// A packing scene: `title`, `seed`, `[packing]` and `[output] dir`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PackingScene {
+    #[allow(dead_code)]
+    title: Option<String>,
+    seed: Option<u64>,
+    packing: PackingSpec,
+    #[serde(default)]
+    output: PackingOutput,
+    /// Read only to be refused with the reason.
+    run: Option<toml::Value>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PackingOutput {
+    dir: Option<String>,
+}
+
+/// `mote run` on a scene with a `[packing]` table: the packing goes to
+/// `DIR/packing.xyz` (with .csv and .pov beside it).
+pub(crate) fn run(
+    input: &Input,
+    options: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    const WHY_NO_TIME: &str =
+        "a packing grows until it jams; bound it with [packing] phi, max_pressure, max_collisions or time_limit";
+    options.refuse(
+        "packings",
+        &[
+            (options.dt.is_some(), "--dt", WHY_NO_TIME),
+            (options.steps.is_some(), "--steps", WHY_NO_TIME),
+            (options.until.is_some(), "--until", WHY_NO_TIME),
+            (options.solver.is_some(), "--solver", crate::WHY_NO_SOLVER),
+            (options.system.is_some(), "--system", crate::WHY_NO_SYSTEM),
+            (
+                options.checkpoint_every.is_some(),
+                "--checkpoint-every",
+                "packings write no checkpoints yet; a signal still writes the packing so far",
+            ),
+        ],
+    )?;
+    let source = mote_io::Source::new(&input.label, &input.text);
+    let scene: PackingScene = toml::from_str(&input.text)
+        .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))?;
+    if scene.run.is_some() {
+        refuse!(
+            "{}:{}: [run] has nothing to set for a packing: {WHY_NO_TIME}",
+            source.file,
+            source.key_line("run")
+        );
+    }
+    let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
+    let base = input.folder();
+    let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
+    let spec = &scene.packing;
+    let settings = spec.settings(seed, Naming::Scene(source), &base)?;
+    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
+    let _lock = crate::lock::FolderLock::take(&dir)?;
+    monitor.start(&format!(
+        "mote run {}: packing {} {} by growth (rate {}, {}), {}, {}",
+        input.label,
+        spec.n,
+        if spec.dimension == 2 {
+            "disks"
+        } else {
+            "spheres"
+        },
+        spec.rate,
+        spec.dist,
+        crate::seed_phrase(seed, chosen),
+        crate::threads_phrase()
+    ));
+    let files = PackFiles {
+        xyz: Some(dir.join("packing.xyz")),
+        picture: options.picture.clone(),
+    };
+    let provenance = crate::provenance(&input.label, seed);
+    let packed = pack(
+        spec.dimension,
+        settings,
+        spec.tol,
+        &files,
+        &provenance,
+        monitor,
+    )?;
+    Ok(Outcome {
+        engine: Engine::Packing,
+        seed,
+        dir,
+        summary: packed.summary,
+        ending: packed.ending,
+    })
+}
