@@ -9,14 +9,12 @@ use mote_io::{IoError, Provenance};
 use crate::error::FrontError;
 use crate::{Input, RunOptions};
 
-pub(crate) fn hex(x: f64) -> String {
-    format!("{:016x}", x.to_bits())
-}
+pub(crate) use mote_io::checkpoint::hex;
 
+/// A checkpoint option written by [`hex`], exactly.
 pub(crate) fn unhex(s: &str) -> Result<f64, FrontError> {
-    u64::from_str_radix(s, 16)
-        .map(f64::from_bits)
-        .map_err(|_| FrontError::request("a checkpoint option is not a hexadecimal f64"))
+    mote_io::checkpoint::unhex(s)
+        .ok_or_else(|| FrontError::request("a checkpoint option is not a hexadecimal f64"))
 }
 
 fn number<T: std::str::FromStr>(key: &str, v: String) -> Result<T, FrontError> {

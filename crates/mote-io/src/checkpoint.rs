@@ -50,8 +50,15 @@ impl Checkpoint {
     }
 }
 
-fn hex(x: f64) -> String {
+/// An f64 as the 16 hexadecimal digits of its bits: how checkpoints keep
+/// every number exactly (options included).
+pub fn hex(x: f64) -> String {
     format!("{:016x}", x.to_bits())
+}
+
+/// The f64 whose bits [`hex`] wrote; `None` if `s` is not 1–16 hex digits.
+pub fn unhex(s: &str) -> Option<f64> {
+    u64::from_str_radix(s, 16).ok().map(f64::from_bits)
 }
 
 /// Writes `cp` to `path` atomically.
@@ -146,9 +153,7 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
     let mut cp = Checkpoint::default();
     let mut k = 1;
     let bits = |s: &str, k: usize| -> Result<f64, ParseError> {
-        u64::from_str_radix(s, 16)
-            .map(f64::from_bits)
-            .map_err(|_| err(k, &format!("'{s}' is not a hexadecimal f64")))
+        unhex(s).ok_or_else(|| err(k, &format!("'{s}' is not a hexadecimal f64")))
     };
     while k < lines.len() {
         let line = lines[k];

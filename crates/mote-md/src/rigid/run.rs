@@ -133,7 +133,7 @@ impl Propagator for RigidDynamics {
         let b = &self.bodies;
         cp.options.retain(|(k, _)| k != "dt" && k != "total-steps");
         cp.options
-            .push(("dt".into(), format!("{:016x}", self.dt.to_bits())));
+            .push(("dt".into(), mote_io::checkpoint::hex(self.dt)));
         cp.options
             .push(("total-steps".into(), self.last_step.to_string()));
         cp.time = b.time;
