@@ -264,7 +264,7 @@ fn hoist_event_driven(
     let Some(table) = item.into_table().ok() else {
         return Err(EdmdError::Scene {
             file: source.file.to_string(),
-            line: 1,
+            line: source.key_line("event_driven"),
             message: "`event_driven` must be a table: [event_driven]".into(),
         });
     };
@@ -879,8 +879,8 @@ mod tests {
             "bad.toml:6: unknown key `density` in [event_driven]; it takes dimension, n,"
         ));
         assert_eq!(
-            e("event_driven = 3\n"),
-            "bad.toml:1: `event_driven` must be a table: [event_driven]"
+            e("seed = 1\nevent_driven = 3\n"),
+            "bad.toml:2: `event_driven` must be a table: [event_driven]"
         );
     }
 

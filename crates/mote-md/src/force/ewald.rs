@@ -504,11 +504,10 @@ impl Interaction for EwaldDipoles {
     fn add_forces_and_torques(
         &mut self,
         state: &State,
-        spin: &Spin,
+        _spin: &Spin,
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        let _ = spin;
         let n = force.len();
         if state.dipole.len() != n {
             return;

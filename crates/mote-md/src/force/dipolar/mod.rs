@@ -693,11 +693,10 @@ impl Interaction for DipoleDipole {
     fn add_forces_and_torques(
         &mut self,
         state: &State,
-        spin: &Spin,
+        _spin: &Spin,
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        let _ = spin;
         if state.dipole.len() == state.position.len() {
             let shared = self.shared(state);
             self.forces_through(state.position, state.dipole, shared, force, torque);
@@ -917,11 +916,10 @@ impl Interaction for Zeeman {
     fn add_forces_and_torques(
         &mut self,
         state: &State,
-        spin: &Spin,
+        _spin: &Spin,
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        let _ = spin;
         if state.dipole.len() == state.position.len() {
             self.forces_and_torques(state.position, state.dipole, state.time, force, torque);
         }
