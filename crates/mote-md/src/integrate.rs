@@ -18,6 +18,7 @@
 //! ignore torques; scenes with rotation require leap-frog.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::force::{ForceField, Spin, State};
 use crate::particles::System;
@@ -82,6 +83,19 @@ pub fn rotate(m: DVec3, theta: DVec3) -> DVec3 {
     let k = theta / angle;
     let (sin, cos) = angle.sin_cos();
     m * cos + k.cross(m) * sin + k * (k.dot(m) * (1.0 - cos))
+}
+
+/// Particles per parallel task of the element-wise updates (each element
+/// is computed alone, so every thread count gives the same bits).
+const PER_TASK: usize = 4096;
+
+/// v += a h for every particle.
+fn kick(velocity: &mut [DVec3], acc: &[DVec3], h: f64) {
+    velocity
+        .par_iter_mut()
+        .zip(acc)
+        .with_min_len(PER_TASK)
+        .for_each(|(v, a)| *v += *a * h);
 }
 
 /// An integrator with its scratch space (the state itself lives in [`System`]).
@@ -156,21 +170,29 @@ impl Stepper {
         let half = 0.5 * h;
         {
             let p = &mut sys.particles;
-            for i in 0..n {
-                p.velocity[i] += acc[i] * half;
-                p.position[i] += p.velocity[i] * h;
-                p.angular_velocity[i] += alpha[i] * half;
-                if p.dipole[i] != DVec3::ZERO {
-                    p.dipole[i] = rotate(p.dipole[i], p.angular_velocity[i] * h);
-                }
-            }
+            (&mut p.velocity, &mut p.position)
+                .into_par_iter()
+                .zip(&acc)
+                .with_min_len(PER_TASK)
+                .for_each(|((v, x), a)| {
+                    *v += *a * half;
+                    *x += *v * h;
+                });
+            (&mut p.angular_velocity, &mut p.dipole)
+                .into_par_iter()
+                .zip(&alpha)
+                .with_min_len(PER_TASK)
+                .for_each(|((w, m), a)| {
+                    *w += *a * half;
+                    if *m != DVec3::ZERO {
+                        *m = rotate(*m, *w * h);
+                    }
+                });
         }
         Self::eval_rotating(ff, sys, t + h, h, &mut acc, &mut alpha);
         let p = &mut sys.particles;
-        for i in 0..n {
-            p.velocity[i] += acc[i] * half;
-            p.angular_velocity[i] += alpha[i] * half;
-        }
+        kick(&mut p.velocity, &acc, half);
+        kick(&mut p.angular_velocity, &alpha, half);
         sys.carried_acceleration = acc;
         sys.carried_angular_acceleration = alpha;
     }
@@ -252,10 +274,14 @@ impl Stepper {
                 let half = 0.5 * h;
                 {
                     let p = &mut sys.particles;
-                    for i in 0..p.len() {
-                        p.velocity[i] += acc[i] * half;
-                        p.position[i] += p.velocity[i] * h;
-                    }
+                    (&mut p.velocity, &mut p.position)
+                        .into_par_iter()
+                        .zip(&acc)
+                        .with_min_len(PER_TASK)
+                        .for_each(|((v, x), a)| {
+                            *v += *a * half;
+                            *x += *v * h;
+                        });
                 }
                 Self::eval(
                     ff,
@@ -266,10 +292,7 @@ impl Stepper {
                     h,
                     &mut acc,
                 );
-                let p = &mut sys.particles;
-                for i in 0..p.len() {
-                    p.velocity[i] += acc[i] * half;
-                }
+                kick(&mut sys.particles.velocity, &acc, half);
                 sys.carried_acceleration = acc;
             }
             Integrator::Rk4 => self.rk4(sys, ff, h),

@@ -1,6 +1,7 @@
 //! Particles as a structure of arrays, and the system that owns them.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::boundary::Boundary;
 
@@ -130,7 +131,8 @@ impl System {
             let b = self.boundary;
             self.particles
                 .position
-                .iter_mut()
+                .par_iter_mut()
+                .with_min_len(4096)
                 .for_each(|r| *r = b.wrap(*r));
         }
     }

@@ -75,11 +75,11 @@ fn cpu_seconds() -> f64 {
     tick(11) + tick(12)
 }
 
-#[test]
-#[ignore = "timing"]
-fn lj_dipole_fluid_32000_one_thread() {
+/// 100 steps of the 32000-atom fluid on `threads` threads (after one
+/// step that builds the list): CPU and wall µs per atom-step.
+fn lj_dipole_fluid_32000(threads: usize) {
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
+        .num_threads(threads)
         .build()
         .unwrap();
     pool.install(|| {
@@ -93,8 +93,20 @@ fn lj_dipole_fluid_32000_one_thread() {
         }
         let (cpu, wall) = (cpu_seconds() - c0, w0.elapsed().as_secs_f64());
         let n = sys.particles.len() as f64;
-        println!("dipolar LJ fluid, N = {n}, {steps} steps: {cpu:.2} CPU-s, {wall:.2} wall-s: {:.3} CPU-µs per atom-step ({:.3} wall)", cpu / (n * steps as f64) * 1e6, wall / (n * steps as f64) * 1e6);
+        println!("dipolar LJ fluid, N = {n}, {steps} steps, {threads} thread(s): {cpu:.2} CPU-s, {wall:.2} wall-s: {:.3} CPU-µs per atom-step ({:.3} wall)", cpu / (n * steps as f64) * 1e6, wall / (n * steps as f64) * 1e6);
     });
+}
+
+#[test]
+#[ignore = "timing"]
+fn lj_dipole_fluid_32000_one_thread() {
+    lj_dipole_fluid_32000(1);
+}
+
+#[test]
+#[ignore = "timing"]
+fn lj_dipole_fluid_32000_two_threads() {
+    lj_dipole_fluid_32000(2);
 }
 
 #[test]

@@ -1,7 +1,8 @@
-//! One neighbour list, owned by the force field, serves every short-range
-//! interaction: granular contacts and cut-off dipoles read it through the
-//! step's `State` and give the same forces, bit for bit, as each through a
-//! list of its own; one list is built, not one per interaction.
+//! The force field's shared half neighbour list: granular contacts read it
+//! through the step's `State` and give the same forces, bit for bit, as
+//! through a list of their own. Cut-off dipoles (like Lennard-Jones) run
+//! their SIMD rows over a ghost list of their own and do not widen the
+//! shared list.
 
 use mote_md::force::dipolar::DipoleDipole;
 use mote_md::force::granular::{ContactLaw, Damping, GranularContacts, Material};
@@ -44,7 +45,7 @@ fn particles() -> Spheres {
 }
 
 #[test]
-fn granular_and_dipoles_share_one_list_with_the_same_forces() {
+fn granular_contacts_read_the_shared_list_beside_dipoles_on_their_ghost_list() {
     let (pos, vel, radius, mass, dipole) = particles();
     let n = pos.len();
     let omega = vec![DVec3::new(0.0, 0.0, 0.5); n];
@@ -66,7 +67,7 @@ fn granular_and_dipoles_share_one_list_with_the_same_forces() {
     d.add_forces_and_torques(&state, &spin, &mut f_own, &mut t_own);
     assert_eq!((g.list.builds, d.list.builds), (1, 1));
 
-    // Both through the force field's one list.
+    // Both in one force field.
     let mut ff = ForceField::new().with(granular()).with(dipoles());
     let (mut f, mut t) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
     ff.add_forces_and_torques(&state, &spin, &mut f, &mut t);
@@ -75,9 +76,10 @@ fn granular_and_dipoles_share_one_list_with_the_same_forces() {
 
     let shared = ff.neighbours().expect("a shared list");
     assert_eq!(shared.builds, 1);
-    // Its reach covers both: max(2·0.55 + 0.2, 2.5 + 0.3) = 2.8.
-    assert_eq!(shared.cutoff, 2.5);
-    assert!((shared.cutoff + shared.skin - 2.8).abs() < 1e-12);
+    // Its reach is the contacts' alone, 2·0.55 + 0.2: the dipoles' rows
+    // run over their own ghost list (a full list with periodic images).
+    assert_eq!(shared.cutoff, 1.1);
+    assert!((shared.cutoff + shared.skin - 1.3).abs() < 1e-12);
     // Energies through the shared list, as through the own ones.
     let (u, _) = ff.potential_energy(&state);
     assert_eq!(u, g.potential_energy(&state) + d.potential_energy(&state));

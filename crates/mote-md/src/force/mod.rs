@@ -316,9 +316,12 @@ impl ForceField {
         for interaction in &mut self.interactions {
             interaction.add_forces(state, &mut self.force);
         }
-        for i in 0..n {
-            acc[i] = self.force[i] / state.mass[i] * mobility[i];
-        }
+        use rayon::prelude::*;
+        let (force, mass) = (&self.force, state.mass);
+        acc.par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, a)| *a = force[i] / mass[i] * mobility[i]);
     }
 
     /// Whether any interaction exerts torques.
@@ -349,14 +352,20 @@ impl ForceField {
         torque.resize(n, DVec3::ZERO);
         self.add_forces_and_torques(state, spin, &mut force, &mut torque);
         (self.force, self.torque) = (force, torque);
-        for i in 0..n {
-            acc[i] = self.force[i] / state.mass[i] * particles.mobility[i];
-            alpha[i] = if particles.rotates(i) {
-                self.torque[i] / particles.inertia[i]
-            } else {
-                DVec3::ZERO
-            };
-        }
+        use rayon::prelude::*;
+        let (force, torque, mass) = (&self.force, &self.torque, state.mass);
+        (acc, alpha)
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(i, (a, al))| {
+                *a = force[i] / mass[i] * particles.mobility[i];
+                *al = if particles.rotates(i) {
+                    torque[i] / particles.inertia[i]
+                } else {
+                    DVec3::ZERO
+                };
+            });
     }
 
     /// Adds every interaction's forces and torques at `state` to `force`

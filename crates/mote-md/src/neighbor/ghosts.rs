@@ -25,6 +25,10 @@ use crate::boundary::Boundary;
 /// Particles per parallel block of a build or refresh.
 const BLOCK: usize = 512;
 
+/// Rows per block of [`GhostList::sum_rows`] (fixed, so sums do not depend
+/// on the number of threads).
+pub const ROWS: usize = 256;
+
 /// A copy's coordinates (x, y, z, 0), aligned to 32 bytes.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 #[repr(C, align(32))]
@@ -98,6 +102,60 @@ impl GhostList {
     #[inline]
     pub fn row(&self, r: usize) -> &[u32] {
         &self.neighbors[self.start[r] as usize..self.start[r + 1] as usize]
+    }
+
+    /// Runs `row` on every row in fixed blocks of [`ROWS`], in parallel:
+    /// its first part goes to `out[r]` (one entry per row), its K numbers
+    /// are summed row after row within a block and block after block, so
+    /// every thread count gives the same bits.
+    pub fn sum_rows<T: Send, const K: usize>(
+        &self,
+        out: &mut [T],
+        row: impl Fn(usize) -> (T, [f64; K]) + Sync,
+    ) -> [f64; K] {
+        assert_eq!(out.len(), self.len(), "one output per row");
+        let sums: Vec<[f64; K]> = out
+            .par_chunks_mut(ROWS)
+            .enumerate()
+            .map(|(b, out)| {
+                let mut sum = [0.0; K];
+                for (m, o) in out.iter_mut().enumerate() {
+                    let (value, numbers) = row(b * ROWS + m);
+                    *o = value;
+                    for (s, x) in sum.iter_mut().zip(numbers) {
+                        *s += x;
+                    }
+                }
+                sum
+            })
+            .collect();
+        sums.iter().fold([0.0; K], |mut total, s| {
+            for (t, x) in total.iter_mut().zip(s) {
+                *t += x;
+            }
+            total
+        })
+    }
+
+    /// A per-particle vector for every copy (ghosts take their particle's),
+    /// as aligned records in copy order: what row kernels read beside the
+    /// positions (dipole moments, velocities).
+    pub fn gather(&self, values: &[DVec3], out: &mut Vec<Copy4>) {
+        out.clear();
+        out.par_extend(self.particle.par_iter().with_min_len(BLOCK).map(|&i| {
+            let v = values[i as usize];
+            Copy4([v.x, v.y, v.z, 0.0])
+        }));
+    }
+
+    /// Adds the value of each particle's row (`sorted`, in row order) to
+    /// the particle's entry of `to`.
+    pub fn scatter_add(&self, sorted: &[DVec3], to: &mut [DVec3]) {
+        let slot = &self.slot;
+        to.par_iter_mut()
+            .with_min_len(4096)
+            .enumerate()
+            .for_each(|(i, f)| *f += sorted[slot[i] as usize]);
     }
 
     /// Counts one step: rebuilds the list if it is due or stale, else moves

@@ -12,6 +12,8 @@ use rayon::prelude::*;
 
 use crate::boundary::Boundary;
 
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx512;
 mod ghosts;
 pub use ghosts::{Copy4, GhostList};
 

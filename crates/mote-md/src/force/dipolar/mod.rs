@@ -24,8 +24,10 @@
 //! - **all pairs** (open boundaries, no cut-off): exact; each particle's
 //!   row is summed over all others in a fixed order, parallel over
 //!   particles, so results are bit-identical for every thread count;
-//! - **minimum image with a spherical cut-off** r_c ≤ L/2 (periodic boxes):
-//!   an *approximation*. The dipolar sum converges only conditionally;
+//! - **a spherical cut-off** r_c ≤ L/2 (periodic boxes: each pair's
+//!   minimum image), through a full ghost list with SIMD rows
+//!   (`listed.rs`; every thread count gives the same bits): an
+//!   *approximation*. The dipolar sum converges only conditionally;
 //!   truncating it at r_c amounts to a sphere of radius r_c around every
 //!   dipole surrounded by vacuum, which leaves out the Lorentz field M/3 of
 //!   the far dipoles and so underestimates magnetisation and susceptibility.
@@ -59,10 +61,11 @@ use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
 mod avx512;
+mod listed;
 
-use super::{add_block_buffers, BlockBuffers, Interaction, Spin, State};
+use super::{Interaction, Spin, State};
 use crate::boundary::Boundary;
-use crate::neighbor::VerletList;
+use crate::neighbor::{Copy4, GhostList};
 use crate::units::UnitSystem;
 
 /// μ₀ in a unit system: SI 1.256 637 061 27 × 10⁻⁶ N/A² (CODATA 2022);
@@ -224,13 +227,17 @@ pub struct DipoleDipole {
     pub reaction_field: f64,
     pub repulsion: Option<PairRepulsion>,
     pub boundary: Boundary,
-    /// Half Verlet list (cut-off mode only).
-    pub list: VerletList,
+    /// Full list over sorted copies and periodic ghosts (cut-off mode only).
+    pub list: GhostList,
     virial: f64,
-    /// Per-block force and torque buffers (cut-off mode).
-    buffers: BlockBuffers,
+    /// The moments of the list's copies (cut-off mode).
+    moment: Vec<Copy4>,
+    /// Force and torque of each row of the list (cut-off mode).
+    sorted: Vec<(DVec3, DVec3)>,
     /// Structure-of-arrays copies for the all-pairs loop.
     soa: Soa,
+    /// The row kernels' instruction set.
+    isa: Isa,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -253,16 +260,19 @@ impl DipoleDipole {
             reaction_field: 1.0,
             repulsion: None,
             boundary: Boundary::open(),
-            list: VerletList::half(0.0, 0.0),
+            list: GhostList::new(0.0, 0.0),
             virial: 0.0,
-            buffers: Vec::new(),
+            moment: Vec::new(),
+            sorted: Vec::new(),
             soa: Soa::default(),
+            isa: isa(),
         }
     }
 
-    /// Pairs closer than `cutoff`, found through a half Verlet list with
-    /// `skin`, with minimum-image separations on periodic axes (an
-    /// approximation for periodic systems: see the module page).
+    /// Pairs closer than `cutoff`, found through a ghost list with `skin`
+    /// (each periodic image within the cut-off, which r_c ≤ L/2 makes the
+    /// minimum image; an approximation for periodic systems: see the
+    /// module page).
     pub fn cut_off(
         mu0: f64,
         cutoff: f64,
@@ -277,7 +287,7 @@ impl DipoleDipole {
         let mut s = Self::all_pairs(mu0);
         s.cutoff = cutoff;
         s.boundary = boundary;
-        s.list = VerletList::half(cutoff, skin);
+        s.list = GhostList::new(cutoff, skin);
         s.check_box(cutoff)?;
         Ok(s)
     }
@@ -315,6 +325,13 @@ impl DipoleDipole {
         Ok(())
     }
 
+    /// Uses the AVX-512 rows where the CPU has them (the default) or the
+    /// portable ones; for tests that compare the two.
+    #[doc(hidden)]
+    pub fn set_simd(&mut self, on: bool) {
+        self.isa = if on { isa() } else { Isa::Portable };
+    }
+
     fn kernel(&self) -> Kernel {
         let k = self.mu0 / (4.0 * PI);
         let rf = if self.cutoff.is_finite() && self.reaction_field != 1.0 {
@@ -348,8 +365,8 @@ impl DipoleDipole {
         }
     }
 
-    /// Adds forces and torques at positions `pos` with moments `dipoles`;
-    /// returns the virial Σ r_ij·F_ij.
+    /// Adds forces and torques at positions `pos` with moments `dipoles`
+    /// (in this interaction's box); returns the virial Σ r_ij·F_ij.
     pub fn forces_and_torques(
         &mut self,
         pos: &[DVec3],
@@ -357,83 +374,53 @@ impl DipoleDipole {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) -> f64 {
-        self.forces_through(pos, dipoles, None, force, torque)
+        let boundary = self.boundary;
+        self.forces_in(pos, dipoles, &boundary, force, torque)
     }
 
-    /// The force field's shared list, when the state brings one made in
-    /// this interaction's box; `None`: the own list.
-    fn shared<'a>(&self, state: &State<'a>) -> Option<&'a VerletList> {
-        state
-            .neighbours
-            .filter(|_| *state.boundary == self.boundary)
-    }
-
-    /// [`Self::forces_and_torques`] through `shared` (cut-off mode) or the own list.
-    fn forces_through(
+    /// [`Self::forces_and_torques`] in `boundary`.
+    fn forces_in(
         &mut self,
         pos: &[DVec3],
         dipoles: &[DVec3],
-        shared: Option<&VerletList>,
+        boundary: &Boundary,
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) -> f64 {
         assert_eq!(pos.len(), dipoles.len(), "one dipole per particle");
         self.virial = if self.cutoff.is_finite() {
-            self.cut_off_forces(pos, dipoles, shared, force, torque)
+            let (virial, _) = self.cut_off_rows(pos, dipoles, boundary, true, false);
+            self.add_sorted(force, torque);
+            virial
         } else {
             self.all_pairs_forces(pos, dipoles, force, torque)
         };
         self.virial
     }
 
-    /// The potential energy at positions `pos` with moments `dipoles`.
+    /// The potential energy at positions `pos` with moments `dipoles` (in
+    /// this interaction's box).
     pub fn energy(&mut self, pos: &[DVec3], dipoles: &[DVec3]) -> f64 {
-        self.energy_through(pos, dipoles, None)
+        let boundary = self.boundary;
+        self.energy_in(pos, dipoles, &boundary)
     }
 
-    fn energy_through(
-        &mut self,
-        pos: &[DVec3],
-        dipoles: &[DVec3],
-        shared: Option<&VerletList>,
-    ) -> f64 {
+    fn energy_in(&mut self, pos: &[DVec3], dipoles: &[DVec3], boundary: &Boundary) -> f64 {
         assert_eq!(pos.len(), dipoles.len(), "one dipole per particle");
+        if self.cutoff.is_finite() {
+            return self.cut_off_rows(pos, dipoles, boundary, false, true).1;
+        }
         let kern = self.kernel();
         let n = pos.len();
-        if !self.cutoff.is_finite() {
-            let per_i: Vec<f64> = (0..n)
-                .into_par_iter()
-                .with_min_len(64)
-                .map(|i| {
-                    let mut u = 0.0;
-                    for j in i + 1..n {
-                        let d = pos[i] - pos[j];
-                        let r2 = d.length_squared();
-                        if r2 > 0.0 {
-                            u += kern.pair(d, r2, dipoles[i], dipoles[j]).0;
-                        }
-                    }
-                    u
-                })
-                .collect();
-            return per_i.iter().sum();
-        }
-        if shared.is_none() {
-            self.list.update(pos, &self.boundary);
-        }
-        let image = self.boundary.image();
-        let reach2 = kern.reach2();
-        let list = shared.unwrap_or(&self.list);
         let per_i: Vec<f64> = (0..n)
             .into_par_iter()
-            .with_min_len(512)
+            .with_min_len(64)
             .map(|i| {
                 let mut u = 0.0;
-                for &j in list.of(i) {
-                    let j = j as usize;
-                    let d = image.apply(pos[i] - pos[j]);
+                for j in i + 1..n {
+                    let d = pos[i] - pos[j];
                     let r2 = d.length_squared();
-                    if r2 < reach2 {
+                    if r2 > 0.0 {
                         u += kern.pair(d, r2, dipoles[i], dipoles[j]).0;
                     }
                 }
@@ -441,66 +428,6 @@ impl DipoleDipole {
             })
             .collect();
         per_i.iter().sum()
-    }
-
-    /// Half Verlet list, Newton's third law, one buffer pair per block of
-    /// particles summed in block order (as `LennardJones`).
-    fn cut_off_forces(
-        &mut self,
-        pos: &[DVec3],
-        dipoles: &[DVec3],
-        shared: Option<&VerletList>,
-        force: &mut [DVec3],
-        torque: &mut [DVec3],
-    ) -> f64 {
-        let n = pos.len();
-        if shared.is_none() {
-            self.list.update(pos, &self.boundary);
-        }
-        let kern = self.kernel();
-        let reach2 = kern.reach2();
-        let image = self.boundary.image();
-        let blocks = rayon::current_num_threads().clamp(1, n.max(1));
-        let per_block = n.div_ceil(blocks);
-        self.buffers.resize_with(blocks, Default::default);
-        let mut buffers = std::mem::take(&mut self.buffers);
-        let list = shared.unwrap_or(&self.list);
-        let virials: Vec<f64> = buffers
-            .par_iter_mut()
-            .enumerate()
-            .map(|(b, (fbuf, tbuf))| {
-                fbuf.clear();
-                fbuf.resize(n, DVec3::ZERO);
-                tbuf.clear();
-                tbuf.resize(n, DVec3::ZERO);
-                let mut w = 0.0;
-                for i in b * per_block..((b + 1) * per_block).min(n) {
-                    let ri = pos[i];
-                    let mi = dipoles[i];
-                    let mut fi = DVec3::ZERO;
-                    let mut ti = DVec3::ZERO;
-                    for &j in list.of(i) {
-                        let j = j as usize;
-                        let d = image.apply(ri - pos[j]);
-                        let r2 = d.length_squared();
-                        if r2 < reach2 {
-                            let (_, f, a, c, wij) = kern.pair(d, r2, mi, dipoles[j]);
-                            fi += f;
-                            ti += a;
-                            fbuf[j] -= f;
-                            tbuf[j] += c;
-                            w += wij;
-                        }
-                    }
-                    fbuf[i] += fi;
-                    tbuf[i] += ti;
-                }
-                w
-            })
-            .collect();
-        add_block_buffers(force, torque, &buffers);
-        self.buffers = buffers;
-        virials.iter().sum()
     }
 
     /// All pairs, each particle's row over all others (every pair twice),
@@ -681,8 +608,13 @@ impl Interaction for DipoleDipole {
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         if state.dipole.len() == state.position.len() {
             let mut torque = vec![DVec3::ZERO; force.len()];
-            let shared = self.shared(state);
-            self.forces_through(state.position, state.dipole, shared, force, &mut torque);
+            self.forces_in(
+                state.position,
+                state.dipole,
+                state.boundary,
+                force,
+                &mut torque,
+            );
         }
     }
 
@@ -698,16 +630,14 @@ impl Interaction for DipoleDipole {
         torque: &mut [DVec3],
     ) {
         if state.dipole.len() == state.position.len() {
-            let shared = self.shared(state);
-            self.forces_through(state.position, state.dipole, shared, force, torque);
+            self.forces_in(state.position, state.dipole, state.boundary, force, torque);
         }
     }
 
     /// Σ_{i<j} U_ij (0 for a state without dipoles).
     fn potential_energy(&mut self, state: &State) -> f64 {
         if state.dipole.len() == state.position.len() {
-            let shared = self.shared(state);
-            self.energy_through(state.position, state.dipole, shared)
+            self.energy_in(state.position, state.dipole, state.boundary)
         } else {
             0.0
         }
@@ -717,10 +647,15 @@ impl Interaction for DipoleDipole {
         self.virial
     }
 
-    fn neighbour_reach(&self) -> Option<(f64, f64)> {
-        self.cutoff
-            .is_finite()
-            .then_some((self.list.cutoff, self.list.skin))
+    /// The ghost list's build (see [`GhostList::carried_state`]): rows are
+    /// summed eight neighbours at a time, skin pairs included as zeros, so
+    /// the bits of a force depend on when the list was built.
+    fn carried_state(&self) -> Vec<f64> {
+        self.list.carried_state()
+    }
+
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        self.list.restore(state)
     }
 }
 

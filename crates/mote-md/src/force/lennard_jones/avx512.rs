@@ -1,6 +1,6 @@
 //! One row of the Lennard-Jones pair loop, eight neighbours at a time:
-//! eight 32-byte records loaded and transposed, 1/r² from `vrcp14pd` refined by two
-//! Newton–Raphson steps y ← y (2 − r² y) (14 → 28 → 56 bits), lanes beyond
+//! eight 32-byte records loaded and transposed (`load_copies`), 1/r² from `vrcp14pd`
+//! refined by two Newton–Raphson steps y ← y (2 − r² y) (14 → 28 → 56 bits), lanes beyond
 //! r_c masked to zero. The portable loop in `mod.rs` is the reference.
 
 use std::arch::x86_64::*;
@@ -8,6 +8,7 @@ use std::arch::x86_64::*;
 use glam::DVec3;
 
 use super::{Coefficients, RowSum};
+use crate::neighbor::avx512::load_copies;
 use crate::neighbor::Copy4;
 
 /// The sums of row `row` of particle copy `k` (see [`super::row_portable`]).
@@ -25,10 +26,6 @@ pub(super) unsafe fn row(
 ) -> RowSum {
     let [xi, yi, zi, _] = position[k].0;
     let (xi, yi, zi) = (_mm512_set1_pd(xi), _mm512_set1_pd(yi), _mm512_set1_pd(zi));
-    let base = position.as_ptr() as *const f64;
-    // Lane order of the transpose below: records 0..8 to lanes 0..8.
-    let low = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
-    let high = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
     let cutoff2 = _mm512_set1_pd(c.cutoff2);
     let sigma2 = _mm512_set1_pd(c.sigma2);
     let eps48 = _mm512_set1_pd(c.eps48);
@@ -41,19 +38,8 @@ pub(super) unsafe fn row(
     let (mut fx, mut fy, mut fz, mut w, mut u) = (zero, zero, zero, zero, zero);
 
     let mut lanes = |index: &[u32; 8], valid: __mmask8| {
-        // Eight 32-byte records (x, y, z, 0), two to a register, then
-        // transposed: a_k = (r_k | r_{k+4}); unpacking pairs them per
-        // 128-bit lane, and two-source permutes gather each coordinate.
         // SAFETY: the caller guarantees every index is in bounds.
-        let record = |m: usize| unsafe { _mm256_load_pd(base.add(4 * index[m] as usize)) };
-        let pair =
-            |m: usize| _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(record(m)), record(m + 4));
-        let (a0, a1, a2, a3) = (pair(0), pair(1), pair(2), pair(3));
-        let (xz01, yw01) = (_mm512_unpacklo_pd(a0, a1), _mm512_unpackhi_pd(a0, a1));
-        let (xz23, yw23) = (_mm512_unpacklo_pd(a2, a3), _mm512_unpackhi_pd(a2, a3));
-        let xj = _mm512_permutex2var_pd(xz01, low, xz23);
-        let zj = _mm512_permutex2var_pd(xz01, high, xz23);
-        let yj = _mm512_permutex2var_pd(yw01, low, yw23);
+        let (xj, yj, zj) = unsafe { load_copies(position, index) };
         let dx = _mm512_sub_pd(xi, xj);
         let dy = _mm512_sub_pd(yi, yj);
         let dz = _mm512_sub_pd(zi, zj);

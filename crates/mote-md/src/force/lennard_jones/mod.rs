@@ -14,17 +14,12 @@
 //! else through the portable loop below; the two agree to a few ulp. Rows are
 //! summed in fixed blocks, so every thread count gives the same bits.
 
-use glam::DVec3;
-use rayon::prelude::*;
-
 use super::{Interaction, State};
 use crate::neighbor::{Copy4, GhostList};
+use glam::DVec3;
 
 #[cfg(target_arch = "x86_64")]
 mod avx512;
-
-/// Rows per parallel block (fixed, so sums do not depend on threads).
-const BLOCK: usize = 256;
 
 /// Lennard-Jones between all particles, through a Verlet list.
 #[derive(Debug, Clone)]
@@ -125,40 +120,16 @@ impl LennardJones {
         }
     }
 
-    /// Runs every row into `sorted_force` (if given) and returns the
-    /// halved sums of the virial and the energy.
-    fn rows(&self, sorted_force: Option<&mut [DVec3]>, energy: bool) -> (f64, f64) {
+    /// Runs every row into `sorted_force` and returns the halved sums of
+    /// the virial and the energy.
+    fn rows(&self, sorted_force: &mut [DVec3], energy: bool) -> (f64, f64) {
         let list = &self.list;
-        let n = list.len();
         let c = self.coefficients();
         let simd = self.simd;
-        let block = |b: usize, out: Option<&mut [DVec3]>| -> (f64, f64) {
-            let (mut w, mut u) = (0.0, 0.0);
-            let first = b * BLOCK;
-            let last = (first + BLOCK).min(n);
-            let mut out = out;
-            for r in first..last {
-                let s = row(list, r, &c, energy, simd);
-                if let Some(f) = out.as_deref_mut() {
-                    f[r - first] = s.force;
-                }
-                w += s.virial;
-                u += s.energy;
-            }
-            (w, u)
-        };
-        let sums: Vec<(f64, f64)> = match sorted_force {
-            Some(f) => f
-                .par_chunks_mut(BLOCK)
-                .enumerate()
-                .map(|(b, f)| block(b, Some(f)))
-                .collect(),
-            None => (0..n.div_ceil(BLOCK))
-                .into_par_iter()
-                .map(|b| block(b, None))
-                .collect(),
-        };
-        let (w, u) = sums.iter().fold((0.0, 0.0), |(w, u), s| (w + s.0, u + s.1));
+        let [w, u] = list.sum_rows(sorted_force, |r| {
+            let s = row(list, r, &c, energy, simd);
+            (s.force, [s.virial, s.energy])
+        });
         (0.5 * w, 0.5 * u)
     }
 }
@@ -237,13 +208,8 @@ impl Interaction for LennardJones {
         self.list.update(pos, state.boundary);
         let mut sorted = std::mem::take(&mut self.sorted_force);
         sorted.resize(pos.len(), DVec3::ZERO);
-        self.virial = self.rows(Some(&mut sorted), false).0;
-        let slot = &self.list.slot;
-        force
-            .par_iter_mut()
-            .with_min_len(4096)
-            .enumerate()
-            .for_each(|(i, f)| *f += sorted[slot[i] as usize]);
+        self.virial = self.rows(&mut sorted, false).0;
+        self.list.scatter_add(&sorted, force);
         self.sorted_force = sorted;
     }
 
@@ -251,7 +217,10 @@ impl Interaction for LennardJones {
         self.list.refresh(state.position, state.boundary);
         // The virial comes with the energy, so a pressure measured before
         // the first step (no force evaluation yet) is right too.
-        let (virial, energy) = self.rows(None, true);
+        let mut sorted = std::mem::take(&mut self.sorted_force);
+        sorted.resize(state.position.len(), DVec3::ZERO);
+        let (virial, energy) = self.rows(&mut sorted, true);
+        self.sorted_force = sorted;
         self.virial = virial;
         energy
     }
