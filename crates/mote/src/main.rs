@@ -85,15 +85,18 @@ fn main() -> ExitCode {
     ) {
         stop_cleanly_on_signals();
     }
-    let result = match cli.command {
-        Command::Run(args) => cmd::run::run(&cli.global, args),
-        Command::Examples(args) => cmd::examples::run(&cli.global, args),
-        Command::Rcp { args } => cmd::rcp::run(&cli.global, &args),
-        Command::Edmd(args) => cmd::edmd::run(&cli.global, args),
-        Command::Pack(args) => cmd::pack::run(&cli.global, args),
-        Command::Render(args) => cmd::render::run(&cli.global, args),
-        Command::Plot(args) => cmd::plot::run(&cli.global, args),
+    let global = cli.global;
+    let pool = global.threads();
+    let command = move || match cli.command {
+        Command::Run(args) => cmd::run::run(&global, args),
+        Command::Examples(args) => cmd::examples::run(&global, args),
+        Command::Rcp { args } => cmd::rcp::run(&global, &args),
+        Command::Edmd(args) => cmd::edmd::run(&global, args),
+        Command::Pack(args) => cmd::pack::run(&global, args),
+        Command::Render(args) => cmd::render::run(&global, args),
+        Command::Plot(args) => cmd::plot::run(&global, args),
     };
+    let result = pool.and_then(|pool| pool.install(command));
     match result {
         Ok(code) => code,
         Err(err) => {

@@ -770,7 +770,6 @@ fn scan(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode>
         Ok(a) => a,
         Err(code) => return Ok(code),
     };
-    global.init_threads()?;
     let x: Axis = a.x.parse().context("--x")?;
     let y: Axis = a.y.parse().context("--y")?;
     let pops = a.input.populations()?;

@@ -80,7 +80,6 @@ pub struct RenderArgs {
 }
 
 pub fn run(global: &super::GlobalOpts, a: RenderArgs) -> anyhow::Result<ExitCode> {
-    global.init_threads()?;
     let opts_view = parse_vec3(a.view.as_deref(), "--view")?;
     let (w, h) = parse_size(&a.size)?;
     let map = ColorMap::parse(&a.colormap).with_context(|| {

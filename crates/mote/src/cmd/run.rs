@@ -63,7 +63,6 @@ impl RunArgs {
 }
 
 pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode> {
-    global.init_threads()?;
     let options = args.options(global);
     let mut terminal = Terminal::new(global.quiet);
     let outcome = mote_front::run(&options, &mut terminal)?;
