@@ -32,7 +32,6 @@ pub(super) unsafe fn row(
     let eps24 = _mm512_set1_pd(c.eps24);
     let eps4 = _mm512_set1_pd(c.eps4);
     let shift = _mm512_set1_pd(c.shift);
-    let one = _mm512_set1_pd(1.0);
     let two = _mm512_set1_pd(2.0);
     let zero = _mm512_setzero_pd();
     let (mut fx, mut fy, mut fz, mut w, mut u) = (zero, zero, zero, zero, zero);
@@ -45,14 +44,18 @@ pub(super) unsafe fn row(
         let dz = _mm512_sub_pd(zi, zj);
         let r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
         let inside = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(valid, r2, cutoff2);
-        let r2s = _mm512_mask_blend_pd(inside, one, r2);
-        let mut inv = _mm512_rcp14_pd(r2s);
-        inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(r2s, inv, two));
-        inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(r2s, inv, two));
+        // Lanes outside (padding: r² = 0) may compute infinities; the
+        // masked product below discards them.
+        let mut inv = _mm512_rcp14_pd(r2);
+        inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(r2, inv, two));
+        inv = _mm512_mul_pd(inv, _mm512_fnmadd_pd(r2, inv, two));
         let s2 = _mm512_mul_pd(sigma2, inv);
         let s6 = _mm512_mul_pd(_mm512_mul_pd(s2, s2), s2);
-        let f = _mm512_mul_pd(_mm512_mul_pd(inv, s6), _mm512_fmsub_pd(eps48, s6, eps24));
-        let f = _mm512_maskz_mov_pd(inside, f);
+        let f = _mm512_maskz_mul_pd(
+            inside,
+            _mm512_mul_pd(inv, s6),
+            _mm512_fmsub_pd(eps48, s6, eps24),
+        );
         fx = _mm512_fmadd_pd(f, dx, fx);
         fy = _mm512_fmadd_pd(f, dy, fy);
         fz = _mm512_fmadd_pd(f, dz, fz);
