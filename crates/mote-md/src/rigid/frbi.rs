@@ -12,6 +12,7 @@ use mote_geom::{compose_rotations, rotation_matrix, DMat3, Inertia, DE};
 use rayon::prelude::*;
 
 use super::bodies::RigidBodies;
+use super::free8::{free_step8, Group, LANES};
 use super::interaction::{BodyInteraction, BodyView, WorldFrame};
 
 /// How the centre of mass moves in a free step.
@@ -142,15 +143,16 @@ pub fn react(
     *velocity += impulse.v * (1.0 / inertia0.mass);
 }
 
-/// One body's (index, ((r, x), (ω, v))) in the zipped state arrays.
-type BodyItem<'a> = (
-    usize,
-    ((&'a mut DVec3, &'a mut DVec3), (&'a mut DVec3, &'a DVec3)),
-);
-
 /// Bodies at or above this count are stepped in parallel (each body's
 /// update is independent, so the result does not depend on threads).
 const PARALLEL_BODIES: usize = 2048;
+
+/// One block's (index, ((rotation vectors, positions), angular velocities)).
+type BodyBlock<'a> = (usize, ((&'a mut [DVec3], &'a mut [DVec3]), &'a mut [DVec3]));
+
+/// Bodies per parallel block of the free steps (a multiple of
+/// [`LANES`]).
+const BODY_BLOCK: usize = 256;
 
 /// The many-body integrator: owns the interactions, the free-flight rule and
 /// scratch space (world frame, wrenches); the state is the [`RigidBodies`].
@@ -214,29 +216,60 @@ impl Frbi {
         &self.interactions
     }
 
-    /// Every body `freeStep(dt)`.
+    /// Every body `freeStep(dt)`: eight bodies at a time through
+    /// [`free8`](super::free8) (the same bits as [`free_step`]), the last
+    /// few one by one; blocks of bodies in parallel when there are many.
     pub fn free_all(&self, b: &mut RigidBodies, dt: f64) {
         let (flight, spin) = (self.flight, self.spin);
         let templates = &b.templates;
         let kind = &b.kind;
-        let body = |(i, ((r, x), (w, v))): BodyItem<'_>| {
-            let inertia0 = &templates[kind[i] as usize].inertia;
-            free_step(inertia0, r, x, w, *v, dt, flight, spin);
+        let velocity = &b.velocity;
+        let block = |(c, ((r, x), w)): BodyBlock<'_>| {
+            let first = c * BODY_BLOCK;
+            let inertia = |i: usize| &templates[kind[i] as usize].inertia;
+            let groups = r.len() / LANES;
+            for g in 0..groups {
+                let at = g * LANES;
+                let mut group = Group {
+                    inertia: std::array::from_fn(|l| inertia(first + at + l)),
+                    rotation: std::array::from_fn(|l| r[at + l]),
+                    position: std::array::from_fn(|l| x[at + l]),
+                    omega: std::array::from_fn(|l| w[at + l]),
+                    velocity: std::array::from_fn(|l| velocity[first + at + l]),
+                };
+                free_step8(&mut group, dt, flight, spin);
+                r[at..at + LANES].copy_from_slice(&group.rotation);
+                x[at..at + LANES].copy_from_slice(&group.position);
+                w[at..at + LANES].copy_from_slice(&group.omega);
+            }
+            for k in groups * LANES..r.len() {
+                let i = first + k;
+                free_step(
+                    inertia(i),
+                    &mut r[k],
+                    &mut x[k],
+                    &mut w[k],
+                    velocity[i],
+                    dt,
+                    flight,
+                    spin,
+                );
+            }
         };
         if b.len() >= PARALLEL_BODIES {
             b.rotation
-                .par_iter_mut()
-                .zip(b.position.par_iter_mut())
-                .zip(b.omega.par_iter_mut().zip(b.velocity.par_iter()))
+                .par_chunks_mut(BODY_BLOCK)
+                .zip(b.position.par_chunks_mut(BODY_BLOCK))
+                .zip(b.omega.par_chunks_mut(BODY_BLOCK))
                 .enumerate()
-                .for_each(body);
+                .for_each(block);
         } else {
             b.rotation
-                .iter_mut()
-                .zip(b.position.iter_mut())
-                .zip(b.omega.iter_mut().zip(b.velocity.iter()))
+                .chunks_mut(BODY_BLOCK)
+                .zip(b.position.chunks_mut(BODY_BLOCK))
+                .zip(b.omega.chunks_mut(BODY_BLOCK))
                 .enumerate()
-                .for_each(body);
+                .for_each(block);
         }
     }
 

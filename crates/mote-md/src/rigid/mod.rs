@@ -21,6 +21,7 @@
 pub mod bodies;
 pub mod contacts;
 pub mod frbi;
+mod free8;
 pub mod interaction;
 pub mod run;
 pub mod scene;

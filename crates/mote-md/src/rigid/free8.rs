@@ -1,0 +1,481 @@
+//! The FRBI's free step ([`super::frbi::free_step`]) for eight bodies at
+//! once in AVX-512: the same operations in the same order, each on eight
+//! lanes (one body per lane). No operation is fused or reassociated, so
+//! every lane gets the bits the scalar step gives (tested); CPUs without
+//! AVX-512 take the scalar step body by body.
+//!
+//! Groups with a rotation vector near a half turn (|r|² > 10¹⁰⁰, where the
+//! rotation matrix takes another formula) go through the scalar step; so
+//! does the factor tan(φ/2)/φ of a lane whose turn in the step is not
+//! small (φ = |ω|τ ≥ 10⁻³, where it is not the series).
+use glam::DVec3;
+use mote_geom::Inertia;
+
+use super::frbi::{free_step, FreeFlight, SpinUpdate};
+
+/// Bodies per group.
+pub const LANES: usize = 8;
+
+/// A group of eight bodies: their templates' inertia and their state.
+pub struct Group<'a> {
+    pub inertia: [&'a Inertia; LANES],
+    pub rotation: [DVec3; LANES],
+    pub position: [DVec3; LANES],
+    pub omega: [DVec3; LANES],
+    pub velocity: [DVec3; LANES],
+}
+
+/// [`free_step`] of eight bodies: the rotation vectors, positions and
+/// angular velocities of the group advance by `dt`.
+pub fn free_step8(g: &mut Group, dt: f64, flight: FreeFlight, spin: SpinUpdate) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let vector = mote_geom::simd::has_avx512()
+            && flight == FreeFlight::Straight
+            && g.rotation.iter().all(|r| r.dot(*r) <= 1e100);
+        // SAFETY: the CPU has AVX-512F.
+        if vector && unsafe { avx512::lanes(g, dt, spin) } {
+            return;
+        }
+    }
+    for l in 0..LANES {
+        let (r, x, w) = (&mut g.rotation[l], &mut g.position[l], &mut g.omega[l]);
+        free_step(g.inertia[l], r, x, w, g.velocity[l], dt, flight, spin);
+    }
+}
+
+/// The eight-lane arithmetic.
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use glam::DVec3;
+    use mote_geom::{DE, EPSILON};
+
+    use super::{Group, LANES};
+    use crate::rigid::frbi::SpinUpdate;
+
+    type S = __m512d;
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn splat(v: f64) -> S {
+        _mm512_set1_pd(v)
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn add(a: S, b: S) -> S {
+        _mm512_add_pd(a, b)
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn sub(a: S, b: S) -> S {
+        _mm512_sub_pd(a, b)
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn mul(a: S, b: S) -> S {
+        _mm512_mul_pd(a, b)
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn div(a: S, b: S) -> S {
+        _mm512_div_pd(a, b)
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn lanes_of(v: S) -> [f64; LANES] {
+        // SAFETY: __m512d and [f64; 8] have the same size and any bits are valid.
+        unsafe { std::mem::transmute::<S, [f64; LANES]>(v) }
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn from_lanes(v: [f64; LANES]) -> S {
+        // SAFETY: as above.
+        unsafe { std::mem::transmute::<[f64; LANES], S>(v) }
+    }
+
+    /// Eight vectors, one per lane.
+    #[derive(Clone, Copy)]
+    struct V {
+        x: S,
+        y: S,
+        z: S,
+    }
+
+    /// The helpers below are AVX-512 functions (`#[target_feature]`), inlined
+    /// into [`lanes`].
+    impl V {
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn of(v: &[DVec3; LANES]) -> Self {
+            let coordinate = |k: usize| from_lanes(std::array::from_fn(|l| v[l][k]));
+            Self {
+                x: coordinate(0),
+                y: coordinate(1),
+                z: coordinate(2),
+            }
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn splat(v: DVec3) -> Self {
+            Self {
+                x: splat(v.x),
+                y: splat(v.y),
+                z: splat(v.z),
+            }
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn write(self, out: &mut [DVec3; LANES]) {
+            let (x, y, z) = (lanes_of(self.x), lanes_of(self.y), lanes_of(self.z));
+            for l in 0..LANES {
+                out[l] = DVec3::new(x[l], y[l], z[l]);
+            }
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn add(self, o: V) -> V {
+            V {
+                x: add(self.x, o.x),
+                y: add(self.y, o.y),
+                z: add(self.z, o.z),
+            }
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn sub(self, o: V) -> V {
+            V {
+                x: sub(self.x, o.x),
+                y: sub(self.y, o.y),
+                z: sub(self.z, o.z),
+            }
+        }
+
+        /// Component by component (glam's `DVec3 * DVec3`).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn mul(self, o: V) -> V {
+            V {
+                x: mul(self.x, o.x),
+                y: mul(self.y, o.y),
+                z: mul(self.z, o.z),
+            }
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn scale(self, s: S) -> V {
+            V {
+                x: mul(self.x, s),
+                y: mul(self.y, s),
+                z: mul(self.z, s),
+            }
+        }
+
+        /// (x·x' + y·y') + z·z', glam's order.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn dot(self, o: V) -> S {
+            add(add(mul(self.x, o.x), mul(self.y, o.y)), mul(self.z, o.z))
+        }
+
+        /// glam's `cross`, term for term.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn cross(self, o: V) -> V {
+            V {
+                x: sub(mul(self.y, o.z), mul(o.y, self.z)),
+                y: sub(mul(self.z, o.x), mul(o.z, self.x)),
+                z: sub(mul(self.x, o.y), mul(o.x, self.y)),
+            }
+        }
+    }
+
+    /// Eight 3 × 3 matrices by columns.
+    #[derive(Clone, Copy)]
+    struct M {
+        x: V,
+        y: V,
+        z: V,
+    }
+
+    impl M {
+        /// glam's `mul_vec3`: ((x_axis v.x) + (y_axis v.y)) + (z_axis v.z).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn apply(&self, v: V) -> V {
+            self.x
+                .scale(v.x)
+                .add(self.y.scale(v.y))
+                .add(self.z.scale(v.z))
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn mul(&self, o: &M) -> M {
+            M {
+                x: self.apply(o.x),
+                y: self.apply(o.y),
+                z: self.apply(o.z),
+            }
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn transpose(&self) -> M {
+            M {
+                x: V {
+                    x: self.x.x,
+                    y: self.y.x,
+                    z: self.z.x,
+                },
+                y: V {
+                    x: self.x.y,
+                    y: self.y.y,
+                    z: self.z.y,
+                },
+                z: V {
+                    x: self.x.z,
+                    y: self.y.z,
+                    z: self.z.z,
+                },
+            }
+        }
+
+        /// P (d ⊙ Pᵀ x): the inertia (or its inverse) of principal moments d
+        /// with principal axes P, applied to x.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn sandwich(&self, d: V, x: V) -> V {
+            self.apply(d.mul(self.transpose().apply(x)))
+        }
+    }
+
+    /// The matrix of x ↦ x * r, as `frbi::matrix` (all lanes |r|² ≤ 10¹⁰⁰).
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn matrix(r: V) -> M {
+        let rr = r.dot(r);
+        let one = splat(1.0);
+        let s = div(one, add(one, rr));
+        let c = mul(sub(one, rr), s);
+        let t = mul(splat(2.0), s);
+        let (x, y, z) = (r.x, r.y, r.z);
+        let txx = mul(mul(t, x), x);
+        let tyy = mul(mul(t, y), y);
+        let tzz = mul(mul(t, z), z);
+        let (xy, xz, yz) = (mul(x, y), mul(x, z), mul(y, z));
+        M {
+            x: V {
+                x: add(c, txx),
+                y: mul(t, add(xy, z)),
+                z: mul(t, sub(xz, y)),
+            },
+            y: V {
+                x: mul(t, sub(xy, z)),
+                y: add(c, tyy),
+                z: mul(t, add(yz, x)),
+            },
+            z: V {
+                x: mul(t, add(xz, y)),
+                y: mul(t, sub(yz, x)),
+                z: add(c, tzz),
+            },
+        }
+    }
+
+    /// `DE::exp_rotation(ω, τ)` = ωτ tan(φ/2)/φ, φ = |ωτ|: the series
+    /// (1 + φ²/12 + φ⁴/120)/2 of `mote_geom`'s `half_tan_over` where φ < 10⁻³,
+    /// the scalar function in the other lanes.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn exp_rotation(w: V, tau: f64) -> V {
+        let wt = w.scale(splat(tau));
+        let phi = _mm512_sqrt_pd(wt.dot(wt));
+        let p2 = mul(phi, phi);
+        let series = mul(
+            splat(0.5),
+            add(
+                add(splat(1.0), div(p2, splat(12.0))),
+                div(mul(p2, p2), splat(120.0)),
+            ),
+        );
+        let r = wt.scale(series);
+        let small = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(phi, splat(1e-3));
+        if small == 0xff {
+            return r;
+        }
+        let mut out = [DVec3::ZERO; LANES];
+        r.write(&mut out);
+        let mut omega = [DVec3::ZERO; LANES];
+        w.write(&mut omega);
+        for l in 0..LANES {
+            if small & (1 << l) == 0 {
+                out[l] = DE::exp_rotation(omega[l], tau);
+            }
+        }
+        V::of(&out)
+    }
+
+    /// `compose_rotations(r1, r2)`: 1/s, or 1/ε where |s| < ε, selected.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn compose(r1: V, r2: V) -> V {
+        let s = sub(splat(1.0), r1.dot(r2));
+        let abs = _mm512_abs_pd(s);
+        let tiny = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(abs, splat(EPSILON));
+        let big_s = _mm512_mask_blend_pd(tiny, div(splat(1.0), s), splat(1.0 / EPSILON));
+        r1.add(r2).sub(r1.cross(r2)).scale(big_s)
+    }
+
+    /// The free step of `frbi::free_step` (straight flight) on eight lanes;
+    /// false, with the group untouched, if a new rotation vector is near a
+    /// half turn (its matrix needs the scalar formula).
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn lanes(g: &mut Group, dt: f64, spin: SpinUpdate) -> bool {
+        // One template for the whole group (the common case) is broadcast.
+        let shared = g.inertia.iter().all(|i| std::ptr::eq(*i, g.inertia[0]));
+        let (a, j) = if shared {
+            let i = g.inertia[0];
+            let a = M {
+                x: V::splat(i.axes[0]),
+                y: V::splat(i.axes[1]),
+                z: V::splat(i.axes[2]),
+            };
+            (a, V::splat(DVec3::from(i.moments)))
+        } else {
+            let a = M {
+                x: V::of(&g.inertia.map(|i| i.axes[0])),
+                y: V::of(&g.inertia.map(|i| i.axes[1])),
+                z: V::of(&g.inertia.map(|i| i.axes[2])),
+            };
+            (a, V::of(&g.inertia.map(|i| DVec3::from(i.moments))))
+        };
+        let one = splat(1.0);
+        let j_inv = V {
+            x: div(one, j.x),
+            y: div(one, j.y),
+            z: div(one, j.z),
+        };
+        let tau = 0.5 * dt;
+        let w = V::of(&g.omega);
+        let rotation = V::of(&g.rotation);
+        let p = matrix(rotation).mul(&a);
+        let l = p.sandwich(j, w);
+        let r_c = exp_rotation(w, tau);
+        let p_c = matrix(r_c).mul(&p);
+        let dl = l.sub(p_c.sandwich(j, w));
+        let dw = p.sandwich(j_inv, dl);
+        let w_c = w.add(dw);
+        let rotation = compose(rotation, exp_rotation(w_c, dt));
+        let rr = rotation.dot(rotation);
+        if _mm512_cmp_pd_mask::<_CMP_GT_OQ>(rr, splat(1e100)) != 0 {
+            return false;
+        }
+        let position = V::of(&g.position).add(V::of(&g.velocity).scale(splat(dt)));
+        let omega = match spin {
+            SpinUpdate::Seed => w_c.add(dw),
+            SpinUpdate::KeepMomentum => matrix(rotation).mul(&a).sandwich(j_inv, l),
+        };
+        rotation.write(&mut g.rotation);
+        position.write(&mut g.position);
+        omega.write(&mut g.omega);
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mote_geom::rotation_matrix;
+    use rand::{Rng, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    fn vector(rng: &mut Xoshiro256PlusPlus, scale: f64) -> DVec3 {
+        DVec3::new(rng.gen(), rng.gen(), rng.gen()) * (2.0 * scale) - DVec3::splat(scale)
+    }
+
+    /// Every lane of the eight-body step has the scalar step's bits: one
+    /// or two templates per group, slow and fast turns (the series and the
+    /// scalar tan(φ/2)/φ), rotation vectors up to near a half turn, both
+    /// spin updates and both free flights.
+    #[test]
+    fn eight_bodies_step_as_eight_scalar_steps_bit_for_bit() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+        let template = |rng: &mut Xoshiro256PlusPlus| {
+            let m = rotation_matrix(vector(rng, 1.0));
+            let moments = [
+                rng.gen_range(0.5..2.0),
+                rng.gen_range(0.5..2.0),
+                rng.gen_range(0.5..2.0),
+            ];
+            Inertia::new(moments, [m.x_axis, m.y_axis, m.z_axis], 1.0)
+        };
+        let (t1, t2) = (template(&mut rng), template(&mut rng));
+        let dt = 1e-3;
+        let mut groups = 0;
+        for case in 0..400 {
+            let mixed = case % 2 == 1;
+            let fast = case % 3 == 0;
+            let spin = if case % 5 == 0 {
+                SpinUpdate::Seed
+            } else {
+                SpinUpdate::KeepMomentum
+            };
+            let flight = if case % 7 == 0 {
+                FreeFlight::Screw
+            } else {
+                FreeFlight::Straight
+            };
+            let mut g = Group {
+                inertia: std::array::from_fn(|l| if mixed && l % 3 == 0 { &t2 } else { &t1 }),
+                rotation: std::array::from_fn(|_| vector(&mut rng, 3.0)),
+                position: std::array::from_fn(|_| vector(&mut rng, 10.0)),
+                omega: std::array::from_fn(|_| vector(&mut rng, if fast { 10.0 } else { 0.5 })),
+                velocity: std::array::from_fn(|_| vector(&mut rng, 1.0)),
+            };
+            if case % 11 == 0 {
+                g.rotation[3] = DVec3::new(1e60, 0.0, 0.0);
+            }
+            let mut scalar = (g.rotation, g.position, g.omega);
+            for l in 0..LANES {
+                let (r, x, w) = (&mut scalar.0[l], &mut scalar.1[l], &mut scalar.2[l]);
+                free_step(g.inertia[l], r, x, w, g.velocity[l], dt, flight, spin);
+            }
+            free_step8(&mut g, dt, flight, spin);
+            for l in 0..LANES {
+                assert_eq!(
+                    g.rotation[l].to_array().map(f64::to_bits),
+                    scalar.0[l].to_array().map(f64::to_bits),
+                    "case {case}, lane {l}: rotation"
+                );
+                assert_eq!(
+                    g.position[l].to_array().map(f64::to_bits),
+                    scalar.1[l].to_array().map(f64::to_bits),
+                    "case {case}, lane {l}: position"
+                );
+                assert_eq!(
+                    g.omega[l].to_array().map(f64::to_bits),
+                    scalar.2[l].to_array().map(f64::to_bits),
+                    "case {case}, lane {l}: angular velocity"
+                );
+            }
+            groups += 1;
+        }
+        assert_eq!(groups, 400);
+    }
+}
