@@ -12,7 +12,7 @@ use mote_geom::{compose_rotations, rotation_matrix, DMat3, Inertia, DE};
 use rayon::prelude::*;
 
 use super::bodies::RigidBodies;
-use super::free8::{free_step8, Group, LANES};
+use super::free8::{free_step8, react8, Group, LANES};
 use super::interaction::{BodyInteraction, BodyView, WorldFrame};
 
 /// How the centre of mass moves in a free step.
@@ -230,17 +230,17 @@ impl Frbi {
             let groups = r.len() / LANES;
             for g in 0..groups {
                 let at = g * LANES;
+                let lanes = at..at + LANES;
                 let mut group = Group {
                     inertia: std::array::from_fn(|l| inertia(first + at + l)),
-                    rotation: std::array::from_fn(|l| r[at + l]),
-                    position: std::array::from_fn(|l| x[at + l]),
-                    omega: std::array::from_fn(|l| w[at + l]),
-                    velocity: std::array::from_fn(|l| velocity[first + at + l]),
+                    rotation: (&mut r[lanes.clone()]).try_into().expect("eight"),
+                    position: (&mut x[lanes.clone()]).try_into().expect("eight"),
+                    omega: (&mut w[lanes]).try_into().expect("eight"),
+                    velocity: velocity[first + at..first + at + LANES]
+                        .try_into()
+                        .expect("eight"),
                 };
                 free_step8(&mut group, dt, flight, spin);
-                r[at..at + LANES].copy_from_slice(&group.rotation);
-                x[at..at + LANES].copy_from_slice(&group.position);
-                w[at..at + LANES].copy_from_slice(&group.omega);
             }
             for k in groups * LANES..r.len() {
                 let i = first + k;
@@ -301,20 +301,41 @@ impl Frbi {
         let templates = &b.templates;
         let kind = &b.kind;
         let rotation = &b.rotation;
-        let kick = |(i, (w, v)): (usize, (&mut DVec3, &mut DVec3))| {
-            let inertia0 = &templates[kind[i] as usize].inertia;
-            react(inertia0, rotation[i], w, v, wrench[i] * dt);
+        let kick = |(c, (w, v)): (usize, (&mut [DVec3], &mut [DVec3]))| {
+            let first = c * BODY_BLOCK;
+            let inertia = |i: usize| &templates[kind[i] as usize].inertia;
+            let groups = w.len() / LANES;
+            for g in 0..groups {
+                let (at, i) = (g * LANES, first + g * LANES);
+                react8(
+                    std::array::from_fn(|l| inertia(i + l)),
+                    rotation[i..i + LANES].try_into().expect("eight"),
+                    (&mut w[at..at + LANES]).try_into().expect("eight"),
+                    (&mut v[at..at + LANES]).try_into().expect("eight"),
+                    &std::array::from_fn(|l| wrench[i + l] * dt),
+                );
+            }
+            for k in groups * LANES..w.len() {
+                let i = first + k;
+                react(
+                    inertia(i),
+                    rotation[i],
+                    &mut w[k],
+                    &mut v[k],
+                    wrench[i] * dt,
+                );
+            }
         };
         if b.len() >= PARALLEL_BODIES {
             b.omega
-                .par_iter_mut()
-                .zip(b.velocity.par_iter_mut())
+                .par_chunks_mut(BODY_BLOCK)
+                .zip(b.velocity.par_chunks_mut(BODY_BLOCK))
                 .enumerate()
                 .for_each(kick);
         } else {
             b.omega
-                .iter_mut()
-                .zip(b.velocity.iter_mut())
+                .chunks_mut(BODY_BLOCK)
+                .zip(b.velocity.chunks_mut(BODY_BLOCK))
                 .enumerate()
                 .for_each(kick);
         }

@@ -9,20 +9,21 @@
 //! does the factor tan(φ/2)/φ of a lane whose turn in the step is not
 //! small (φ = |ω|τ ≥ 10⁻³, where it is not the series).
 use glam::DVec3;
-use mote_geom::Inertia;
+use mote_geom::{Inertia, DE};
 
-use super::frbi::{free_step, FreeFlight, SpinUpdate};
+use super::frbi::{free_step, react, FreeFlight, SpinUpdate};
 
 /// Bodies per group.
 pub const LANES: usize = 8;
 
-/// A group of eight bodies: their templates' inertia and their state.
+/// A group of eight bodies: their templates' inertia and their state, in
+/// place in the bodies' arrays.
 pub struct Group<'a> {
     pub inertia: [&'a Inertia; LANES],
-    pub rotation: [DVec3; LANES],
-    pub position: [DVec3; LANES],
-    pub omega: [DVec3; LANES],
-    pub velocity: [DVec3; LANES],
+    pub rotation: &'a mut [DVec3; LANES],
+    pub position: &'a mut [DVec3; LANES],
+    pub omega: &'a mut [DVec3; LANES],
+    pub velocity: &'a [DVec3; LANES],
 }
 
 /// [`free_step`] of eight bodies: the rotation vectors, positions and
@@ -44,13 +45,39 @@ pub fn free_step8(g: &mut Group, dt: f64, flight: FreeFlight, spin: SpinUpdate) 
     }
 }
 
+/// [`react`] of eight bodies: `omega` and `velocity` take the impulses
+/// `(angular, linear)` at the rotations `rotation`.
+pub fn react8(
+    inertia: [&Inertia; LANES],
+    rotation: &[DVec3; LANES],
+    omega: &mut [DVec3; LANES],
+    velocity: &mut [DVec3; LANES],
+    impulse: &[DE; LANES],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if mote_geom::simd::has_avx512() && rotation.iter().all(|r| r.dot(*r) <= 1e100) {
+        // SAFETY: the CPU has AVX-512F.
+        unsafe { avx512::react(inertia, rotation, omega, velocity, impulse) };
+        return;
+    }
+    for l in 0..LANES {
+        react(
+            inertia[l],
+            rotation[l],
+            &mut omega[l],
+            &mut velocity[l],
+            impulse[l],
+        );
+    }
+}
+
 /// The eight-lane arithmetic.
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
     use std::arch::x86_64::*;
 
     use glam::DVec3;
-    use mote_geom::{DE, EPSILON};
+    use mote_geom::{Inertia, DE, EPSILON};
 
     use super::{Group, LANES};
     use crate::rigid::frbi::SpinUpdate;
@@ -339,18 +366,14 @@ mod avx512 {
         r1.add(r2).sub(r1.cross(r2)).scale(big_s)
     }
 
-    /// The free step of `frbi::free_step` (straight flight) on eight lanes;
-    /// false, with the group untouched, if a new rotation vector is near a
-    /// half turn (its matrix needs the scalar formula).
-    ///
-    /// # Safety
-    /// The CPU must have AVX-512F.
+    /// The templates' principal axes A (columns), moments J and 1/J, one
+    /// template for the whole group (the common case) broadcast.
+    #[inline]
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn lanes(g: &mut Group, dt: f64, spin: SpinUpdate) -> bool {
-        // One template for the whole group (the common case) is broadcast.
-        let shared = g.inertia.iter().all(|i| std::ptr::eq(*i, g.inertia[0]));
+    fn principal(inertia: &[&Inertia; LANES]) -> (M, V, V) {
+        let shared = inertia.iter().all(|i| std::ptr::eq(*i, inertia[0]));
         let (a, j) = if shared {
-            let i = g.inertia[0];
+            let i = inertia[0];
             let a = M {
                 x: V::splat(i.axes[0]),
                 y: V::splat(i.axes[1]),
@@ -359,11 +382,11 @@ mod avx512 {
             (a, V::splat(DVec3::from(i.moments)))
         } else {
             let a = M {
-                x: V::of(&g.inertia.map(|i| i.axes[0])),
-                y: V::of(&g.inertia.map(|i| i.axes[1])),
-                z: V::of(&g.inertia.map(|i| i.axes[2])),
+                x: V::of(&inertia.map(|i| i.axes[0])),
+                y: V::of(&inertia.map(|i| i.axes[1])),
+                z: V::of(&inertia.map(|i| i.axes[2])),
             };
-            (a, V::of(&g.inertia.map(|i| DVec3::from(i.moments))))
+            (a, V::of(&inertia.map(|i| DVec3::from(i.moments))))
         };
         let one = splat(1.0);
         let j_inv = V {
@@ -371,9 +394,47 @@ mod avx512 {
             y: div(one, j.y),
             z: div(one, j.z),
         };
+        (a, j, j_inv)
+    }
+
+    /// `frbi::react` on eight lanes (all |r|² ≤ 10¹⁰⁰).
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn react(
+        inertia: [&Inertia; LANES],
+        rotation: &[DVec3; LANES],
+        omega: &mut [DVec3; LANES],
+        velocity: &mut [DVec3; LANES],
+        impulse: &[DE; LANES],
+    ) {
+        let (a, _, j_inv) = principal(&inertia);
+        let p = matrix(V::of(rotation)).mul(&a);
+        let angular = V::of(&impulse.map(|h| h.omega));
+        p.sandwich(j_inv, angular).add(V::of(omega)).write(omega);
+        let inverse_mass = V {
+            x: from_lanes(inertia.map(|i| 1.0 / i.mass)),
+            y: from_lanes(inertia.map(|i| 1.0 / i.mass)),
+            z: from_lanes(inertia.map(|i| 1.0 / i.mass)),
+        };
+        V::of(velocity)
+            .add(V::of(&impulse.map(|h| h.v)).mul(inverse_mass))
+            .write(velocity);
+    }
+
+    /// The free step of `frbi::free_step` (straight flight) on eight lanes;
+    /// false, with the group untouched, if a new rotation vector is near a
+    /// half turn (its matrix needs the scalar formula).
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn lanes(g: &mut Group, dt: f64, spin: SpinUpdate) -> bool {
+        let (a, j, j_inv) = principal(&g.inertia);
         let tau = 0.5 * dt;
-        let w = V::of(&g.omega);
-        let rotation = V::of(&g.rotation);
+        let w = V::of(g.omega);
+        let rotation = V::of(g.rotation);
         let p = matrix(rotation).mul(&a);
         let l = p.sandwich(j, w);
         let r_c = exp_rotation(w, tau);
@@ -386,14 +447,14 @@ mod avx512 {
         if _mm512_cmp_pd_mask::<_CMP_GT_OQ>(rr, splat(1e100)) != 0 {
             return false;
         }
-        let position = V::of(&g.position).add(V::of(&g.velocity).scale(splat(dt)));
+        let position = V::of(g.position).add(V::of(g.velocity).scale(splat(dt)));
         let omega = match spin {
             SpinUpdate::Seed => w_c.add(dw),
             SpinUpdate::KeepMomentum => matrix(rotation).mul(&a).sandwich(j_inv, l),
         };
-        rotation.write(&mut g.rotation);
-        position.write(&mut g.position);
-        omega.write(&mut g.omega);
+        rotation.write(g.rotation);
+        position.write(g.position);
+        omega.write(g.omega);
         true
     }
 }
@@ -409,7 +470,8 @@ mod tests {
         DVec3::new(rng.gen(), rng.gen(), rng.gen()) * (2.0 * scale) - DVec3::splat(scale)
     }
 
-    /// Every lane of the eight-body step has the scalar step's bits: one
+    /// Every lane of the eight-body step (and kick) has the scalar step's
+    /// bits: one
     /// or two templates per group, slow and fast turns (the series and the
     /// scalar tan(φ/2)/φ), rotation vectors up to near a half turn, both
     /// spin updates and both free flights.
@@ -441,17 +503,22 @@ mod tests {
             } else {
                 FreeFlight::Straight
             };
+            let mut rotation: [DVec3; LANES] = std::array::from_fn(|_| vector(&mut rng, 3.0));
+            let mut position: [DVec3; LANES] = std::array::from_fn(|_| vector(&mut rng, 10.0));
+            let mut omega: [DVec3; LANES] =
+                std::array::from_fn(|_| vector(&mut rng, if fast { 10.0 } else { 0.5 }));
+            let velocity: [DVec3; LANES] = std::array::from_fn(|_| vector(&mut rng, 1.0));
+            if case % 11 == 0 {
+                rotation[3] = DVec3::new(1e60, 0.0, 0.0);
+            }
+            let mut scalar = (rotation, position, omega);
             let mut g = Group {
                 inertia: std::array::from_fn(|l| if mixed && l % 3 == 0 { &t2 } else { &t1 }),
-                rotation: std::array::from_fn(|_| vector(&mut rng, 3.0)),
-                position: std::array::from_fn(|_| vector(&mut rng, 10.0)),
-                omega: std::array::from_fn(|_| vector(&mut rng, if fast { 10.0 } else { 0.5 })),
-                velocity: std::array::from_fn(|_| vector(&mut rng, 1.0)),
+                rotation: &mut rotation,
+                position: &mut position,
+                omega: &mut omega,
+                velocity: &velocity,
             };
-            if case % 11 == 0 {
-                g.rotation[3] = DVec3::new(1e60, 0.0, 0.0);
-            }
-            let mut scalar = (g.rotation, g.position, g.omega);
             for l in 0..LANES {
                 let (r, x, w) = (&mut scalar.0[l], &mut scalar.1[l], &mut scalar.2[l]);
                 free_step(g.inertia[l], r, x, w, g.velocity[l], dt, flight, spin);
@@ -474,6 +541,33 @@ mod tests {
                     "case {case}, lane {l}: angular velocity"
                 );
             }
+            // The kick: eight lanes against eight scalar `react`s.
+            let impulse: [DE; LANES] =
+                std::array::from_fn(|_| DE::new(vector(&mut rng, 1e-3), vector(&mut rng, 1e-3)));
+            let mut kicked = (*g.omega, velocity);
+            let mut scalar_kicked = kicked;
+            react8(
+                g.inertia,
+                g.rotation,
+                &mut kicked.0,
+                &mut kicked.1,
+                &impulse,
+            );
+            for l in 0..LANES {
+                let (w, v) = (&mut scalar_kicked.0[l], &mut scalar_kicked.1[l]);
+                react(g.inertia[l], g.rotation[l], w, v, impulse[l]);
+            }
+            let bits = |v: &[DVec3; LANES]| v.map(|v| v.to_array().map(f64::to_bits));
+            assert_eq!(
+                bits(&kicked.0),
+                bits(&scalar_kicked.0),
+                "case {case}: kicked ω"
+            );
+            assert_eq!(
+                bits(&kicked.1),
+                bits(&scalar_kicked.1),
+                "case {case}: kicked v"
+            );
             groups += 1;
         }
         assert_eq!(groups, 400);
