@@ -35,3 +35,20 @@ pub(crate) unsafe fn load_copies(
         _mm512_permutex2var_pd(xz01, high, xz23),
     )
 }
+
+/// Calls `lanes(index, valid)` on a row's neighbours eight at a time: full
+/// groups with every lane valid, then the rest padded with `pad` (any index
+/// the kernel may load) and only its own lanes valid.
+#[inline(always)]
+pub(crate) fn in_eights(row: &[u32], pad: u32, mut lanes: impl FnMut(&[u32; 8], __mmask8)) {
+    let chunks = row.chunks_exact(8);
+    let tail = chunks.remainder();
+    for chunk in chunks {
+        lanes(chunk.try_into().expect("eight"), 0xff);
+    }
+    if !tail.is_empty() {
+        let mut padded = [pad; 8];
+        padded[..tail.len()].copy_from_slice(tail);
+        lanes(&padded, ((1u32 << tail.len()) - 1) as __mmask8);
+    }
+}

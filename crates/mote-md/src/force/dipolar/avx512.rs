@@ -15,7 +15,7 @@ use mote_geom::simd::avx512::rsqrt;
 
 use super::listed::RowSum;
 use super::{Kernel, Soa};
-use crate::neighbor::avx512::load_copies;
+use crate::neighbor::avx512::{in_eights, load_copies};
 use crate::neighbor::Copy4;
 
 /// A kernel's constants, broadcast.
@@ -209,7 +209,7 @@ pub(super) unsafe fn list_row(
     let [ax, ay, az, _] = moment[k].0;
     let a = [set(ax), set(ay), set(az)];
     let mut acc = [_mm512_setzero_pd(); 8];
-    let mut lanes = |index: &[u32; 8], valid: __mmask8| {
+    let lanes = |index: &[u32; 8], valid: __mmask8| {
         // SAFETY: the caller guarantees every index is in bounds of both.
         let ((xj, yj, zj), (bx, by, bz)) =
             unsafe { (load_copies(position, index), load_copies(moment, index)) };
@@ -226,15 +226,6 @@ pub(super) unsafe fn list_row(
             *a = _mm512_add_pd(*a, v);
         }
     };
-    let chunks = row.chunks_exact(8);
-    let tail = chunks.remainder();
-    for chunk in chunks {
-        lanes(chunk.try_into().expect("eight"), 0xff);
-    }
-    if !tail.is_empty() {
-        let mut padded = [k as u32; 8];
-        padded[..tail.len()].copy_from_slice(tail);
-        lanes(&padded, ((1u32 << tail.len()) - 1) as __mmask8);
-    }
+    in_eights(row, k as u32, lanes);
     totals(&acc)
 }

@@ -8,7 +8,7 @@ use std::arch::x86_64::*;
 use glam::DVec3;
 
 use super::{Coefficients, RowSum};
-use crate::neighbor::avx512::load_copies;
+use crate::neighbor::avx512::{in_eights, load_copies};
 use crate::neighbor::Copy4;
 
 /// The sums of row `row` of particle copy `k` (see [`super::row_portable`]).
@@ -36,7 +36,7 @@ pub(super) unsafe fn row(
     let zero = _mm512_setzero_pd();
     let (mut fx, mut fy, mut fz, mut w, mut u) = (zero, zero, zero, zero, zero);
 
-    let mut lanes = |index: &[u32; 8], valid: __mmask8| {
+    let lanes = |index: &[u32; 8], valid: __mmask8| {
         // SAFETY: the caller guarantees every index is in bounds.
         let (xj, yj, zj) = unsafe { load_copies(position, index) };
         let dx = _mm512_sub_pd(xi, xj);
@@ -66,16 +66,7 @@ pub(super) unsafe fn row(
         }
     };
 
-    let chunks = row.chunks_exact(8);
-    let tail = chunks.remainder();
-    for chunk in chunks {
-        lanes(chunk.try_into().expect("eight"), 0xff);
-    }
-    if !tail.is_empty() {
-        let mut padded = [k as u32; 8];
-        padded[..tail.len()].copy_from_slice(tail);
-        lanes(&padded, ((1u32 << tail.len()) - 1) as __mmask8);
-    }
+    in_eights(row, k as u32, lanes);
     RowSum {
         force: DVec3::new(
             _mm512_reduce_add_pd(fx),
