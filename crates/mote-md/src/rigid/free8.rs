@@ -71,6 +71,35 @@ pub fn react8(
     }
 }
 
+/// The world frame of eight bodies of one template (sphere centres
+/// `centres0` and dipole `dipole0` in the body frame): sphere centres
+/// x + M b into `centres` (body after body) and dipoles M m₀ into
+/// `dipole`, M = `rotation_matrix(r)`, bit for bit as
+/// `WorldFrame::update` computes them. False, with nothing written, where
+/// the CPU lacks AVX-512 or a rotation is near a half turn.
+pub fn world8(
+    rotation: &[DVec3; LANES],
+    position: &[DVec3; LANES],
+    centres0: &[DVec3],
+    dipole0: DVec3,
+    centres: &mut [DVec3],
+    dipole: &mut [DVec3; LANES],
+) -> bool {
+    assert_eq!(
+        centres.len(),
+        LANES * centres0.len(),
+        "eight bodies' spheres"
+    );
+    #[cfg(target_arch = "x86_64")]
+    if mote_geom::simd::has_avx512() && rotation.iter().all(|r| r.dot(*r) <= 1e100) {
+        // SAFETY: the CPU has AVX-512F.
+        unsafe { avx512::world(rotation, position, centres0, dipole0, centres, dipole) };
+        return true;
+    }
+    let _ = (rotation, position, dipole0, dipole);
+    false
+}
+
 /// The eight-lane arithmetic.
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
@@ -397,6 +426,58 @@ mod avx512 {
         (a, j, j_inv)
     }
 
+    /// `mote_geom::rotate(x, r)` for a constant x, term for term:
+    /// (x(1 − r·r) + (2 x·r) r − 2 x × r) / (1 + r·r) (all |r|² ≤ 10¹⁰⁰).
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn rotate(x: DVec3, r: V) -> V {
+        let x = V::splat(x);
+        let rr = r.dot(r);
+        let (one, two) = (splat(1.0), splat(2.0));
+        let num = x
+            .scale(sub(one, rr))
+            .add(r.scale(mul(two, x.dot(r))))
+            .sub(x.cross(r).scale(two));
+        let den = add(one, rr);
+        V {
+            x: div(num.x, den),
+            y: div(num.y, den),
+            z: div(num.z, den),
+        }
+    }
+
+    /// [`super::world8`]'s arithmetic: `rotation_matrix(r)` by columns
+    /// (the images of the axes), then x + M b and M m₀.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn world(
+        rotation: &[DVec3; LANES],
+        position: &[DVec3; LANES],
+        centres0: &[DVec3],
+        dipole0: DVec3,
+        centres: &mut [DVec3],
+        dipole: &mut [DVec3; LANES],
+    ) {
+        let r = V::of(rotation);
+        let m = M {
+            x: rotate(DVec3::X, r),
+            y: rotate(DVec3::Y, r),
+            z: rotate(DVec3::Z, r),
+        };
+        let x = V::of(position);
+        let count = centres0.len();
+        let mut lanes = [DVec3::ZERO; LANES];
+        for (s, b) in centres0.iter().enumerate() {
+            x.add(m.apply(V::splat(*b))).write(&mut lanes);
+            for (l, c) in lanes.iter().enumerate() {
+                centres[l * count + s] = *c;
+            }
+        }
+        m.apply(V::splat(dipole0)).write(dipole);
+    }
+
     /// `frbi::react` on eight lanes (all |r|² ≤ 10¹⁰⁰).
     ///
     /// # Safety
@@ -571,5 +652,60 @@ mod tests {
             groups += 1;
         }
         assert_eq!(groups, 400);
+    }
+
+    /// The world frame of eight bodies (sphere centres and dipoles) has the
+    /// bits of `x + rotation_matrix(r) b` body by body; a rotation near a
+    /// half turn leaves the group to the scalar code.
+    #[test]
+    fn eight_world_frames_as_eight_scalar_ones_bit_for_bit() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+        let centres0: Vec<DVec3> = (0..3).map(|_| vector(&mut rng, 1.0)).collect();
+        let dipole0 = vector(&mut rng, 2.0);
+        for case in 0..200 {
+            let scale = [0.1, 3.0, 1e20][case % 3];
+            let mut rotation: [DVec3; LANES] = std::array::from_fn(|_| vector(&mut rng, scale));
+            if case % 7 == 0 {
+                rotation[5] = DVec3::new(0.0, 1e60, 0.0);
+            }
+            let position: [DVec3; LANES] = std::array::from_fn(|_| vector(&mut rng, 10.0));
+            let mut centres = vec![DVec3::ZERO; LANES * centres0.len()];
+            let mut dipole = [DVec3::ZERO; LANES];
+            let vector_path = world8(
+                &rotation,
+                &position,
+                &centres0,
+                dipole0,
+                &mut centres,
+                &mut dipole,
+            );
+            if !mote_geom::simd::has_avx512() {
+                assert!(!vector_path);
+                continue;
+            }
+            let near_half_turn = rotation.iter().any(|r| r.dot(*r) > 1e100);
+            assert_eq!(vector_path, !near_half_turn, "case {case}");
+            if !vector_path {
+                continue;
+            }
+            for l in 0..LANES {
+                let m = rotation_matrix(rotation[l]);
+                for (s, b) in centres0.iter().enumerate() {
+                    let want = position[l] + m * *b;
+                    let got = centres[l * centres0.len() + s];
+                    assert_eq!(
+                        got.to_array().map(f64::to_bits),
+                        want.to_array().map(f64::to_bits),
+                        "case {case}, body {l}, sphere {s}"
+                    );
+                }
+                let want = m * dipole0;
+                assert_eq!(
+                    dipole[l].to_array().map(f64::to_bits),
+                    want.to_array().map(f64::to_bits),
+                    "case {case}, body {l}: dipole"
+                );
+            }
+        }
     }
 }

@@ -14,6 +14,7 @@ use mote_geom::{rotation_matrix, DE};
 use rayon::prelude::*;
 
 use super::bodies::RigidBodies;
+use super::free8::{world8, LANES};
 
 /// A source of forces and torques on bodies; one virtual call per step.
 pub trait BodyInteraction: Send + Sync {
@@ -92,33 +93,64 @@ impl WorldFrame {
             }
             *dipole = m * t.dipole;
         };
-        if n >= 4096 {
-            // split the sphere array at body boundaries
-            let starts = &self.sphere_start;
-            let mut rest: &mut [DVec3] = &mut self.sphere_centre;
-            let mut parts = Vec::with_capacity(n);
-            for i in 0..n {
-                let len = (starts[i + 1] - starts[i]) as usize;
-                let (head, tail) = rest.split_at_mut(len);
-                parts.push(head);
-                rest = tail;
+        let starts = &self.sphere_start;
+        // Blocks of bodies with their spheres; in a block, eight bodies of
+        // one template at a time on the vector lanes, the others one by one.
+        let block = |(c, (centres, dipoles)): (usize, (&mut [DVec3], &mut [DVec3]))| {
+            let first = c * WORLD_BLOCK;
+            let base = starts[first] as usize;
+            let spheres = |i: usize, j: usize| starts[i] as usize - base..starts[j] as usize - base;
+            let mut i = first;
+            while i < first + dipoles.len() {
+                let group = i + LANES <= first + dipoles.len()
+                    && bodies.kind[i..i + LANES]
+                        .iter()
+                        .all(|&k| k == bodies.kind[i]);
+                if group {
+                    let t = bodies.template(i);
+                    let d = &mut dipoles[i - first..i - first + LANES];
+                    if world8(
+                        bodies.rotation[i..i + LANES].try_into().expect("eight"),
+                        bodies.position[i..i + LANES].try_into().expect("eight"),
+                        &t.centres,
+                        t.dipole,
+                        &mut centres[spheres(i, i + LANES)],
+                        d.try_into().expect("eight"),
+                    ) {
+                        i += LANES;
+                        continue;
+                    }
+                }
+                fill(i, &mut centres[spheres(i, i + 1)], &mut dipoles[i - first]);
+                i += 1;
             }
+        };
+        let mut rest: &mut [DVec3] = &mut self.sphere_centre;
+        let mut parts = Vec::with_capacity(n.div_ceil(WORLD_BLOCK));
+        for c in 0..n.div_ceil(WORLD_BLOCK) {
+            let (i, j) = (c * WORLD_BLOCK, ((c + 1) * WORLD_BLOCK).min(n));
+            let (head, tail) = rest.split_at_mut((starts[j] - starts[i]) as usize);
+            parts.push(head);
+            rest = tail;
+        }
+        if n >= 4096 {
             parts
                 .into_par_iter()
-                .zip(self.dipole.par_iter_mut())
+                .zip(self.dipole.par_chunks_mut(WORLD_BLOCK))
                 .enumerate()
-                .for_each(|(i, (c, d))| fill(i, c, d));
+                .for_each(block);
         } else {
-            for i in 0..n {
-                let (a, b) = (
-                    self.sphere_start[i] as usize,
-                    self.sphere_start[i + 1] as usize,
-                );
-                fill(i, &mut self.sphere_centre[a..b], &mut self.dipole[i]);
-            }
+            parts
+                .into_iter()
+                .zip(self.dipole.chunks_mut(WORLD_BLOCK))
+                .enumerate()
+                .for_each(block);
         }
     }
 }
+
+/// Bodies per block of the world-frame update.
+const WORLD_BLOCK: usize = 256;
 
 /// What an interaction sees: the bodies and their world-frame spheres.
 #[derive(Clone, Copy)]
