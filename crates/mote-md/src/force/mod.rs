@@ -21,6 +21,7 @@ pub use springs::{Spring, SpringNetwork};
 pub use uniform::UniformField;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::boundary::Boundary;
 use crate::neighbor::VerletList;
@@ -216,7 +217,6 @@ pub(crate) type BlockBuffers = Vec<(Vec<DVec3>, Vec<DVec3>)>;
 /// Adds the blocks' buffers to `force` and `torque`, buffer after buffer in
 /// block order for every particle, so every thread count gives the same bits.
 pub(crate) fn add_block_buffers(force: &mut [DVec3], torque: &mut [DVec3], buffers: &BlockBuffers) {
-    use rayon::prelude::*;
     if buffers.is_empty() {
         return;
     }
@@ -316,7 +316,6 @@ impl ForceField {
         for interaction in &mut self.interactions {
             interaction.add_forces(state, &mut self.force);
         }
-        use rayon::prelude::*;
         let (force, mass) = (&self.force, state.mass);
         acc.par_iter_mut()
             .enumerate()
@@ -352,7 +351,6 @@ impl ForceField {
         torque.resize(n, DVec3::ZERO);
         self.add_forces_and_torques(state, spin, &mut force, &mut torque);
         (self.force, self.torque) = (force, torque);
-        use rayon::prelude::*;
         let (force, torque, mass) = (&self.force, &self.torque, state.mass);
         (acc, alpha)
             .into_par_iter()

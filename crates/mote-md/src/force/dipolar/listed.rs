@@ -14,6 +14,7 @@
 
 use glam::DVec3;
 use mote_geom::simd::Isa;
+use rayon::prelude::*;
 
 use super::{DipoleDipole, Kernel};
 use crate::boundary::Boundary;
@@ -111,7 +112,6 @@ impl DipoleDipole {
     /// Adds the rows' forces and torques to the particles'.
     pub(super) fn add_sorted(&self, force: &mut [DVec3], torque: &mut [DVec3]) {
         let (sorted, slot) = (&self.sorted, &self.list.slot);
-        use rayon::prelude::*;
         force
             .par_iter_mut()
             .zip(torque.par_iter_mut())
