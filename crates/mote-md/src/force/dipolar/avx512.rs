@@ -14,6 +14,7 @@ use glam::DVec3;
 use mote_geom::simd::avx512::rsqrt;
 
 use super::listed::RowSum;
+use super::tiled::Reactions;
 use super::{Kernel, Soa};
 use crate::neighbor::avx512::{in_eights, load_copies};
 use crate::neighbor::Copy4;
@@ -50,6 +51,14 @@ impl Lanes {
 
 type V3 = [__m512d; 3];
 
+/// What [`pair8`] gives: [F_x, F_y, F_z, τ_x, τ_y, τ_z, r·F, U] on i, and
+/// the two factors of the field of i at j, B_i = c (a·r) r − (k/r³ − rf) a.
+struct Pair8 {
+    on_i: [__m512d; 8],
+    c_a_r: __m512d,
+    field: __m512d,
+}
+
 /// Eight pairs at separations d = r_i − r_j (r² = |d|²) between moment
 /// `a` (of i) and moments `b`: [F_x, F_y, F_z, τ_x, τ_y, τ_z, r·F, U] on
 /// i, the dipolar terms (with the reaction field) in the lanes of `dip`,
@@ -70,7 +79,7 @@ fn pair8(
     dip: __mmask8,
     lj: __mmask8,
     energy: bool,
-) -> [__m512d; 8] {
+) -> Pair8 {
     let set = _mm512_set1_pd;
     let (one, two, three, five) = (set(1.0), set(2.0), set(3.0), set(5.0));
     let [dx, dy, dz] = d;
@@ -87,30 +96,34 @@ fn pair8(
     let b_r = _mm512_fmadd_pd(bx, dx, _mm512_fmadd_pd(by, dy, _mm512_mul_pd(bz, dz)));
     let ab = _mm512_fmadd_pd(ax, bx, _mm512_fmadd_pd(ay, by, _mm512_mul_pd(az, bz)));
     let a_r_b_r = _mm512_mul_pd(a_r, b_r);
-    // radial = c (a·b) − 5 c (a·r)(b·r)/r²
-    let radial = _mm512_fmsub_pd(
+    let (ca, cb) = (_mm512_mul_pd(cc, a_r), _mm512_mul_pd(cc, b_r));
+    // radial = c (a·b − 5 (a·r)(b·r)/r²)
+    let radial = _mm512_mul_pd(
         cc,
-        ab,
-        _mm512_mul_pd(_mm512_mul_pd(five, cc), _mm512_mul_pd(a_r_b_r, inv_r2)),
+        _mm512_fnmadd_pd(five, _mm512_mul_pd(a_r_b_r, inv_r2), ab),
     );
-    // LJ: 6·4ε s⁶ (2 s⁶ − 1)/r², s² = σ²/r².
-    let s2 = _mm512_mul_pd(c.lj_s2, inv_r2);
-    let s6 = _mm512_mul_pd(_mm512_mul_pd(s2, s2), s2);
-    let lj_f = _mm512_maskz_mul_pd(
-        lj,
-        _mm512_mul_pd(c.lj6, _mm512_mul_pd(s6, _mm512_fmsub_pd(two, s6, one))),
-        inv_r2,
-    );
-    let along = _mm512_add_pd(radial, lj_f);
+    // LJ: 6·4ε s⁶ (2 s⁶ − 1)/r², s² = σ²/r²; skipped where no lane is
+    // within its reach (adding its zeros would change no bit).
+    let s6 = || {
+        let s2 = _mm512_mul_pd(c.lj_s2, inv_r2);
+        _mm512_mul_pd(_mm512_mul_pd(s2, s2), s2)
+    };
+    let along = if lj != 0 {
+        let s6 = s6();
+        let lj_f = _mm512_maskz_mul_pd(
+            lj,
+            _mm512_mul_pd(c.lj6, _mm512_mul_pd(s6, _mm512_fmsub_pd(two, s6, one))),
+            inv_r2,
+        );
+        _mm512_add_pd(radial, lj_f)
+    } else {
+        radial
+    };
+    // F_i = along r + c ((b·r) a + (a·r) b)
     let g = |d: __m512d, a: __m512d, b: __m512d| {
-        _mm512_fmadd_pd(
-            d,
-            along,
-            _mm512_mul_pd(cc, _mm512_fmadd_pd(a, b_r, _mm512_mul_pd(b, a_r))),
-        )
+        _mm512_fmadd_pd(d, along, _mm512_fmadd_pd(a, cb, _mm512_mul_pd(b, ca)))
     };
     let (gx, gy, gz) = (g(dx, ax, bx), g(dy, ay, by), g(dz, az, bz));
-    let cb = _mm512_mul_pd(cc, b_r);
     let bfx = _mm512_fmsub_pd(cb, dx, _mm512_mul_pd(field, bx));
     let bfy = _mm512_fmsub_pd(cb, dy, _mm512_mul_pd(field, by));
     let bfz = _mm512_fmsub_pd(cb, dz, _mm512_mul_pd(field, bz));
@@ -119,13 +132,22 @@ fn pair8(
     let tz = _mm512_fmsub_pd(ax, bfy, _mm512_mul_pd(ay, bfx));
     let w = _mm512_fmadd_pd(gx, dx, _mm512_fmadd_pd(gy, dy, _mm512_mul_pd(gz, dz)));
     let u = if energy {
-        let lj_u = _mm512_fmsub_pd(_mm512_fmsub_pd(c.lj4e, s6, c.lj4e), s6, c.lj_shift);
         let dip_u = _mm512_fmsub_pd(field, ab, _mm512_mul_pd(cc, a_r_b_r));
-        _mm512_mask_add_pd(dip_u, lj, dip_u, lj_u)
+        if lj != 0 {
+            let s6 = s6();
+            let lj_u = _mm512_fmsub_pd(_mm512_fmsub_pd(c.lj4e, s6, c.lj4e), s6, c.lj_shift);
+            _mm512_mask_add_pd(dip_u, lj, dip_u, lj_u)
+        } else {
+            dip_u
+        }
     } else {
         _mm512_setzero_pd()
     };
-    [gx, gy, gz, tx, ty, tz, w, u]
+    Pair8 {
+        on_i: [gx, gy, gz, tx, ty, tz, w, u],
+        c_a_r: ca,
+        field,
+    }
 }
 
 /// The eight sums as a row's totals.
@@ -141,17 +163,21 @@ fn totals(acc: &[__m512d; 8]) -> RowSum {
     }
 }
 
-/// Force and torque on particle i from all others, and its share of the
-/// virial; see [`super::all_pairs_row`].
+/// Force and torque on particle i from the first n others, and its share
+/// of the virial; see [`super::all_pairs_row`].
 ///
 /// # Safety
-/// The CPU must support AVX-512F; the arrays of `s` must have equal lengths.
+/// The CPU must support AVX-512F; the arrays of `s` must hold at least n values.
 #[target_feature(enable = "avx512f")]
-pub(super) unsafe fn all_pairs_row(kern: &Kernel, s: &Soa, i: usize) -> (DVec3, DVec3, f64) {
-    let n = s.x.len();
-    debug_assert!([&s.y, &s.z, &s.mx, &s.my, &s.mz]
+pub(super) unsafe fn all_pairs_row(
+    kern: &Kernel,
+    s: &Soa,
+    i: usize,
+    n: usize,
+) -> (DVec3, DVec3, f64) {
+    debug_assert!([&s.x, &s.y, &s.z, &s.mx, &s.my, &s.mz]
         .iter()
-        .all(|v| v.len() == n));
+        .all(|v| v.len() >= n));
     let c = Lanes::of(kern);
     let set = _mm512_set1_pd;
     let (xi, yi, zi) = (set(s.x[i]), set(s.y[i]), set(s.z[i]));
@@ -174,7 +200,7 @@ pub(super) unsafe fn all_pairs_row(kern: &Kernel, s: &Soa, i: usize) -> (DVec3, 
         let r2 = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dz, dz)));
         let live = _mm512_mask_cmp_pd_mask::<_CMP_GT_OQ>(lanes, r2, zero);
         let lj = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(live, r2, c.lj_rc2);
-        let v = pair8(&c, [dx, dy, dz], r2, a, b, live, lj, false);
+        let v = pair8(&c, [dx, dy, dz], r2, a, b, live, lj, false).on_i;
         for (a, v) in acc.iter_mut().zip(v) {
             *a = _mm512_add_pd(*a, v);
         }
@@ -221,11 +247,122 @@ pub(super) unsafe fn list_row(
         let r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
         let dip = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(valid, r2, c.rc2);
         let lj = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(valid, r2, c.lj_rc2);
-        let v = pair8(&c, [dx, dy, dz], r2, a, [bx, by, bz], dip, lj, energy);
+        let v = pair8(&c, [dx, dy, dz], r2, a, [bx, by, bz], dip, lj, energy).on_i;
         for (a, v) in acc.iter_mut().zip(v) {
             *a = _mm512_add_pd(*a, v);
         }
     };
     in_eights(row, k as u32, lanes);
     totals(&acc)
+}
+
+/// Rows i₀, i₀ + 1, …, i₀ + R − 1 of a tile of the all-pairs sum (see
+/// `tiled.rs`): row i₀ + q takes the pairs (i, j) for j in
+/// `j_start[q]..j_end` and j < n, eight at a time, and the R rows share
+/// each block's loads and its reaction updates (row 0's, then row 1's, …:
+/// the order of R single rows). Returns the force, torque and virial on
+/// each i and adds the reactions −F and τ_j = m_j × B_i to `r` at j − base.
+/// Dead lanes (below a row's start, past n) add exact zeros.
+///
+/// # Safety
+/// The CPU must have AVX-512F; the arrays of `s` must hold at least
+/// `j_end` values, `j_end` a multiple of 8; i₀ ≥ base, j_start[q] > i₀ + q
+/// and j_start[q] ≥ j_start[0]; the reaction arrays must cover
+/// `base..j_end`.
+#[target_feature(enable = "avx512f")]
+#[allow(clippy::too_many_arguments)]
+pub(super) unsafe fn reacting_rows<const R: usize>(
+    kern: &Kernel,
+    s: &Soa,
+    i0: usize,
+    j_start: [usize; R],
+    j_end: usize,
+    n: usize,
+    base: usize,
+    r: &mut Reactions,
+) -> [(DVec3, DVec3, f64); R] {
+    debug_assert!(j_end.is_multiple_of(8) && i0 >= base);
+    debug_assert!((0..R).all(|q| j_start[q] > i0 + q && j_start[q] >= j_start[0]));
+    debug_assert!([&s.x, &s.y, &s.z, &s.mx, &s.my, &s.mz]
+        .iter()
+        .all(|v| v.len() >= j_end));
+    debug_assert!(r.tz.len() >= j_end - base);
+    let c = Lanes::of(kern);
+    let set = _mm512_set1_pd;
+    let zero = _mm512_setzero_pd();
+    let ri: [V3; R] =
+        std::array::from_fn(|q| [set(s.x[i0 + q]), set(s.y[i0 + q]), set(s.z[i0 + q])]);
+    let a: [V3; R] =
+        std::array::from_fn(|q| [set(s.mx[i0 + q]), set(s.my[i0 + q]), set(s.mz[i0 + q])]);
+    let mut acc = [[zero; 7]; R];
+    let mut j = j_start[0] & !7;
+    let reactions = [
+        r.fx.as_mut_ptr(),
+        r.fy.as_mut_ptr(),
+        r.fz.as_mut_ptr(),
+        r.tx.as_mut_ptr(),
+        r.ty.as_mut_ptr(),
+        r.tz.as_mut_ptr(),
+    ];
+    while j < j_end {
+        let tail: __mmask8 = if j + 8 > n {
+            ((1u16 << (n - j).min(8)) - 1) as u8
+        } else {
+            0xFF
+        };
+        // SAFETY: j + 8 ≤ j_end ≤ every array's length.
+        let load = |v: &[f64]| unsafe { _mm512_loadu_pd(v.as_ptr().add(j)) };
+        let rj = [load(&s.x), load(&s.y), load(&s.z)];
+        let b = [load(&s.mx), load(&s.my), load(&s.mz)];
+        let [bx, by, bz] = b;
+        let k = j - base;
+        for q in 0..R {
+            let lanes = if j_start[q] > j {
+                tail & (0xFFu8.checked_shl((j_start[q] - j) as u32).unwrap_or(0))
+            } else {
+                tail
+            };
+            let dx = _mm512_sub_pd(ri[q][0], rj[0]);
+            let dy = _mm512_sub_pd(ri[q][1], rj[1]);
+            let dz = _mm512_sub_pd(ri[q][2], rj[2]);
+            let r2 = _mm512_fmadd_pd(dx, dx, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dz, dz)));
+            let live = _mm512_mask_cmp_pd_mask::<_CMP_GT_OQ>(lanes, r2, zero);
+            let lj = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(live, r2, c.lj_rc2);
+            let p = pair8(&c, [dx, dy, dz], r2, a[q], b, live, lj, false);
+            for (a, v) in acc[q].iter_mut().zip(p.on_i) {
+                *a = _mm512_add_pd(*a, v);
+            }
+            // B_i = c (a·r) r − field a; τ_j = b × B_i.
+            let field_i =
+                |d: __m512d, a: __m512d| _mm512_fmsub_pd(p.c_a_r, d, _mm512_mul_pd(p.field, a));
+            let (fx, fy, fz) = (
+                field_i(dx, a[q][0]),
+                field_i(dy, a[q][1]),
+                field_i(dz, a[q][2]),
+            );
+            let tj = [
+                _mm512_fmsub_pd(by, fz, _mm512_mul_pd(bz, fy)),
+                _mm512_fmsub_pd(bz, fx, _mm512_mul_pd(bx, fz)),
+                _mm512_fmsub_pd(bx, fy, _mm512_mul_pd(by, fx)),
+            ];
+            for c in 0..3 {
+                // SAFETY: k + 8 ≤ j_end − base ≤ the reaction arrays' length.
+                unsafe {
+                    let pf = reactions[c].add(k);
+                    _mm512_storeu_pd(pf, _mm512_sub_pd(_mm512_loadu_pd(pf), p.on_i[c]));
+                    let pt = reactions[3 + c].add(k);
+                    _mm512_storeu_pd(pt, _mm512_add_pd(_mm512_loadu_pd(pt), tj[c]));
+                }
+            }
+        }
+        j += 8;
+    }
+    std::array::from_fn(|q| {
+        let sum = |c: usize| _mm512_reduce_add_pd(acc[q][c]);
+        (
+            DVec3::new(sum(0), sum(1), sum(2)),
+            DVec3::new(sum(3), sum(4), sum(5)),
+            sum(6),
+        )
+    })
 }

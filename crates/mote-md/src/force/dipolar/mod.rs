@@ -21,9 +21,11 @@
 //!
 //! Three ways to sum the pairs:
 //!
-//! - **all pairs** (open boundaries, no cut-off): exact; each particle's
-//!   row is summed over all others in a fixed order, parallel over
-//!   particles, so results are bit-identical for every thread count;
+//! - **all pairs** (open boundaries, no cut-off): exact; each pair is
+//!   evaluated once, in tiles whose reactions are gathered in a fixed
+//!   order (`tiled.rs`, as gravity does), so results are bit-identical for
+//!   every thread count; past 65 536 particles each particle's row is
+//!   summed over all others instead;
 //! - **a spherical cut-off** r_c ≤ L/2 (periodic boxes: each pair's
 //!   minimum image), through a full ghost list with SIMD rows
 //!   (`listed.rs`; every thread count gives the same bits): an
@@ -62,6 +64,7 @@ use rayon::prelude::*;
 
 mod avx512;
 mod listed;
+mod tiled;
 
 use super::{Interaction, Spin, State};
 use crate::boundary::Boundary;
@@ -234,8 +237,11 @@ pub struct DipoleDipole {
     moment: Vec<Copy4>,
     /// Force and torque of each row of the list (cut-off mode).
     sorted: Vec<(DVec3, DVec3)>,
-    /// Structure-of-arrays copies for the all-pairs loop.
+    /// Structure-of-arrays copies for the all-pairs loop, padded with
+    /// zeros to a multiple of 8.
     soa: Soa,
+    /// Scratch of the all-pairs tiles (`tiled.rs`).
+    tiles: Vec<tiled::TileRow>,
     /// The row kernels' instruction set.
     isa: Isa,
 }
@@ -265,6 +271,7 @@ impl DipoleDipole {
             moment: Vec::new(),
             sorted: Vec::new(),
             soa: Soa::default(),
+            tiles: Vec::new(),
             isa: isa(),
         }
     }
@@ -430,10 +437,12 @@ impl DipoleDipole {
         per_i.iter().sum()
     }
 
-    /// All pairs, each particle's row over all others (every pair twice),
-    /// parallel over particles: the same bits for every thread count.
-    /// Positions and moments are copied into separate arrays so that the
-    /// inner loop vectorises; with AVX-512, 8 partners per instruction.
+    /// All pairs: each pair once in tiles with reactions (`tiled.rs`) up
+    /// to [`tiled::TILED_MAX`] particles, beyond that each particle's row
+    /// over all others (every pair twice). Either way the same bits for
+    /// every thread count. Positions and moments are copied into separate
+    /// arrays so that the inner loop vectorises; with AVX-512, 8 partners
+    /// per instruction.
     fn all_pairs_forces(
         &mut self,
         pos: &[DVec3],
@@ -441,7 +450,8 @@ impl DipoleDipole {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) -> f64 {
-        self.all_pairs_forces_with(pos, dipoles, force, torque, isa())
+        let isa = self.isa;
+        self.all_pairs_forces_with(pos, dipoles, force, torque, isa, true)
     }
 
     fn all_pairs_forces_with(
@@ -451,23 +461,27 @@ impl DipoleDipole {
         force: &mut [DVec3],
         torque: &mut [DVec3],
         isa: Isa,
+        tiled: bool,
     ) -> f64 {
         let n = pos.len();
-        let kern = self.kernel();
+        let npad = n.div_ceil(LANES) * LANES;
         let s = &mut self.soa;
-        for v in [
-            &mut s.x, &mut s.y, &mut s.z, &mut s.mx, &mut s.my, &mut s.mz,
+        for (v, c) in [
+            (&mut s.x, 0),
+            (&mut s.y, 1),
+            (&mut s.z, 2),
+            (&mut s.mx, 3),
+            (&mut s.my, 4),
+            (&mut s.mz, 5),
         ] {
             v.clear();
+            v.extend((0..n).map(|i| if c < 3 { pos[i][c] } else { dipoles[i][c - 3] }));
+            v.resize(npad, 0.0);
         }
-        for i in 0..n {
-            s.x.push(pos[i].x);
-            s.y.push(pos[i].y);
-            s.z.push(pos[i].z);
-            s.mx.push(dipoles[i].x);
-            s.my.push(dipoles[i].y);
-            s.mz.push(dipoles[i].z);
+        if tiled && n <= tiled::TILED_MAX {
+            return self.tiled_forces(n, force, torque, isa);
         }
+        let kern = self.kernel();
         let soa = &self.soa;
         let virials: Vec<f64> = force
             .par_iter_mut()
@@ -476,10 +490,10 @@ impl DipoleDipole {
             .with_min_len(16)
             .map(|(i, (f, t))| {
                 let (fi, ti, w) = match isa {
-                    // SAFETY: the CPU supports AVX-512F (`isa`); the arrays have length n.
+                    // SAFETY: the CPU supports AVX-512F (`isa`); the arrays have length ≥ n.
                     #[cfg(target_arch = "x86_64")]
-                    Isa::Avx512 => unsafe { avx512::all_pairs_row(&kern, soa, i) },
-                    Isa::Portable => all_pairs_row(&kern, soa, i),
+                    Isa::Avx512 => unsafe { avx512::all_pairs_row(&kern, soa, i, n) },
+                    Isa::Portable => all_pairs_row(&kern, soa, i, n),
                 };
                 *f += fi;
                 *t += ti;
@@ -495,15 +509,14 @@ impl DipoleDipole {
 /// compiler) and the result is the same on every CPU.
 const LANES: usize = 8;
 
-/// Force and torque on particle i from all others, and its share of the
-/// virial: branch-free lanes, the self pair masked by r² = 0, the partial
-/// sums of the lanes added in a fixed order.
+/// Force and torque on particle i from the first n others, and its share
+/// of the virial: branch-free lanes, the self pair masked by r² = 0, the
+/// partial sums of the lanes added in a fixed order.
 #[inline(always)]
-fn all_pairs_row(kern: &Kernel, s: &Soa, i: usize) -> (DVec3, DVec3, f64) {
+fn all_pairs_row(kern: &Kernel, s: &Soa, i: usize, n: usize) -> (DVec3, DVec3, f64) {
     let (xi, yi, zi) = (s.x[i], s.y[i], s.z[i]);
     let (ax, ay, az) = (s.mx[i], s.my[i], s.mz[i]);
     let k = kern.k;
-    let n = s.x.len();
     let mut acc = [[0.0f64; LANES]; 7];
     let full = n - n % LANES;
     #[inline(always)]
@@ -874,17 +887,8 @@ impl Interaction for Zeeman {
 mod kernel_tests {
     use super::*;
 
-    /// The AVX-512 all-pairs row kernel agrees with the portable one (forces,
-    /// torques and virial to 1e-12 of the largest), with and without WCA,
-    /// for a particle count that leaves a partial last block.
-    #[test]
-    fn vector_kernel_agrees_with_the_scalar_reference() {
-        if isa() == Isa::Portable {
-            eprintln!("no AVX-512 here: nothing to compare");
-            return;
-        }
-        let n = 203;
-        let pos: Vec<DVec3> = (0..n)
+    fn cloud(n: usize) -> (Vec<DVec3>, Vec<DVec3>) {
+        let pos = (0..n)
             .map(|k| {
                 let t = k as f64;
                 DVec3::new(
@@ -895,42 +899,106 @@ mod kernel_tests {
                     + DVec3::new(0.013 * t, 0.0, 0.0)
             })
             .collect();
-        let dip: Vec<DVec3> = (0..n)
+        let dip = (0..n)
             .map(|k| {
                 let t = k as f64;
                 DVec3::new((0.9 * t).cos(), (1.1 * t).sin(), 0.5 + (0.3 * t).sin())
             })
             .collect();
-        for wca in [false, true] {
-            let mut dd = DipoleDipole::all_pairs(4.0 * PI);
-            if wca {
-                dd = dd.with_repulsion(PairRepulsion::wca(1.0, 1.0)).unwrap();
-            }
-            let run = |dd: &mut DipoleDipole, isa: Isa| {
-                let (mut f, mut t) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-                let w = dd.all_pairs_forces_with(&pos, &dip, &mut f, &mut t, isa);
-                (f, t, w)
-            };
-            let (f0, t0, w0) = run(&mut dd, Isa::Portable);
-            let (f1, t1, w1) = run(&mut dd, isa());
-            let close = |a: &[DVec3], b: &[DVec3], what: &str| {
-                let scale = a.iter().map(|v| v.length()).fold(0.0, f64::max);
-                let worst = a
-                    .iter()
-                    .zip(b)
-                    .map(|(x, y)| (*x - *y).length())
-                    .fold(0.0, f64::max);
-                assert!(
-                    worst <= 1e-12 * scale,
-                    "{what} (wca {wca}): worst difference {worst:e} of {scale:e}"
-                );
-            };
-            close(&f0, &f1, "forces");
-            close(&t0, &t1, "torques");
-            assert!(
-                (w0 - w1).abs() <= 1e-12 * w0.abs().max(1.0),
-                "virial {w0} vs {w1}"
-            );
+        (pos, dip)
+    }
+
+    type Sums = (Vec<DVec3>, Vec<DVec3>, f64);
+
+    fn run(dd: &mut DipoleDipole, pos: &[DVec3], dip: &[DVec3], isa: Isa, tiled: bool) -> Sums {
+        let n = pos.len();
+        let (mut f, mut t) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        let w = dd.all_pairs_forces_with(pos, dip, &mut f, &mut t, isa, tiled);
+        (f, t, w)
+    }
+
+    /// The all-pairs kernels — tiled with reactions (each pair once) and
+    /// rows (each pair twice), AVX-512 and portable — agree with the
+    /// portable rows (forces, torques and virial to 1e-12 of the largest),
+    /// with and without WCA, for particle counts that leave a partial last
+    /// block (7, 203) and need several tiles and column blocks (1100).
+    #[test]
+    fn every_kernel_agrees_with_the_scalar_reference() {
+        let mut isas = vec![Isa::Portable];
+        if isa() != Isa::Portable {
+            isas.push(isa());
         }
+        for n in [7, 203, 1100] {
+            let (pos, dip) = cloud(n);
+            for wca in [false, true] {
+                let mut dd = DipoleDipole::all_pairs(4.0 * PI);
+                if wca {
+                    dd = dd.with_repulsion(PairRepulsion::wca(1.0, 1.0)).unwrap();
+                }
+                let (f0, t0, w0) = run(&mut dd, &pos, &dip, Isa::Portable, false);
+                let close = |a: &[DVec3], b: &[DVec3], what: &str| {
+                    let scale = a.iter().map(|v| v.length()).fold(0.0, f64::max);
+                    let worst = a
+                        .iter()
+                        .zip(b)
+                        .map(|(x, y)| (*x - *y).length())
+                        .fold(0.0, f64::max);
+                    assert!(
+                        worst <= 1e-12 * scale,
+                        "{what} (n {n}, wca {wca}): worst difference {worst:e} of {scale:e}"
+                    );
+                };
+                for &isa in &isas {
+                    for tiled in [false, true] {
+                        let (f1, t1, w1) = run(&mut dd, &pos, &dip, isa, tiled);
+                        let what = format!("{isa:?}, tiled {tiled}");
+                        close(&f0, &f1, &format!("forces, {what}"));
+                        close(&t0, &t1, &format!("torques, {what}"));
+                        assert!(
+                            (w0 - w1).abs() <= 1e-12 * w0.abs().max(1.0),
+                            "{what}: virial {w0} vs {w1}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Tiles give the same bits on one thread and on three, and conserve
+    /// momentum and angular momentum pair by pair (Σ F = 0 and
+    /// Σ (τ + r × F) = 0 to round-off).
+    #[test]
+    fn tiles_are_thread_count_independent_and_conserve_momenta() {
+        let (pos, dip) = cloud(1100);
+        let mut dd = DipoleDipole::all_pairs(4.0 * PI)
+            .with_repulsion(PairRepulsion::wca(1.0, 1.0))
+            .unwrap();
+        let mut on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| run(&mut dd, &pos, &dip, isa(), true))
+        };
+        let (f1, t1, w1) = on(1);
+        let (f3, t3, w3) = on(3);
+        let bits = |v: &[DVec3]| {
+            v.iter()
+                .flat_map(|a| a.to_array())
+                .map(f64::to_bits)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&f1), bits(&f3));
+        assert_eq!(bits(&t1), bits(&t3));
+        assert_eq!(w1.to_bits(), w3.to_bits());
+        let total: DVec3 = f1.iter().copied().sum();
+        let spin: DVec3 = (0..pos.len()).map(|i| t1[i] + pos[i].cross(f1[i])).sum();
+        let scale: f64 = f1
+            .iter()
+            .zip(&pos)
+            .map(|(f, r)| f.length() * (1.0 + r.length()))
+            .sum();
+        assert!(total.length() < 1e-13 * scale, "Σ F = {total}");
+        assert!(spin.length() < 1e-13 * scale, "Σ (τ + r × F) = {spin}");
     }
 }

@@ -1,0 +1,246 @@
+//! All pairs of an open system of dipoles, each pair evaluated once
+//! (Newton's third law), in tiles, as [`crate::force::gravity`] does.
+//!
+//! Particles are cut into tiles of `tile` consecutive indices. The rayon
+//! task of tile I sums, for every i in I, the force F_i, the torque τ_i and
+//! the virial r·F_i of all pairs (i, j > i) — the "own" part of i — and
+//! writes the reactions on each j into six arrays of its own:
+//!
+//! F_j = −F_i,   τ_j = m_j × B_i,   B_i = k [3 (m_i·r) r / r⁵ − m_i / r³]
+//!
+//! (004 Eq. 8; r = r_i − r_j and B_i even in r). Every force and torque is
+//! then its own part plus the reactions of tiles 0, 1, …, I in that order,
+//! so the result is bit-identical for every thread count. Within a task the
+//! columns go in blocks of [`COLUMNS`] for all rows of the tile before the
+//! next block, so the reactions in use stay in L1.
+//!
+//! Memory: tile I keeps reactions for particles from its own start to the
+//! end, 48 bytes each; with at most 64 tiles that is ≤ 1.6 kB per particle,
+//! so above [`TILED_MAX`] particles each row sums over all others instead
+//! (every pair twice).
+
+use glam::DVec3;
+use mote_geom::simd::Isa;
+use rayon::prelude::*;
+
+use super::{DipoleDipole, Kernel, Soa};
+
+/// Above this many particles the reaction arrays would pass ~100 MB.
+pub(super) const TILED_MAX: usize = 1 << 16;
+/// Columns per block of a tile's sweep: 6 reaction arrays × 8 bytes × 512
+/// = 24 kB, within L1.
+const COLUMNS: usize = 512;
+
+/// Reactions on particles from a tile's start onwards: forces and torques
+/// as six arrays of components.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Reactions {
+    pub fx: Vec<f64>,
+    pub fy: Vec<f64>,
+    pub fz: Vec<f64>,
+    pub tx: Vec<f64>,
+    pub ty: Vec<f64>,
+    pub tz: Vec<f64>,
+}
+
+impl Reactions {
+    fn reset(&mut self, len: usize) {
+        for v in self.arrays() {
+            v.clear();
+            v.resize(len, 0.0);
+        }
+    }
+
+    fn arrays(&mut self) -> [&mut Vec<f64>; 6] {
+        [
+            &mut self.fx,
+            &mut self.fy,
+            &mut self.fz,
+            &mut self.tx,
+            &mut self.ty,
+            &mut self.tz,
+        ]
+    }
+
+    fn at(&self, k: usize) -> (DVec3, DVec3) {
+        (
+            DVec3::new(self.fx[k], self.fy[k], self.fz[k]),
+            DVec3::new(self.tx[k], self.ty[k], self.tz[k]),
+        )
+    }
+}
+
+/// The scratch of one tile's task.
+#[derive(Debug, Clone, Default)]
+pub(super) struct TileRow {
+    /// Own force and torque of the tile's particles.
+    own: Vec<(DVec3, DVec3)>,
+    /// Σ r·F over the tile's pairs.
+    virial: f64,
+    reactions: Reactions,
+}
+
+/// Force and torque on i (returned with the pairs' virial) from the pairs
+/// (i, j), j in `j_start..j_end` and j < n, with the reactions added to
+/// `r` at j − base; one pair at a time through [`Kernel::pair`].
+#[allow(clippy::too_many_arguments)]
+pub(super) fn reacting_row_portable(
+    kern: &Kernel,
+    s: &Soa,
+    i: usize,
+    j_start: usize,
+    j_end: usize,
+    n: usize,
+    base: usize,
+    r: &mut Reactions,
+) -> (DVec3, DVec3, f64) {
+    let ri = DVec3::new(s.x[i], s.y[i], s.z[i]);
+    let a = DVec3::new(s.mx[i], s.my[i], s.mz[i]);
+    let (mut f, mut t, mut w) = (DVec3::ZERO, DVec3::ZERO, 0.0);
+    for j in j_start..j_end.min(n) {
+        let d = ri - DVec3::new(s.x[j], s.y[j], s.z[j]);
+        let r2 = d.length_squared();
+        if r2 > 0.0 {
+            let (_, fi, ti, tj, wi) = kern.pair(d, r2, a, DVec3::new(s.mx[j], s.my[j], s.mz[j]));
+            f += fi;
+            t += ti;
+            w += wi;
+            let k = j - base;
+            r.fx[k] -= fi.x;
+            r.fy[k] -= fi.y;
+            r.fz[k] -= fi.z;
+            r.tx[k] += tj.x;
+            r.ty[k] += tj.y;
+            r.tz[k] += tj.z;
+        }
+    }
+    (f, t, w)
+}
+
+impl DipoleDipole {
+    /// Tile length: at least 64, at most 64 tiles, a multiple of 8.
+    fn tile(npad: usize) -> usize {
+        (npad.div_ceil(64).div_ceil(8) * 8).max(64)
+    }
+
+    /// Adds the forces and torques of all pairs among the first `n`
+    /// particles of the (padded) structure of arrays; returns the virial.
+    pub(super) fn tiled_forces(
+        &mut self,
+        n: usize,
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+        isa: Isa,
+    ) -> f64 {
+        let kern = self.kernel();
+        let soa = &self.soa;
+        let npad = soa.x.len();
+        let tile = Self::tile(npad);
+        let tiles = npad.div_ceil(tile);
+        self.tiles.resize_with(tiles, TileRow::default);
+        let sweep = |t: usize, row: &mut TileRow| {
+            let base = t * tile;
+            let end_i = (base + tile).min(n);
+            row.own.clear();
+            row.own
+                .resize(end_i.saturating_sub(base), (DVec3::ZERO, DVec3::ZERO));
+            row.reactions.reset(npad - base);
+            row.virial = 0.0;
+            let mut block = base / COLUMNS * COLUMNS;
+            while block < npad {
+                let block_end = (block + COLUMNS).min(npad);
+                let mut i = base;
+                while i < end_i {
+                    let j_start = block.max(i + 1);
+                    if j_start >= block_end {
+                        i += 1;
+                        continue;
+                    }
+                    let r = &mut row.reactions;
+                    // With AVX-512 two rows share each block's loads and
+                    // reaction updates (the arithmetic of two single rows).
+                    #[cfg(target_arch = "x86_64")]
+                    if isa == Isa::Avx512 && i + 1 < end_i {
+                        let starts = [j_start, block.max(i + 2)];
+                        // SAFETY: the CPU supports AVX-512F (`isa`); the
+                        // arrays have the padded length npad ≥ block_end, a
+                        // multiple of 8, and the reactions cover base..npad.
+                        let sums = unsafe {
+                            super::avx512::reacting_rows::<2>(
+                                &kern, soa, i, starts, block_end, n, base, r,
+                            )
+                        };
+                        for (q, (f, tq, w)) in sums.into_iter().enumerate() {
+                            let own = &mut row.own[i + q - base];
+                            own.0 += f;
+                            own.1 += tq;
+                            row.virial += w;
+                        }
+                        i += 2;
+                        continue;
+                    }
+                    let (f, tq, w) = match isa {
+                        // SAFETY: as above, for one row.
+                        #[cfg(target_arch = "x86_64")]
+                        Isa::Avx512 => unsafe {
+                            super::avx512::reacting_rows::<1>(
+                                &kern,
+                                soa,
+                                i,
+                                [j_start],
+                                block_end,
+                                n,
+                                base,
+                                r,
+                            )[0]
+                        },
+                        Isa::Portable => {
+                            reacting_row_portable(&kern, soa, i, j_start, block_end, n, base, r)
+                        }
+                    };
+                    let own = &mut row.own[i - base];
+                    own.0 += f;
+                    own.1 += tq;
+                    row.virial += w;
+                    i += 1;
+                }
+                block = block_end;
+            }
+        };
+        // Tile t has about (N − t·tile) rows of work: tasks take tiles t and
+        // T − 1 − t together, so that each has the same share.
+        self.tiles.truncate(tiles);
+        let (first, last) = self.tiles.split_at_mut(tiles.div_ceil(2));
+        let mut partners: Vec<Option<&mut TileRow>> = last.iter_mut().rev().map(Some).collect();
+        partners.resize_with(first.len(), || None);
+        first
+            .par_iter_mut()
+            .zip(partners)
+            .enumerate()
+            .for_each(|(t, (row, partner))| {
+                sweep(t, row);
+                if let Some(row) = partner {
+                    sweep(tiles - 1 - t, row);
+                }
+            });
+        let rows = &self.tiles;
+        force[..n]
+            .par_chunks_mut(tile)
+            .zip(torque[..n].par_chunks_mut(tile))
+            .enumerate()
+            .for_each(|(t, (fc, tc))| {
+                for (k, (f, tq)) in fc.iter_mut().zip(tc.iter_mut()).enumerate() {
+                    let i = t * tile + k;
+                    let (mut sf, mut st) = rows[t].own[k];
+                    for (s, row) in rows[..=t].iter().enumerate() {
+                        let (rf, rt) = row.reactions.at(i - s * tile);
+                        sf += rf;
+                        st += rt;
+                    }
+                    *f += sf;
+                    *tq += st;
+                }
+            });
+        self.tiles.iter().map(|r| r.virial).sum()
+    }
+}
