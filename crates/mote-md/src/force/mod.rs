@@ -211,15 +211,19 @@ pub trait Interaction: Send {
     }
 }
 
-/// (force, torque) buffers of the parallel blocks of a half-list pair loop.
+/// (force, torque) buffers of the parallel blocks of a half-list pair loop
+/// (j > i): the buffer of a block starting at particle s covers s..n, the
+/// only particles its pairs touch, so it holds the last n − s entries.
 pub(crate) type BlockBuffers = Vec<(Vec<DVec3>, Vec<DVec3>)>;
 
-/// Adds the blocks' buffers to `force` and `torque`, buffer after buffer in
-/// block order for every particle, so every thread count gives the same bits.
+/// Adds the blocks' buffers to `force` and `torque` (each aligned to the
+/// end), buffer after buffer in block order for every particle: the bits
+/// depend on the blocks, not on the threads that ran them.
 pub(crate) fn add_block_buffers(force: &mut [DVec3], torque: &mut [DVec3], buffers: &BlockBuffers) {
     if buffers.is_empty() {
         return;
     }
+    let n = force.len();
     force
         .par_iter_mut()
         .zip(torque.par_iter_mut())
@@ -227,8 +231,10 @@ pub(crate) fn add_block_buffers(force: &mut [DVec3], torque: &mut [DVec3], buffe
         .with_min_len(1024)
         .for_each(|(i, (f, t))| {
             for (bf, bt) in buffers {
-                *f += bf[i];
-                *t += bt[i];
+                if let Some(k) = (i + bf.len()).checked_sub(n) {
+                    *f += bf[k];
+                    *t += bt[k];
+                }
             }
         });
 }

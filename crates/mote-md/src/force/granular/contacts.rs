@@ -83,8 +83,8 @@ impl GranularContacts {
         Self::follow(&mut self.pairs, &mut self.carried_to_build, list);
         let dt = state.dt;
 
-        let blocks = rayon::current_num_threads().clamp(1, n.max(1));
-        let per_block = n.div_ceil(blocks.max(1)).max(1);
+        let blocks = Self::blocks(n);
+        let per_block = n.div_ceil(blocks).max(1);
         self.buffers
             .resize_with(blocks.saturating_sub(1), Default::default);
         let mut buffers = std::mem::take(&mut self.buffers);
@@ -108,13 +108,16 @@ impl GranularContacts {
                 taken = end;
             }
         }
+        // Block 0 adds into the output, block b > 0 into a buffer over the
+        // particles from its first one to the end (pairs have j > i).
         let mut targets: Vec<(&mut [DVec3], &mut [DVec3])> = Vec::with_capacity(blocks);
         targets.push((&mut *force, &mut *torque));
-        for (f, t) in buffers.iter_mut() {
+        for (b, (f, t)) in buffers.iter_mut().enumerate() {
+            let len = n - ((b + 1) * per_block).min(n);
             f.clear();
-            f.resize(n, DVec3::ZERO);
+            f.resize(len, DVec3::ZERO);
             t.clear();
-            t.resize(n, DVec3::ZERO);
+            t.resize(len, DVec3::ZERO);
             targets.push((f.as_mut_slice(), t.as_mut_slice()));
         }
 
@@ -126,7 +129,17 @@ impl GranularContacts {
             .map(|(b, ((f, t), (hist, touch)))| {
                 let first = (b * per_block).min(n);
                 let last = ((b + 1) * per_block).min(n);
-                this.block(state, list, omega, first..last, dt, f, t, hist, touch)
+                let base = n - f.len();
+                this.block(
+                    state,
+                    list,
+                    omega,
+                    first..last,
+                    dt,
+                    (base, f, t),
+                    hist,
+                    touch,
+                )
             })
             .collect();
 
@@ -138,8 +151,18 @@ impl GranularContacts {
         self.virial = results.iter().map(|r| r.1).sum();
     }
 
+    /// Blocks of particles of the parallel pair loop: a function of N
+    /// alone (never of the thread count), one per 4096 particles, at most
+    /// 16, so that the sums, and so the bits, are the same on any number of
+    /// threads; each block past the first costs a buffer of forces and
+    /// torques.
+    fn blocks(n: usize) -> usize {
+        (n / 4096).clamp(1, 16)
+    }
+
     /// The pairs of particles `range` (and their partners j > i), adding
-    /// forces and torques into `f`, `t`; returns (contacts, virial).
+    /// forces and torques into `out` = (base, f, t), f[k] and t[k] those of
+    /// particle base + k; returns (contacts, virial).
     #[allow(clippy::too_many_arguments)]
     fn block(
         &self,
@@ -148,11 +171,12 @@ impl GranularContacts {
         omega: &[DVec3],
         range: std::ops::Range<usize>,
         dt: f64,
-        f: &mut [DVec3],
-        t: &mut [DVec3],
+        out: (usize, &mut [DVec3], &mut [DVec3]),
         hist: &mut [History],
         touch: &mut [bool],
     ) -> (usize, f64) {
+        let (base, f, t) = out;
+        debug_assert!(base <= range.start);
         let pos = state.position;
         let vel = state.velocity;
         let mass = state.mass;
@@ -201,14 +225,14 @@ impl GranularContacts {
                     h,
                 );
                 fi += c.force;
-                f[j] -= c.force;
+                f[j - base] -= c.force;
                 ti += c.torque_i;
-                t[j] += c.torque_j;
+                t[j - base] += c.torque_j;
                 contacts += 1;
                 virial += d.dot(c.force);
             }
-            f[i] += fi;
-            t[i] += ti;
+            f[i - base] += fi;
+            t[i - base] += ti;
         }
         (contacts, virial)
     }
