@@ -4,8 +4,8 @@
 Usage: check_formats.py DIR
 
 DIR holds what crates/mote-io/tests/formats.rs writes: t.xyz (extended XYZ),
-t.dump (LAMMPS dump text), t.vtu (VTK XML) and expected.json (positions, cell
-vectors and origin of every frame). The extended XYZ is read with ASE, the dump
+t.dump (LAMMPS dump text), t.vtu (VTK XML) and expected.json (positions,
+velocities, cell vectors and origin of every frame). The extended XYZ is read with ASE, the dump
 with MDAnalysis and the VTU with meshio; positions and box must agree to 1e-6
 (relative). Exit status: 0 all agree, 1 a mismatch, 77 skipped (a package is
 missing: `pip install ase MDAnalysis meshio`).
@@ -53,8 +53,13 @@ def main():
     atoms = ase.io.read(os.path.join(d, "t.xyz"), index=":")
     check(f"ASE reads {len(want)} frames of t.xyz", len(atoms) == len(want))
     for k, (a, w) in enumerate(zip(atoms, want)):
-        check(f"ASE frame {k} positions", close(flat(a.get_positions()), flat(w["positions"])))
+        # A periodic cell is written from the origin (ASE has no cell origin):
+        # ASE's positions are mote's minus the box's lower corner.
+        shifted = [[p[i] - w["origin"][i] for i in range(3)] for p in w["positions"]]
+        check(f"ASE frame {k} positions (shifted to the cell)", close(flat(a.get_positions()), flat(shifted)))
         check(f"ASE frame {k} cell", close(flat(a.get_cell()[:]), flat(w["cell"])))
+        check(f"ASE frame {k} velocities (momenta / masses)", close(flat(a.get_velocities()), flat(w["velocities"])))
+        check(f"ASE frame {k} symbols {a.get_chemical_symbols()}", a.get_chemical_symbols() == ["Fe", "O"])
 
     # LAMMPS dump with MDAnalysis: positions and box lengths (orthogonal box).
     u = MDAnalysis.Universe(os.path.join(d, "t.dump"), format="LAMMPSDUMP")

@@ -594,5 +594,7 @@ pub fn frame<const D: usize>(sys: &System<D>) -> mote_io::xyz::Frame {
         positions: sys.positions().iter().map(to3).collect(),
         velocities: sys.velocities().iter().map(to3).collect(),
         radii: sys.radii().to_vec(),
+        masses: sys.masses(),
+        ..mote_io::xyz::Frame::default()
     }
 }

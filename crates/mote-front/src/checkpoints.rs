@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use mote_io::checkpoint::Checkpoint;
-use mote_io::{IoError, Provenance};
+use mote_io::IoError;
 
 use crate::error::FrontError;
 use crate::{Input, RunOptions};
@@ -26,12 +26,7 @@ fn number<T: std::str::FromStr>(key: &str, v: String) -> Result<T, FrontError> {
 /// Drops what an interrupted run wrote after its last checkpoint (rows past
 /// `step`, or past `time` in tables without a step column, and frames past
 /// `time`), so the resumed run continues the files.
-pub(crate) fn trim_outputs(
-    dir: &Path,
-    step: u64,
-    time: f64,
-    provenance: &Provenance,
-) -> Result<(), FrontError> {
+pub(crate) fn trim_outputs(dir: &Path, step: u64, time: f64) -> Result<(), FrontError> {
     let csv = dir.join("observables.csv");
     if let Ok(text) = std::fs::read_to_string(&csv) {
         let mut column = None;
@@ -64,11 +59,15 @@ pub(crate) fn trim_outputs(
     }
     let xyz = dir.join("trajectory.xyz");
     if xyz.exists() {
-        let frames = mote_io::xyz::read_frames(&xyz)?;
-        let mut w = mote_io::xyz::XyzWriter::create(&xyz, provenance.clone())?;
-        for f in frames.iter().filter(|f| f.time <= time) {
-            w.write(f)?;
+        // Frames up to the checkpoint are kept verbatim (byte for byte).
+        let text = std::fs::read_to_string(&xyz).map_err(|e| IoError::os(&xyz, e))?;
+        let mut kept = String::new();
+        for (t, span) in mote_io::xyz::frame_spans(&text) {
+            if t <= time {
+                kept.push_str(&text[span]);
+            }
         }
+        std::fs::write(&xyz, kept).map_err(|e| IoError::os(&xyz, e))?;
     }
     Ok(())
 }

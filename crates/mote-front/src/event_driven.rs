@@ -128,7 +128,7 @@ fn run_events(
     ));
     let provenance = crate::provenance(&input.label, seed);
     if let Some(cp) = resumed {
-        trim_outputs(&dir, cp.step, cp.time, &provenance)?;
+        trim_outputs(&dir, cp.step, cp.time)?;
     }
     // Checkpoints every N output intervals; the measured time is recorded
     // so a resumed run ends where this one would have.

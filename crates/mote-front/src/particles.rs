@@ -136,7 +136,7 @@ pub(crate) fn run(
         RunLength::Steps(total_steps - resumed.as_ref().map_or(0, |cp| cp.step.min(total_steps)));
     let provenance = crate::provenance(&input.label, seed);
     if let Some(cp) = &resumed {
-        trim_outputs(&dir, cp.step, cp.time, &provenance)?;
+        trim_outputs(&dir, cp.step, cp.time)?;
     }
     let out = &scene.output;
     let sim = &mut built.simulation;

@@ -72,7 +72,7 @@ fn run_with(
         },
     });
     if let Some(cp) = resumed {
-        trim_outputs(&dir, cp.step, cp.time, &provenance)?;
+        trim_outputs(&dir, cp.step, cp.time)?;
     }
     let run = RigidRun {
         seed: Some(seed),

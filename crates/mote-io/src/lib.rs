@@ -6,6 +6,7 @@
 
 pub mod checkpoint;
 pub mod csv;
+pub mod elements;
 pub mod error;
 pub mod header;
 pub mod lammps_data;

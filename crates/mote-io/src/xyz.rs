@@ -1,9 +1,25 @@
-//! Extended XYZ trajectories, as read by ASE and OVITO.
+//! Extended XYZ trajectories, as read and written by ASE and OVITO.
 //!
 //! Each frame is a count line, a comment line of `key=value` pairs
-//! (`Lattice="ax ay az bx by bz cx cy cz"`, `Origin="x y z"`,
-//! `Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1`, `Time=`, `pbc=`,
-//! and the provenance), then one line per particle.
+//! (`Lattice="ax ay az bx by bz cx cy cz"`, `Properties=name:type:count:…`,
+//! `Time=`, `pbc=`, the provenance), then one line per particle whose
+//! columns the `Properties` key names.
+//!
+//! mote writes `species:S:1:pos:R:3:velo:R:3:radius:R:1:id:I:1`, then
+//! `masses:R:1:momenta:R:3` where masses are known (ASE takes velocities
+//! from momenta and masses, not from `velo`, which OVITO reads), then
+//! `omega`, `dipole` and `body` where present. A periodic box whose lower
+//! corner is not the origin is written shifted to it (ASE ignores
+//! `Origin=`), with the shift in `Shift="x y z"`; mote adds it back on
+//! reading. Open boxes, and exact files (whose numbers must read back bit
+//! for bit, which a shift would spoil), keep their positions and declare
+//! the corner in `Origin=` (OVITO's key).
+//!
+//! The reader takes what others write: any `Properties` in any order
+//! (unknown columns skipped), plain XYZ (symbol x y z) when there is none,
+//! and momenta converted to velocities with the masses column or, failing
+//! that, the standard atomic weights of the species ([`crate::elements`])
+//! — never taken as velocities.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -11,7 +27,8 @@ use std::path::{Path, PathBuf};
 
 use crate::{IoError, ParseError, Provenance};
 
-/// One frame of particles as plain data.
+/// One frame of particles as plain data. Per-particle vectors other than
+/// `positions` may be empty (not known).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Frame {
     /// Simulated time of the frame.
@@ -26,6 +43,13 @@ pub struct Frame {
     pub positions: Vec<[f64; 3]>,
     pub velocities: Vec<[f64; 3]>,
     pub radii: Vec<f64>,
+    pub masses: Vec<f64>,
+    /// Identifiers (empty: 1, 2, … in order).
+    pub ids: Vec<u64>,
+    pub angular_velocities: Vec<[f64; 3]>,
+    pub dipoles: Vec<[f64; 3]>,
+    /// The rigid body each sphere belongs to.
+    pub bodies: Vec<u64>,
 }
 
 impl Frame {
@@ -131,6 +155,17 @@ pub fn write_frame(
     write_frame_as(out, frame, provenance, false)
 }
 
+/// One number: shortest round-trip form when `exact`, else `digits`
+/// significant digits in scientific notation.
+fn number(out: &mut String, x: f64, exact: bool, digits: usize) {
+    use std::fmt::Write as _;
+    let _ = if exact {
+        write!(out, " {x:e}")
+    } else {
+        write!(out, " {x:.digits$e}", digits = digits - 1)
+    };
+}
+
 /// Writes one frame in extended XYZ; `exact`: numbers that read back bit
 /// for bit (see [`XyzWriter::exact`]).
 pub fn write_frame_as(
@@ -141,11 +176,49 @@ pub fn write_frame_as(
 ) -> std::io::Result<()> {
     let n = frame.positions.len();
     let c = &frame.cell;
+    let has = |len: usize| len == n && n > 0;
+    let (velocities, masses) = (has(frame.velocities.len()), has(frame.masses.len()));
+    let mut properties = String::from("species:S:1:pos:R:3");
+    if velocities {
+        properties += ":velo:R:3";
+    }
+    if has(frame.radii.len()) {
+        properties += ":radius:R:1";
+    }
+    properties += ":id:I:1";
+    if masses {
+        properties += ":masses:R:1";
+        if velocities {
+            properties += ":momenta:R:3";
+        }
+    }
+    for (len, name) in [
+        (frame.angular_velocities.len(), ":omega:R:3"),
+        (frame.dipoles.len(), ":dipole:R:3"),
+        (frame.bodies.len(), ":body:I:1"),
+    ] {
+        if has(len) {
+            properties += name;
+        }
+    }
+    // A periodic cell is written from the origin (ASE ignores `Origin=`),
+    // unless every number must read back bit for bit.
+    let shift = if !exact && frame.pbc.iter().any(|&p| p) && frame.origin != [0.0; 3] {
+        Some(frame.origin)
+    } else {
+        None
+    };
+    let corner = match shift {
+        Some(o) => format!("Shift=\"{} {} {}\"", o[0], o[1], o[2]),
+        None => format!(
+            "Origin=\"{} {} {}\"",
+            frame.origin[0], frame.origin[1], frame.origin[2]
+        ),
+    };
     writeln!(out, "{n}")?;
     writeln!(
         out,
-        "Lattice=\"{} {} {} {} {} {} {} {} {}\" Origin=\"{} {} {}\" \
-         Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1 Time={} pbc=\"{} {} {}\" {}",
+        "Lattice=\"{} {} {} {} {} {} {} {} {}\" {corner} Properties={properties} Time={} pbc=\"{} {} {}\" {}",
         c[0][0],
         c[0][1],
         c[0][2],
@@ -155,41 +228,163 @@ pub fn write_frame_as(
         c[2][0],
         c[2][1],
         c[2][2],
-        frame.origin[0],
-        frame.origin[1],
-        frame.origin[2],
         frame.time,
         flag(frame.pbc[0]),
         flag(frame.pbc[1]),
         flag(frame.pbc[2]),
         provenance.line()
     )?;
+    let mut line = String::new();
     for i in 0..n {
-        let p = frame.positions[i];
-        let v = frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
-        let r = frame.radii.get(i).copied().unwrap_or(0.0);
-        let s = frame.species.get(i).map(String::as_str).unwrap_or("X");
-        if exact {
-            writeln!(
-                out,
-                "{s} {:e} {:e} {:e} {:e} {:e} {:e} {:e}",
-                p[0], p[1], p[2], v[0], v[1], v[2], r
-            )?;
-        } else {
-            writeln!(
-                out,
-                "{s} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.6e}",
-                p[0], p[1], p[2], v[0], v[1], v[2], r
-            )?;
+        line.clear();
+        line += frame.species.get(i).map(String::as_str).unwrap_or("X");
+        let mut p = frame.positions[i];
+        if let Some(o) = shift {
+            for d in 0..3 {
+                p[d] -= o[d];
+            }
         }
+        for x in p {
+            number(&mut line, x, exact, 11);
+        }
+        if velocities {
+            for x in frame.velocities[i] {
+                number(&mut line, x, exact, 11);
+            }
+        }
+        if has(frame.radii.len()) {
+            number(&mut line, frame.radii[i], exact, 7);
+        }
+        let id = frame.ids.get(i).copied().unwrap_or(i as u64 + 1);
+        line += &format!(" {id}");
+        if masses {
+            let m = frame.masses[i];
+            number(&mut line, m, exact, 11);
+            if velocities {
+                for x in frame.velocities[i] {
+                    number(&mut line, m * x, exact, 11);
+                }
+            }
+        }
+        for (v, present) in [
+            (
+                &frame.angular_velocities,
+                has(frame.angular_velocities.len()),
+            ),
+            (&frame.dipoles, has(frame.dipoles.len())),
+        ] {
+            if present {
+                for x in v[i] {
+                    number(&mut line, x, exact, 11);
+                }
+            }
+        }
+        if has(frame.bodies.len()) {
+            line += &format!(" {}", frame.bodies[i]);
+        }
+        writeln!(out, "{line}")?;
     }
     Ok(())
 }
 
-/// Reads all frames written by [`XyzWriter`] (the columns species, pos, velo, radius).
+/// A column group of `Properties=`: its name, type letter and width.
+#[derive(Debug, Clone, PartialEq)]
+struct Column {
+    name: String,
+    kind: char,
+    count: usize,
+}
+
+/// What mote does with a column, by its (case-insensitive) name.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Role {
+    Species,
+    AtomicNumber,
+    Position,
+    Velocity,
+    Momentum,
+    Radius,
+    Mass,
+    Id,
+    Omega,
+    Dipole,
+    Body,
+    Skip,
+}
+
+impl Column {
+    fn role(&self) -> Role {
+        let name = self.name.to_ascii_lowercase();
+        let (s, r, i) = (self.kind == 'S', self.kind == 'R', self.kind == 'I');
+        let three = self.count == 3;
+        match name.as_str() {
+            "species" | "element" | "symbol" | "symbols" | "type" | "particle type"
+                if self.count == 1 && (s || i) =>
+            {
+                Role::Species
+            }
+            "z" | "numbers" if i && self.count == 1 => Role::AtomicNumber,
+            "pos" | "position" | "positions" if r && three => Role::Position,
+            "velo" | "vel" | "velocity" | "velocities" if r && three => Role::Velocity,
+            "momenta" | "momentum" if r && three => Role::Momentum,
+            "radius" | "radii" if r && self.count == 1 => Role::Radius,
+            "mass" | "masses" if r && self.count == 1 => Role::Mass,
+            "id" | "ids" | "identifier" | "particle identifier" if i && self.count == 1 => Role::Id,
+            "omega" | "angular_velocity" | "angular_velocities" | "angular velocity"
+                if r && three =>
+            {
+                Role::Omega
+            }
+            "dipole" | "dipoles" | "dipole orientation" | "mu" if r && three => Role::Dipole,
+            "body" | "body_id" | "molecule" | "molecule identifier" if i && self.count == 1 => {
+                Role::Body
+            }
+            _ => Role::Skip,
+        }
+    }
+}
+
+/// The columns of a `Properties=` value (`name:type:count:…`).
+fn columns(spec: &str) -> Result<Vec<Column>, String> {
+    let parts: Vec<&str> = spec.split(':').collect();
+    if !parts.len().is_multiple_of(3) || parts.is_empty() {
+        return Err(format!(
+            "Properties=\"{spec}\" is not a list of name:type:count triples"
+        ));
+    }
+    parts
+        .chunks(3)
+        .map(|t| {
+            let kind = match t[1] {
+                "S" | "R" | "I" | "L" => t[1].chars().next().unwrap_or('S'),
+                k => {
+                    return Err(format!(
+                        "column '{}' has unknown type '{k}' (S, R, I or L)",
+                        t[0]
+                    ))
+                }
+            };
+            let count: usize =
+                t[2].parse().ok().filter(|&c| c > 0).ok_or_else(|| {
+                    format!("column '{}' has width '{}', not a count", t[0], t[2])
+                })?;
+            Ok(Column {
+                name: t[0].to_string(),
+                kind,
+                count,
+            })
+        })
+        .collect()
+}
+
+/// Reads all frames of an extended or plain XYZ file.
 pub fn read_frames(path: &Path) -> Result<Vec<Frame>, IoError> {
     let text = std::fs::read_to_string(path).map_err(|e| IoError::os(path, e))?;
-    let name = path.display().to_string();
+    Ok(parse_frames(&text, &path.display().to_string())?)
+}
+
+/// Parses the frames of XYZ text from the file called `name`.
+pub fn parse_frames(text: &str, name: &str) -> Result<Vec<Frame>, ParseError> {
     let lines: Vec<&str> = text.lines().collect();
     let mut frames = Vec::new();
     let mut k = 0;
@@ -201,74 +396,226 @@ pub fn read_frames(path: &Path) -> Result<Vec<Frame>, IoError> {
         let n: usize = lines[k]
             .trim()
             .parse()
-            .map_err(|_| ParseError::new(&name, k + 1, "expected the particle count of a frame"))?;
+            .map_err(|_| ParseError::new(name, k + 1, "expected the particle count of a frame"))?;
         let comment = lines
             .get(k + 1)
-            .ok_or_else(|| ParseError::new(&name, k + 2, "frame ends before its comment line"))?;
-        let mut frame = Frame {
-            time: key_value(comment, "Time")
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(0.0),
-            ..Frame::default()
-        };
-        if let Some(l) = key_value(comment, "Lattice") {
-            let v: Vec<f64> = l
-                .split_whitespace()
-                .filter_map(|s| s.parse().ok())
-                .collect();
-            if v.len() == 9 {
-                frame.cell = [[v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]];
-            }
-        }
-        if let Some(flags) = key_value(comment, "pbc") {
-            let v: Vec<bool> = flags
-                .split_whitespace()
-                .map(|s| matches!(s, "T" | "t" | "True" | "true" | "1"))
-                .collect();
-            if v.len() == 3 {
-                frame.pbc = [v[0], v[1], v[2]];
-            }
-        }
-        if let Some(o) = key_value(comment, "Origin") {
-            let v: Vec<f64> = o
-                .split_whitespace()
-                .filter_map(|s| s.parse().ok())
-                .collect();
-            if v.len() == 3 {
-                frame.origin = [v[0], v[1], v[2]];
-            }
-        }
-        for j in 0..n {
-            let ln = k + 2 + j;
-            let line = lines.get(ln).ok_or_else(|| {
-                ParseError::new(
-                    &name,
-                    ln + 1,
-                    format!("frame announces {n} particles but the file ends"),
-                )
-            })?;
-            let f: Vec<&str> = line.split_whitespace().collect();
-            if f.len() < 8 {
-                return Err(ParseError::new(
-                    &name,
-                    ln + 1,
-                    "expected: species x y z vx vy vz radius",
-                )
-                .into());
-            }
-            let num = |s: &str| {
-                s.parse::<f64>()
-                    .map_err(|_| ParseError::new(&name, ln + 1, format!("'{s}' is not a number")))
-            };
-            frame.species.push(f[0].to_string());
-            frame.positions.push([num(f[1])?, num(f[2])?, num(f[3])?]);
-            frame.velocities.push([num(f[4])?, num(f[5])?, num(f[6])?]);
-            frame.radii.push(num(f[7])?);
-        }
-        frames.push(frame);
+            .ok_or_else(|| ParseError::new(name, k + 2, "frame ends before its comment line"))?;
+        frames.push(parse_frame(&lines, k, n, comment, name)?);
         k += 2 + n;
     }
     Ok(frames)
+}
+
+/// Three numbers of a quoted key (`Origin="x y z"`).
+fn triple(comment: &str, key: &str) -> Option<[f64; 3]> {
+    let v: Vec<f64> = key_value(comment, key)?
+        .split_whitespace()
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    (v.len() == 3).then(|| [v[0], v[1], v[2]])
+}
+
+/// The frame whose count line is line k (0-based) of `lines`.
+fn parse_frame(
+    lines: &[&str],
+    k: usize,
+    n: usize,
+    comment: &str,
+    name: &str,
+) -> Result<Frame, ParseError> {
+    let mut frame = Frame {
+        time: key_value(comment, "Time")
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(0.0),
+        ..Frame::default()
+    };
+    if let Some(l) = key_value(comment, "Lattice") {
+        let v: Vec<f64> = l
+            .split_whitespace()
+            .filter_map(|s| s.parse().ok())
+            .collect();
+        if v.len() != 9 {
+            return Err(ParseError::new(
+                name,
+                k + 2,
+                format!("Lattice=\"{l}\" needs nine numbers (three cell vectors)"),
+            ));
+        }
+        frame.cell = [[v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]];
+        // ASE's convention: a lattice without pbc is periodic.
+        frame.pbc = [true; 3];
+    }
+    if let Some(flags) = key_value(comment, "pbc") {
+        let v: Vec<bool> = flags
+            .split_whitespace()
+            .map(|s| matches!(s, "T" | "t" | "True" | "true" | "1"))
+            .collect();
+        if v.len() == 3 {
+            frame.pbc = [v[0], v[1], v[2]];
+        }
+    }
+    let shift = triple(comment, "Shift");
+    if let Some(o) = shift.or_else(|| triple(comment, "Origin")) {
+        frame.origin = o;
+    }
+    let cols = match key_value(comment, "Properties") {
+        Some(spec) => columns(spec).map_err(|m| ParseError::new(name, k + 2, m))?,
+        // Plain XYZ: a symbol and three coordinates (further columns ignored).
+        None => columns("species:S:1:pos:R:3").unwrap_or_default(),
+    };
+    let plain = key_value(comment, "Properties").is_none();
+    let roles: Vec<Role> = cols.iter().map(Column::role).collect();
+    if !roles.contains(&Role::Position) {
+        return Err(ParseError::new(
+            name,
+            k + 2,
+            "Properties has no position column (pos:R:3)",
+        ));
+    }
+    let width: usize = cols.iter().map(|c| c.count).sum();
+    let mut momenta: Vec<[f64; 3]> = Vec::new();
+    for j in 0..n {
+        let ln = k + 2 + j;
+        let line = lines.get(ln).ok_or_else(|| {
+            ParseError::new(
+                name,
+                ln + 1,
+                format!("frame announces {n} particles but the file ends"),
+            )
+        })?;
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if f.len() < width || (!plain && f.len() > width) {
+            let expected: Vec<String> = cols
+                .iter()
+                .map(|c| format!("{}×{}", c.name, c.count))
+                .collect();
+            return Err(ParseError::new(
+                name,
+                ln + 1,
+                format!(
+                    "{} columns where Properties names {width}: {}",
+                    f.len(),
+                    expected.join(" ")
+                ),
+            ));
+        }
+        let num = |s: &str| {
+            s.parse::<f64>()
+                .map_err(|_| ParseError::new(name, ln + 1, format!("'{s}' is not a number")))
+        };
+        let int = |s: &str| {
+            s.parse::<i64>()
+                .map_err(|_| ParseError::new(name, ln + 1, format!("'{s}' is not an integer")))
+        };
+        let mut at = 0;
+        for (c, role) in cols.iter().zip(&roles) {
+            let v = &f[at..at + c.count];
+            at += c.count;
+            let vec3 = |v: &[&str]| -> Result<[f64; 3], ParseError> {
+                Ok([num(v[0])?, num(v[1])?, num(v[2])?])
+            };
+            match role {
+                Role::Species => frame.species.push(v[0].to_string()),
+                Role::AtomicNumber => {
+                    let z = int(v[0])?;
+                    let symbol = usize::try_from(z)
+                        .ok()
+                        .and_then(|z| crate::elements::ELEMENTS.get(z))
+                        .ok_or_else(|| {
+                            ParseError::new(name, ln + 1, format!("atomic number {z} is not 0…118"))
+                        })?
+                        .0;
+                    frame.species.push(symbol.to_string());
+                }
+                Role::Position => frame.positions.push(vec3(v)?),
+                Role::Velocity => frame.velocities.push(vec3(v)?),
+                Role::Momentum => momenta.push(vec3(v)?),
+                Role::Radius => frame.radii.push(num(v[0])?),
+                Role::Mass => frame.masses.push(num(v[0])?),
+                Role::Id => {
+                    let id = int(v[0])?;
+                    frame.ids.push(u64::try_from(id).map_err(|_| {
+                        ParseError::new(name, ln + 1, format!("id {id} is negative"))
+                    })?);
+                }
+                Role::Omega => frame.angular_velocities.push(vec3(v)?),
+                Role::Dipole => frame.dipoles.push(vec3(v)?),
+                Role::Body => {
+                    let b = int(v[0])?;
+                    frame.bodies.push(u64::try_from(b).map_err(|_| {
+                        ParseError::new(name, ln + 1, format!("body {b} is negative"))
+                    })?);
+                }
+                Role::Skip => {}
+            }
+        }
+    }
+    if let Some(o) = shift {
+        for p in &mut frame.positions {
+            for d in 0..3 {
+                p[d] += o[d];
+            }
+        }
+    }
+    // Momenta give velocities only where the file has none, divided by
+    // the masses column or the species' standard atomic weights.
+    if frame.velocities.is_empty() && !momenta.is_empty() {
+        for (i, p) in momenta.iter().enumerate() {
+            let m = match frame.masses.get(i) {
+                Some(&m) => m,
+                None => {
+                    let s = frame.species.get(i).map(String::as_str).unwrap_or("");
+                    crate::elements::standard_mass(s).ok_or_else(|| {
+                        ParseError::new(
+                            name,
+                            k + 3 + i,
+                            format!(
+                                "momenta need masses: '{s}' is not a chemical symbol and the file has no masses column"
+                            ),
+                        )
+                    })?
+                }
+            };
+            if m.is_nan() || m <= 0.0 {
+                return Err(ParseError::new(
+                    name,
+                    k + 3 + i,
+                    format!("mass {m} cannot turn momenta into velocities"),
+                ));
+            }
+            frame.velocities.push([p[0] / m, p[1] / m, p[2] / m]);
+        }
+    }
+    Ok(frame)
+}
+
+/// The byte range of every frame of XYZ text, with its `Time=` (0 where
+/// absent): for keeping frames verbatim.
+pub fn frame_spans(text: &str) -> Vec<(f64, std::ops::Range<usize>)> {
+    let mut spans = Vec::new();
+    let mut offsets = Vec::new();
+    let mut at = 0;
+    for line in text.split_inclusive('\n') {
+        offsets.push((at, line));
+        at += line.len();
+    }
+    let mut k = 0;
+    while k < offsets.len() {
+        let (start, line) = offsets[k];
+        let Ok(n) = line.trim().parse::<usize>() else {
+            k += 1;
+            continue;
+        };
+        let time = offsets
+            .get(k + 1)
+            .and_then(|(_, c)| key_value(c.trim_end(), "Time"))
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(0.0);
+        let end = offsets.get(k + 2 + n).map_or(text.len(), |(e, _)| *e);
+        spans.push((time, start..end));
+        k += 2 + n;
+    }
+    spans
 }
 
 /// The value of `key=value` or `key="quoted value"` in a comment line.
@@ -314,6 +661,7 @@ mod tests {
             positions: vec![[0.1, 0.2, 0.3], [-1.25, 2.5, 1e-7]],
             velocities: vec![[1.0, 0.0, 0.0], [0.0, -2.0, 3.0]],
             radii: vec![0.5, 0.25],
+            ..Default::default()
         };
         w.write(&frame).unwrap();
         w.write(&Frame {

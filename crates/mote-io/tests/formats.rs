@@ -18,6 +18,8 @@ fn frame() -> Frame {
         positions: vec![[1.0, 2.0, 3.0], [4.5, 4.0, 7.5]],
         velocities: vec![[0.1, 0.2, 0.3], [-1.0, 0.0, 1.0]],
         radii: vec![0.5, 0.75],
+        masses: vec![55.845, 15.999],
+        ..Default::default()
     }
 }
 
@@ -80,8 +82,9 @@ fn other_programs_read_the_same_positions_and_box() {
             json.push(',');
         }
         json.push_str(&format!(
-            "{{\"positions\":{},\"cell\":{},\"origin\":[{:e},{:e},{:e}]}}",
+            "{{\"positions\":{},\"velocities\":{},\"cell\":{},\"origin\":[{:e},{:e},{:e}]}}",
             rows(&f.positions),
+            rows(&f.velocities),
             rows(&f.cell),
             f.origin[0],
             f.origin[1],

@@ -180,6 +180,19 @@ pub fn frame_of(sys: &System) -> Frame {
         positions,
         velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
         radii: p.radius.clone(),
+        masses: p.mass.clone(),
+        angular_velocities: nonzero(&p.angular_velocity),
+        dipoles: nonzero(&p.dipole),
+        ..Frame::default()
+    }
+}
+
+/// The vectors as arrays, or none if all are zero (a column not worth writing).
+fn nonzero(v: &[DVec3]) -> Vec<[f64; 3]> {
+    if v.iter().any(|x| *x != DVec3::ZERO) {
+        v.iter().map(|x| x.to_array()).collect()
+    } else {
+        Vec::new()
     }
 }
 

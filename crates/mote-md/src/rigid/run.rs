@@ -268,6 +268,22 @@ impl Observer<RigidDynamics> for SphereTrajectory {
 
 /// The spheres of every body as an extended-XYZ frame: world positions,
 /// velocities v + ω × (c − x), radii; species `B<kind>`.
+/// Each sphere's share of its body's mass, in proportion to its volume
+/// (so a body's spheres add up to its mass; overlaps are shared).
+fn sphere_masses(b: &RigidBodies, world: &super::interaction::WorldFrame) -> Vec<f64> {
+    let cube = |r: f64| r * r * r;
+    world
+        .sphere_body
+        .iter()
+        .zip(&world.sphere_radius)
+        .map(|(&k, &r)| {
+            let t = &b.templates[b.kind[k as usize] as usize];
+            let total: f64 = t.radii.iter().map(|&s| cube(s)).sum();
+            t.props.mass * cube(r) / total
+        })
+        .collect()
+}
+
 pub fn sphere_frame(b: &RigidBodies) -> Frame {
     let mut world = super::interaction::WorldFrame::default();
     world.update(b);
@@ -287,14 +303,14 @@ pub fn sphere_frame(b: &RigidBodies) -> Frame {
         cell,
         origin,
         pbc: [false; 3],
-        species: world
-            .sphere_body
-            .iter()
-            .map(|k| format!("B{}", b.kind[*k as usize]))
-            .collect(),
+        // "X" is ASE's dummy element; the body column says which clump.
+        species: vec!["X".to_string(); positions.len()],
+        masses: sphere_masses(b, &world),
+        bodies: world.sphere_body.iter().map(|&k| u64::from(k)).collect(),
         positions,
         velocities,
         radii: world.sphere_radius.clone(),
+        ..Frame::default()
     }
 }
 
