@@ -23,7 +23,14 @@
 //! simulation boxes"). Species names become type numbers 1, 2, ... in order of
 //! first appearance; the reader gives the type numbers back as species names.
 //! The writer omits `ITEM: TIME` (MDAnalysis does not expect it); the reader
-//! accepts it and fills [`Frame::time`].
+//! accepts it and fills [`Frame::time`]. It also reads the general
+//! triclinic box `ITEM: BOX BOUNDS abc origin` (LAMMPS since 2023, OVITO):
+//! one line per cell vector with the origin's component as a fourth number.
+//!
+//! Columns written: `id type x y z`, then `vx vy vz`, `radius`, `mass`,
+//! `omegax omegay omegaz`, `mux muy muz` and `mol` (rigid body) where the
+//! frame has them; numbers with 11 significant digits, or in exact mode
+//! ([`DumpWriter::exact`]) the shortest form that reads back bit for bit.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -44,6 +51,7 @@ pub struct DumpWriter {
     path: PathBuf,
     out: BufWriter<File>,
     types: Vec<String>,
+    exact: bool,
 }
 
 impl DumpWriter {
@@ -53,7 +61,15 @@ impl DumpWriter {
             path: path.to_path_buf(),
             out: BufWriter::new(file),
             types: Vec::new(),
+            exact: false,
         })
+    }
+
+    /// Writes every number so that it reads back bit for bit (for packings,
+    /// whose contacts are gaps of 10⁻¹⁰ and less).
+    pub fn exact(mut self) -> Self {
+        self.exact = true;
+        self
     }
 
     /// Appends one frame at LAMMPS time step `timestep`.
@@ -69,7 +85,7 @@ impl DumpWriter {
                 }
             })
             .collect();
-        write_frame(&mut self.out, timestep, frame, &types)
+        write_frame_as(&mut self.out, timestep, frame, &types, self.exact)
             .and_then(|_| self.out.flush())
             .map_err(|e| match e.kind() {
                 std::io::ErrorKind::InvalidInput => IoError::Parse(ParseError::new(
@@ -105,6 +121,17 @@ pub fn write_frame(
     timestep: u64,
     frame: &Frame,
     types: &[usize],
+) -> std::io::Result<()> {
+    write_frame_as(out, timestep, frame, types, false)
+}
+
+/// [`write_frame`], with numbers that read back bit for bit if `exact`.
+pub fn write_frame_as(
+    out: &mut impl Write,
+    timestep: u64,
+    frame: &Frame,
+    types: &[usize],
+    exact: bool,
 ) -> std::io::Result<()> {
     let n = frame.positions.len();
     let c = &frame.cell;
@@ -144,24 +171,71 @@ pub fn write_frame(
         writeln!(out, "{ylo_b:e} {yhi_b:e} {xz:e}")?;
         writeln!(out, "{:e} {:e} {yz:e}", o[2], o[2] + lz)?;
     }
-    writeln!(out, "ITEM: ATOMS id type x y z vx vy vz radius")?;
+    let has = |len: usize| len == n && n > 0;
+    let vec3s: [(&[[f64; 3]], &str); 3] = [
+        (&frame.velocities, "vx vy vz"),
+        (&frame.angular_velocities, "omegax omegay omegaz"),
+        (&frame.dipoles, "mux muy muz"),
+    ];
+    let mut header = String::from("ITEM: ATOMS id type x y z");
+    for (v, names) in &vec3s[..1] {
+        if has(v.len()) {
+            header = header + " " + names;
+        }
+    }
+    for (len, name) in [(frame.radii.len(), "radius"), (frame.masses.len(), "mass")] {
+        if has(len) {
+            header = header + " " + name;
+        }
+    }
+    for (v, names) in &vec3s[1..] {
+        if has(v.len()) {
+            header = header + " " + names;
+        }
+    }
+    if has(frame.bodies.len()) {
+        header += " mol";
+    }
+    writeln!(out, "{header}")?;
+    let mut line = String::new();
+    let num = |line: &mut String, x: f64| {
+        use std::fmt::Write as _;
+        let _ = if exact {
+            write!(line, " {x:e}")
+        } else {
+            write!(line, " {x:.10e}")
+        };
+    };
     for i in 0..n {
-        let p = frame.positions[i];
-        let v = frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
-        let r = frame.radii.get(i).copied().unwrap_or(0.0);
+        line.clear();
+        let id = frame.ids.get(i).copied().unwrap_or(i as u64 + 1);
         let t = types.get(i).copied().unwrap_or(1);
-        writeln!(
-            out,
-            "{} {t} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.10e} {:.6e}",
-            i + 1,
-            p[0],
-            p[1],
-            p[2],
-            v[0],
-            v[1],
-            v[2],
-            r
-        )?;
+        line += &format!("{id} {t}");
+        for x in frame.positions[i] {
+            num(&mut line, x);
+        }
+        if has(frame.velocities.len()) {
+            for x in frame.velocities[i] {
+                num(&mut line, x);
+            }
+        }
+        for v in [&frame.radii, &frame.masses] {
+            if has(v.len()) {
+                num(&mut line, v[i]);
+            }
+        }
+        for (v, _) in &vec3s[1..] {
+            if has(v.len()) {
+                for x in v[i] {
+                    num(&mut line, x);
+                }
+            }
+        }
+        if has(frame.bodies.len()) {
+            // LAMMPS molecule ids start at 1; 0 means "none".
+            line += &format!(" {}", frame.bodies[i] + 1);
+        }
+        writeln!(out, "{line}")?;
     }
     Ok(())
 }
@@ -232,6 +306,35 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
             ));
         };
         let words: Vec<&str> = rest.split_whitespace().collect();
+        if words.len() >= 2 && words[..2] == ["abc", "origin"] {
+            // General triclinic: "ax ay az ox" / "bx by bz oy" / "cx cy cz oz".
+            let mut pbc = [true; 3];
+            for (d, f) in words[2..].iter().take(3).enumerate() {
+                pbc[d] = *f == "pp";
+            }
+            let mut cell = [[0.0f64; 3]; 3];
+            let mut origin = [0.0f64; 3];
+            for d in 0..3 {
+                let (at, l) = next(&mut k, "a cell vector and origin component")?;
+                let v: Result<Vec<f64>, _> = l.split_whitespace().map(str::parse).collect();
+                match v {
+                    Ok(v) if v.len() == 4 => {
+                        cell[d] = [v[0], v[1], v[2]];
+                        origin[d] = v[3];
+                    }
+                    _ => {
+                        return Err(err(
+                            at,
+                            "expected four numbers: a cell vector and a component of the origin"
+                                .into(),
+                        ))
+                    }
+                }
+            }
+            let frame = atoms(&mut k, &next, &err, n, cell, origin, pbc, time, timestep)?;
+            frames.push(DumpFrame { timestep, frame });
+            continue;
+        }
         let triclinic = words.len() >= 3 && words[..3] == ["xy", "xz", "yz"];
         let flags = if triclinic { &words[3..] } else { &words[..] };
         let mut pbc = [true; 3];
@@ -271,92 +374,146 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
             [xz, yz, zhi - zlo],
         ];
         let origin = [xlo, ylo, zlo];
-        let (at, l) = next(&mut k, "ITEM: ATOMS")?;
-        let Some(cols) = l.strip_prefix("ITEM: ATOMS") else {
-            return Err(err(at, format!("expected 'ITEM: ATOMS ...', found '{l}'")));
-        };
-        let cols: Vec<&str> = cols.split_whitespace().collect();
-        let col = |c: &str| cols.iter().position(|x| *x == c);
-        let (pos, scaled) = if let (Some(x), Some(y), Some(z)) = (col("x"), col("y"), col("z")) {
-            ([x, y, z], false)
-        } else if let (Some(x), Some(y), Some(z)) = (col("xu"), col("yu"), col("zu")) {
-            ([x, y, z], false)
-        } else if let (Some(x), Some(y), Some(z)) = (col("xs"), col("ys"), col("zs")) {
-            ([x, y, z], true)
-        } else {
-            return Err(err(
-                at,
-                "no position columns (x y z, xu yu zu or xs ys zs)".into(),
-            ));
-        };
-        let vel = match (col("vx"), col("vy"), col("vz")) {
-            (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-            _ => None,
-        };
-        let (id_col, type_col, rad_col) = (col("id"), col("type"), col("radius"));
-        let mut rows: Vec<(u64, Frame1)> = Vec::with_capacity(n);
-        for j in 0..n {
-            let (at, l) = next(&mut k, &format!("atom {} of {n}", j + 1))?;
-            let f: Vec<&str> = l.split_whitespace().collect();
-            if f.len() < cols.len() {
-                return Err(err(
-                    at,
-                    format!(
-                        "{} values, but ITEM: ATOMS names {} columns",
-                        f.len(),
-                        cols.len()
-                    ),
-                ));
-            }
-            let num = |c: usize| {
-                f[c].parse::<f64>()
-                    .map_err(|_| err(at, format!("'{}' is not a number", f[c])))
-            };
-            let mut p = [num(pos[0])?, num(pos[1])?, num(pos[2])?];
-            if scaled {
-                p = [
-                    origin[0] + p[0] * cell[0][0] + p[1] * cell[1][0] + p[2] * cell[2][0],
-                    origin[1] + p[1] * cell[1][1] + p[2] * cell[2][1],
-                    origin[2] + p[2] * cell[2][2],
-                ];
-            }
-            let v = match vel {
-                Some(c) => [num(c[0])?, num(c[1])?, num(c[2])?],
-                None => [0.0; 3],
-            };
-            let id = match id_col {
-                Some(c) => f[c]
-                    .parse::<u64>()
-                    .map_err(|_| err(at, format!("'{}' is not an atom id", f[c])))?,
-                None => j as u64 + 1,
-            };
-            let species = type_col.map_or_else(|| "1".to_string(), |c| f[c].to_string());
-            let radius = match rad_col {
-                Some(c) => num(c)?,
-                None => 0.0,
-            };
-            rows.push((id, (species, p, v, radius)));
-        }
-        rows.sort_by_key(|r| r.0);
-        let mut frame = Frame {
-            time: time.unwrap_or(timestep as f64),
-            cell,
-            origin,
-            pbc,
-            ..Frame::default()
-        };
-        for (_, (s, p, v, r)) in rows {
-            frame.species.push(s);
-            frame.positions.push(p);
-            frame.velocities.push(v);
-            frame.radii.push(r);
-        }
+        let frame = atoms(&mut k, &next, &err, n, cell, origin, pbc, time, timestep)?;
         frames.push(DumpFrame { timestep, frame });
     }
     Ok(frames)
 }
 
-type Frame1 = (String, [f64; 3], [f64; 3], f64);
+/// Reads `ITEM: ATOMS` and its n rows into a frame with the given box.
+/// Positions are unwrapped, wrapped or scaled; rows come back in id order.
+#[allow(clippy::too_many_arguments)]
+fn atoms<'a>(
+    k: &mut usize,
+    next: &impl Fn(&mut usize, &str) -> Result<(usize, &'a str), ParseError>,
+    err: &impl Fn(usize, String) -> ParseError,
+    n: usize,
+    cell: [[f64; 3]; 3],
+    origin: [f64; 3],
+    pbc: [bool; 3],
+    time: Option<f64>,
+    timestep: u64,
+) -> Result<Frame, ParseError> {
+    let (at, l) = next(k, "ITEM: ATOMS")?;
+    let Some(cols) = l.strip_prefix("ITEM: ATOMS") else {
+        return Err(err(at, format!("expected 'ITEM: ATOMS ...', found '{l}'")));
+    };
+    let cols: Vec<&str> = cols.split_whitespace().collect();
+    let col = |c: &str| cols.iter().position(|x| *x == c);
+    let triple = |a: &str, b: &str, c: &str| match (col(a), col(b), col(c)) {
+        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+        _ => None,
+    };
+    let (pos, scaled) = if let Some(p) = triple("x", "y", "z") {
+        (p, false)
+    } else if let Some(p) = triple("xu", "yu", "zu") {
+        (p, false)
+    } else if let Some(p) = triple("xs", "ys", "zs") {
+        (p, true)
+    } else {
+        return Err(err(
+            at,
+            "no position columns (x y z, xu yu zu or xs ys zs)".into(),
+        ));
+    };
+    let vel = triple("vx", "vy", "vz");
+    let omega = triple("omegax", "omegay", "omegaz");
+    let mu = triple("mux", "muy", "muz");
+    let (id_col, type_col) = (col("id"), col("type"));
+    let (radius_col, diameter_col, mass_col, mol_col) =
+        (col("radius"), col("diameter"), col("mass"), col("mol"));
+    let mut rows: Vec<(u64, usize)> = Vec::with_capacity(n);
+    let mut frame = Frame {
+        time: time.unwrap_or(timestep as f64),
+        cell,
+        origin,
+        pbc,
+        ..Frame::default()
+    };
+    for j in 0..n {
+        let (at, l) = next(k, &format!("atom {} of {n}", j + 1))?;
+        let f: Vec<&str> = l.split_whitespace().collect();
+        if f.len() < cols.len() {
+            return Err(err(
+                at,
+                format!(
+                    "{} values, but ITEM: ATOMS names {} columns",
+                    f.len(),
+                    cols.len()
+                ),
+            ));
+        }
+        let num = |c: usize| {
+            f[c].parse::<f64>()
+                .map_err(|_| err(at, format!("'{}' is not a number", f[c])))
+        };
+        let vec3 = |c: [usize; 3]| -> Result<[f64; 3], ParseError> {
+            Ok([num(c[0])?, num(c[1])?, num(c[2])?])
+        };
+        let whole = |c: usize, what: &str| {
+            f[c].parse::<u64>()
+                .map_err(|_| err(at, format!("'{}' is not {what}", f[c])))
+        };
+        let mut p = vec3(pos)?;
+        if scaled {
+            p = [
+                origin[0] + p[0] * cell[0][0] + p[1] * cell[1][0] + p[2] * cell[2][0],
+                origin[1] + p[0] * cell[0][1] + p[1] * cell[1][1] + p[2] * cell[2][1],
+                origin[2] + p[0] * cell[0][2] + p[1] * cell[1][2] + p[2] * cell[2][2],
+            ];
+        }
+        frame.positions.push(p);
+        frame
+            .velocities
+            .push(vel.map(vec3).transpose()?.unwrap_or([0.0; 3]));
+        frame
+            .species
+            .push(type_col.map_or_else(|| "1".to_string(), |c| f[c].to_string()));
+        frame.radii.push(match (radius_col, diameter_col) {
+            (Some(c), _) => num(c)?,
+            (None, Some(c)) => 0.5 * num(c)?,
+            (None, None) => 0.0,
+        });
+        if let Some(c) = mass_col {
+            frame.masses.push(num(c)?);
+        }
+        if let Some(c) = omega {
+            frame.angular_velocities.push(vec3(c)?);
+        }
+        if let Some(c) = mu {
+            frame.dipoles.push(vec3(c)?);
+        }
+        if let Some(c) = mol_col {
+            let m = whole(c, "a molecule id")?;
+            frame.bodies.push(m.saturating_sub(1));
+        }
+        let id = match id_col {
+            Some(c) => whole(c, "an atom id")?,
+            None => j as u64 + 1,
+        };
+        rows.push((id, j));
+    }
+    // Rows in id order.
+    rows.sort_by_key(|r| r.0);
+    let order: Vec<usize> = rows.iter().map(|r| r.1).collect();
+    fn permute<T: Clone>(v: &mut Vec<T>, order: &[usize]) {
+        if v.len() == order.len() {
+            *v = order.iter().map(|&j| v[j].clone()).collect();
+        }
+    }
+    permute(&mut frame.positions, &order);
+    permute(&mut frame.velocities, &order);
+    permute(&mut frame.species, &order);
+    permute(&mut frame.radii, &order);
+    permute(&mut frame.masses, &order);
+    permute(&mut frame.angular_velocities, &order);
+    permute(&mut frame.dipoles, &order);
+    permute(&mut frame.bodies, &order);
+    if id_col.is_some() {
+        frame.ids = rows.iter().map(|r| r.0).collect();
+    }
+    Ok(frame)
+}
 
 #[cfg(test)]
 mod tests {
@@ -443,5 +600,61 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("restricted triclinic"), "{e}");
+    }
+
+    /// OVITO's (and LAMMPS 2023's) general triclinic box: cell vectors as
+    /// rows with the origin's components; it used to be refused.
+    #[test]
+    fn reads_abc_origin_boxes() {
+        let text = "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\n\
+                    ITEM: BOX BOUNDS abc origin pp pp ff\n\
+                    2 0 0 -1\n0.5 3 0 -2\n0 0 4 0.5\n\
+                    ITEM: ATOMS id type xs ys zs diameter\n1 1 0.5 0.5 0.5 0.25\n";
+        let f = parse(text, "o.dump").unwrap().remove(0).frame;
+        assert_eq!(f.cell, [[2.0, 0.0, 0.0], [0.5, 3.0, 0.0], [0.0, 0.0, 4.0]]);
+        assert_eq!(f.origin, [-1.0, -2.0, 0.5]);
+        assert_eq!(f.pbc, [true, true, false]);
+        assert_eq!(f.positions, [[0.25, -0.5, 2.5]]);
+        assert_eq!(f.radii, [0.125]);
+        let bad = text.replace("0 0 4 0.5", "0 0 4");
+        let e = parse(&bad, "o.dump").unwrap_err().to_string();
+        assert!(e.starts_with("o.dump:8: expected four numbers"), "{e}");
+    }
+
+    /// Exact mode: a packing's positions and radii come back bit for bit
+    /// (11 digits left overlaps of 6e-8 in a jammed packing), with every
+    /// optional column and the ids.
+    #[test]
+    fn exact_dumps_round_trip_every_column() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("e.dump");
+        let f = Frame {
+            positions: vec![[0.1 + 0.2, 1.0 / 3.0, 2f64.sqrt()], [1e-300, 0.7, 5e-324]],
+            velocities: vec![[1.0 / 7.0, 0.0, -0.1], [0.0, 0.0, 0.0]],
+            radii: vec![0.49999999999999994, 0.1 + 0.7],
+            masses: vec![1.0 / 3.0, 2.0],
+            ids: vec![5, 3],
+            angular_velocities: vec![[0.3, 0.0, 0.1], [1.0, 2.0, 3.0]],
+            dipoles: vec![[0.0, 0.6, 0.8], [1.0, 0.0, 0.0]],
+            bodies: vec![0, 4],
+            species: vec!["1".into(), "2".into()],
+            ..frame([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+        };
+        let mut w = DumpWriter::create(&path).unwrap().exact();
+        w.write(0, &f).unwrap();
+        let back = read_frames(&path).unwrap().remove(0).frame;
+        // Rows come back in id order (3 before 5).
+        let mut want = f.clone();
+        want.positions.swap(0, 1);
+        want.velocities.swap(0, 1);
+        want.radii.swap(0, 1);
+        want.masses.swap(0, 1);
+        want.ids.swap(0, 1);
+        want.angular_velocities.swap(0, 1);
+        want.dipoles.swap(0, 1);
+        want.bodies.swap(0, 1);
+        want.species.swap(0, 1);
+        want.time = back.time;
+        assert_eq!(back, want);
     }
 }
