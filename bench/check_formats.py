@@ -4,7 +4,7 @@
 Usage: check_formats.py DIR
 
 DIR holds what crates/mote-io/tests/formats.rs writes: t.xyz (extended XYZ),
-t.dump (LAMMPS dump text), t.vtu (VTK XML) and expected.json (positions,
+t.dump (LAMMPS dump text), t.gsd (HOOMD's GSD), t.vtu (VTK XML) and expected.json (positions,
 velocities, cell vectors and origin of every frame). The extended XYZ is read with ASE, the dump
 with MDAnalysis and the VTU with meshio; positions and box must agree to 1e-6
 (relative). Exit status: 0 all agree, 1 a mismatch, 77 skipped (a package is
@@ -74,6 +74,27 @@ def main():
         check(f"MDAnalysis frame {k} positions", ok)
         lengths = [w["cell"][0][0], w["cell"][1][1], w["cell"][2][2]]
         check(f"MDAnalysis frame {k} box {list(ts.dimensions[:3])}", close(ts.dimensions[:3], lengths, 1e-5))
+
+    # GSD with the gsd package (HOOMD's reader) and MDAnalysis: f32 positions
+    # relative to the box centre, box lengths, types, velocities.
+    try:
+        import gsd.hoomd
+    except ImportError:
+        gsd = None
+        print("note: the gsd package is not importable (pip install gsd); t.gsd not checked")
+    if gsd is not None:
+        with gsd.hoomd.open(os.path.join(d, "t.gsd"), "r") as traj:
+            check(f"gsd reads {len(want)} frames of t.gsd", len(traj) == len(want))
+            for k, (fr, w) in enumerate(zip(traj, want)):
+                lengths = [w["cell"][0][0], w["cell"][1][1], w["cell"][2][2]]
+                centre = [w["origin"][i] + 0.5 * lengths[i] for i in range(3)]
+                rel = [[p[i] - centre[i] for i in range(3)] for p in w["positions"]]
+                check(f"gsd frame {k} positions (from the box centre)", close(flat(fr.particles.position), flat(rel), 1e-6))
+                check(f"gsd frame {k} box", close(fr.configuration.box[:3], lengths, 1e-6))
+                check(f"gsd frame {k} velocities", close(flat(fr.particles.velocity), flat(w["velocities"]), 1e-6))
+                check(f"gsd frame {k} types {fr.particles.types}", list(fr.particles.types) == ["Fe", "O"])
+        u = MDAnalysis.Universe(os.path.join(d, "t.gsd"))
+        check(f"MDAnalysis reads {len(want)} frames of t.gsd", len(u.trajectory) == len(want))
 
     # VTU with meshio: points, and the cell stored as field data.
     m = meshio.read(os.path.join(d, "t.vtu"))

@@ -8,6 +8,7 @@ pub mod checkpoint;
 pub mod csv;
 pub mod elements;
 pub mod error;
+pub mod gsd;
 pub mod header;
 pub mod lammps_data;
 pub mod lammps_dump;

@@ -53,14 +53,16 @@ fn the_three_trajectory_formats_agree() {
 }
 
 /// Writes two frames in every format, then lets `bench/check_formats.py` read
-/// them with ASE (XYZ), MDAnalysis (dump) and meshio (VTU). Skips, with a
-/// message, where Python or those packages are missing.
+/// them with ASE (XYZ), MDAnalysis (dump and GSD), the `gsd` package and
+/// meshio (VTU). Skips, with a message, where Python or those packages are
+/// missing.
 #[test]
 fn other_programs_read_the_same_positions_and_box() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let mut x = XyzWriter::create(&d.join("t.xyz"), Provenance::default()).unwrap();
     let mut w = lammps_dump::DumpWriter::create(&d.join("t.dump")).unwrap();
+    let mut g = mote_io::gsd::GsdWriter::create(&d.join("t.gsd")).unwrap();
     let mut json = String::from("[");
     for k in 0..2 {
         let mut f = frame();
@@ -70,6 +72,7 @@ fn other_programs_read_the_same_positions_and_box() {
         }
         x.write(&f).unwrap();
         w.write(k, &f).unwrap();
+        g.write(k, &f).unwrap();
         vtu::write_vtu(&d.join("t.vtu"), &f, &Provenance::default()).unwrap();
         let rows = |v: &[[f64; 3]]| {
             let r: Vec<String> = v
@@ -108,7 +111,10 @@ fn other_programs_read_the_same_positions_and_box() {
     let text =
         String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
     match out.status.code() {
-        Some(0) => assert!(text.contains("all formats agree"), "{text}"),
+        Some(0) => {
+            eprintln!("{text}");
+            assert!(text.contains("all formats agree"), "{text}")
+        }
         Some(77) => eprintln!("{text}"),
         _ => panic!("bench/check_formats.py failed:\n{text}"),
     }

@@ -143,6 +143,16 @@ fn fuzz_all(count: usize) -> usize {
     tried += fuzz("vtu", &vtu, count, |b| {
         let _ = mote_io::vtu::parse_vtu(&lossy(b), "fuzz.vtu");
     });
+    // GSD (binary: mutated bytes, never a panic or a huge allocation).
+    let gsd_path = dir.path().join("seed.gsd");
+    let mut g = mote_io::gsd::GsdWriter::create(&gsd_path).unwrap();
+    g.write(0, &frame()).unwrap();
+    g.write(1, &frame()).unwrap();
+    drop(g);
+    let gsd = std::fs::read(&gsd_path).unwrap();
+    tried += fuzz("gsd", &gsd, count, |b| {
+        let _ = mote_io::gsd::parse(b, "fuzz.gsd");
+    });
     // Extended XYZ, CSV and checkpoints, through files.
     let mut xyz = Vec::new();
     mote_io::xyz::write_frame(&mut xyz, &frame(), &provenance()).unwrap();

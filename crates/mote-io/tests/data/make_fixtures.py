@@ -16,3 +16,25 @@ ase.io.write("ase_momenta.extxyz", atoms, format="extxyz")  # species, pos, mome
 plain = Atoms("Ar3Fe", positions=positions)
 ase.io.write("ase_default.extxyz", plain, format="extxyz")  # species, pos
 ase.io.write("ase_plain.xyz", plain, format="xyz")  # no Properties
+
+# A GSD trajectory written by the gsd package (HOOMD's schema): two frames,
+# the second with positions only (the rest comes from frame 0).
+import gsd.hoomd
+
+first = gsd.hoomd.Frame()
+first.configuration.box = [4.0, 5.0, 6.0, 0.0, 0.0, 0.0]
+first.particles.N = 3
+first.particles.types = ["A", "B"]
+first.particles.typeid = [0, 1, 0]
+first.particles.position = [[-1.5, 0.5, 2.0], [0.25, -2.0, -2.5], [1.0, 1.0, 1.0]]
+first.particles.velocity = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, -3.0]]
+first.particles.diameter = [1.0, 0.5, 2.0]
+first.particles.mass = [1.0, 2.0, 4.0]
+second = gsd.hoomd.Frame()
+second.configuration.step = 10
+second.configuration.box = first.configuration.box
+second.particles.N = 3
+second.particles.position = [[-1.25, 0.5, 2.0], [0.25, -1.75, -2.5], [1.0, 1.0, 1.25]]
+with gsd.hoomd.open("gsd_hoomd.gsd", "w") as f:
+    f.append(first)
+    f.append(second)
