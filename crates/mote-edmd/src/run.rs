@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
-use mote_io::xyz::XyzWriter;
+use mote_io::trajectory::{Format, TrajectoryWriter};
 use mote_run::{Checkpoints, Driver, Observer, Propagator, Stopped};
 
 use crate::scene::Scene;
@@ -369,10 +369,11 @@ impl<const D: usize> Observer<EventDriven<D>> for EventCsv {
     }
 }
 
-/// trajectory.xyz of an event-driven run (global times).
-struct EventXyz(XyzWriter);
+/// The trajectory of an event-driven run (global times; the output index
+/// as the step of dumps and GSD).
+struct EventTrajectory(TrajectoryWriter);
 
-impl<const D: usize> Observer<EventDriven<D>> for EventXyz {
+impl<const D: usize> Observer<EventDriven<D>> for EventTrajectory {
     fn every(&self) -> u64 {
         1
     }
@@ -380,7 +381,7 @@ impl<const D: usize> Observer<EventDriven<D>> for EventXyz {
     fn observe(&mut self, p: &EventDriven<D>, _: &EventSample) -> Result<(), EdmdError> {
         let mut f = frame(&p.sys);
         f.time = p.now();
-        Ok(self.0.write(&f)?)
+        Ok(self.0.write(p.k, &f)?)
     }
 }
 
@@ -436,10 +437,12 @@ pub fn run_scene<const D: usize>(
     driver.sample_at_start = !resuming;
     if let Some(f) = &scene.trajectory {
         let path = out.base.join(f);
-        driver.observers.push(Box::new(EventXyz(if resuming {
-            XyzWriter::append(&path, out.provenance.clone())?
+        let format = Format::of_path(&path).unwrap_or_default();
+        let prov = out.provenance.clone();
+        driver.observers.push(Box::new(EventTrajectory(if resuming {
+            TrajectoryWriter::append(&path, format, prov, false)?
         } else {
-            XyzWriter::create(&path, out.provenance.clone())?
+            TrajectoryWriter::create(&path, format, prov, false)?
         })));
     }
     if let Some(f) = &scene.observables {

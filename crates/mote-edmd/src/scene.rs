@@ -138,7 +138,8 @@ pub struct Scene {
     pub notes: Vec<String>,
     /// Explicit particles.
     pub particles: Option<Vec<ParticleSpec>>,
-    /// Initial state from the last frame of an extended XYZ file.
+    /// Initial state from the last frame of a trajectory file (.xyz, .dump,
+    /// .gsd, .vtu/.vtp/.pvd), relative to the scene file.
     pub file: Option<String>,
     /// Check for overlaps at every output (exact, O(N)); default true.
     #[serde(default = "yes")]
@@ -172,9 +173,12 @@ pub struct OutputSection {
     /// Write observables.csv (default true).
     #[serde(default = "yes")]
     pub observables: bool,
-    /// Write trajectory.xyz (default true).
+    /// Write the trajectory (default true).
     #[serde(default = "yes")]
     pub trajectory: bool,
+    /// Its format: `xyz` (default), `dump`, `gsd` or `vtk`; the file is
+    /// `trajectory.<xyz|dump|gsd|pvd>`.
+    pub trajectory_format: Option<String>,
     /// Write speeds.csv, the speed histogram at the end (default true).
     #[serde(default = "yes")]
     pub histogram: bool,
@@ -190,6 +194,7 @@ impl Default for OutputSection {
             interval: None,
             observables: true,
             trajectory: true,
+            trajectory_format: None,
             histogram: true,
             observables_every: None,
             trajectory_every: None,
@@ -470,7 +475,21 @@ impl Scene {
         } else {
             let o = &self.output;
             self.output_interval = o.interval;
-            self.trajectory = o.trajectory.then(|| "trajectory.xyz".to_string());
+            let format = match &o.trajectory_format {
+                None => mote_io::trajectory::Format::Xyz,
+                Some(f) => mote_io::trajectory::Format::named(f).ok_or_else(|| {
+                    err(
+                        "trajectory_format",
+                        format!(
+                            "trajectory_format '{f}' is not one of {}",
+                            mote_io::trajectory::Format::NAMES
+                        ),
+                    )
+                })?,
+            };
+            self.trajectory = o
+                .trajectory
+                .then(|| format!("trajectory.{}", format.extension()));
             self.observables = o.observables.then(|| "observables.csv".to_string());
             self.histogram = o.histogram.then(|| "speeds.csv".to_string());
         }
@@ -662,7 +681,7 @@ impl Scene {
             (size, pos, radii, masses, Some(vel))
         } else if let Some(f) = &self.file {
             let path = base.join(f);
-            let frames = mote_io::xyz::read_frames(&path)?;
+            let frames = mote_io::trajectory::read_frames(&path)?;
             let fr = frames
                 .last()
                 .ok_or_else(|| EdmdError::Invalid(format!("{}: no frames", path.display())))?;
@@ -693,11 +712,16 @@ impl Scene {
             };
             let v0: Vec<[f64; D]> = vel;
             let has_v = v0.iter().any(|v| v.iter().any(|x| *x != 0.0));
+            let masses = if fr.masses.len() == n && self.mass.is_none() {
+                fr.masses.clone()
+            } else {
+                vec![mass; n]
+            };
             (
                 size,
                 pos,
                 radii,
-                vec![mass; n],
+                masses,
                 if has_v { Some(v0) } else { None },
             )
         } else {

@@ -57,17 +57,13 @@ pub(crate) fn trim_outputs(dir: &Path, step: u64, time: f64) -> Result<(), Front
         }
         std::fs::write(&csv, kept).map_err(|e| IoError::os(&csv, e))?;
     }
-    let xyz = dir.join("trajectory.xyz");
-    if xyz.exists() {
-        // Frames up to the checkpoint are kept verbatim (byte for byte).
-        let text = std::fs::read_to_string(&xyz).map_err(|e| IoError::os(&xyz, e))?;
-        let mut kept = String::new();
-        for (t, span) in mote_io::xyz::frame_spans(&text) {
-            if t <= time {
-                kept.push_str(&text[span]);
-            }
+    // Frames up to the checkpoint are kept verbatim (byte for byte).
+    use mote_io::trajectory::{keep_until, Format};
+    for format in [Format::Xyz, Format::Dump, Format::Gsd, Format::Vtk] {
+        let path = dir.join(format!("trajectory.{}", format.extension()));
+        if path.exists() {
+            keep_until(&path, format, step, time)?;
         }
-        std::fs::write(&xyz, kept).map_err(|e| IoError::os(&xyz, e))?;
     }
     Ok(())
 }

@@ -306,8 +306,11 @@ fn pack_dim<const D: usize>(
     let overlap = deepest_overlap(&simbox, &pos, &radii);
     let frame = mote_edmd::scene::frame(sys);
     if let (Some(path), Some(s)) = (&files.xyz, &stem) {
-        let mut w = mote_io::xyz::XyzWriter::create(path, provenance.clone())?.exact();
-        w.write(&frame)?;
+        // The format follows the extension (.xyz, .dump, .gsd, .pvd), in
+        // numbers that read back bit for bit.
+        use mote_io::trajectory::{Format, TrajectoryWriter};
+        let format = Format::of_path(path).unwrap_or_default();
+        TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, &frame)?;
         write_pov(&frame, &s.with_extension("pov"))?;
     }
     if let Some(p) = &files.picture {

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::IoError;
-use mote_md::output::{ObservablesCsv, TrajectoryXyz};
+use mote_md::output::{ObservablesCsv, Trajectory};
 use mote_md::scene::{PlistSystem, Scene};
 use mote_md::{MdError, RunLength, RunReport, Simulation};
 use mote_run::{Checkpoints, Driver};
@@ -165,8 +165,10 @@ pub(crate) fn run(
         )?));
     }
     if out.trajectory_every > 0 {
-        driver.observers.push(Box::new(TrajectoryXyz::create(
-            &dir.join("trajectory.xyz"),
+        let format = out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?;
+        driver.observers.push(Box::new(Trajectory::create(
+            &dir.join(format!("trajectory.{}", format.extension())),
+            format,
             provenance.clone(),
             out.trajectory_every,
             append,

@@ -431,6 +431,45 @@ fn chunks(step: u64, f: &Frame, exact: bool) -> Result<Vec<Chunk>, String> {
     Ok(out)
 }
 
+/// Drops the frames whose `configuration/step` is past `step` from the
+/// index (their data stays, unreferenced), so that [`GsdWriter::append`]
+/// continues after the last frame kept: a run resumed from a checkpoint.
+pub fn keep_until_step(path: &Path, step: u64) -> Result<(), IoError> {
+    let bytes = std::fs::read(path).map_err(|e| IoError::os(path, e))?;
+    let layout = Layout::parse(&bytes, &path.display().to_string())?;
+    let step_id = layout.names.iter().position(|n| n == "configuration/step");
+    let step_of = |f: u64| -> u64 {
+        layout
+            .entries
+            .iter()
+            .find(|e| e.frame == f && Some(e.id as usize) == step_id)
+            .map_or(0, |e| {
+                values(&bytes, e).0.first().copied().unwrap_or(0.0) as u64
+            })
+    };
+    let first_dropped = layout
+        .entries
+        .iter()
+        .map(|e| e.frame)
+        .find(|&f| step_of(f) > step);
+    let Some(first_dropped) = first_dropped else {
+        return Ok(());
+    };
+    let kept = layout
+        .entries
+        .iter()
+        .take_while(|e| e.frame < first_dropped)
+        .count() as u64;
+    let zeros = vec![0u8; ((layout.entries.len() as u64 - kept) * ENTRY_SIZE) as usize];
+    let mut file = OpenOptions::new()
+        .write(true)
+        .open(path)
+        .map_err(|e| IoError::os(path, e))?;
+    file.seek(SeekFrom::Start(layout.index_location + kept * ENTRY_SIZE))
+        .and_then(|_| file.write_all(&zeros))
+        .map_err(|e| IoError::os(path, e))
+}
+
 /// Header, index and names of a file in memory.
 struct Layout {
     index_location: u64,
@@ -459,7 +498,8 @@ impl Layout {
         let gsd_version = u32::from_le_bytes(bytes[44..48].try_into().unwrap_or([0; 4]));
         let v1 = gsd_version < version(2, 0);
         let (index_location, index_capacity) = (u64_at(8), u64_at(16));
-        let (namelist_location, namelist_capacity) = (u64_at(24), u64_at(32) * NAME_SIZE);
+        let (namelist_location, namelist_capacity) =
+            (u64_at(24), u64_at(32).saturating_mul(NAME_SIZE));
         let len = bytes.len() as u64;
         let inside = |at: u64, size: u64| at.checked_add(size).is_some_and(|end| end <= len);
         if !inside(index_location, index_capacity.saturating_mul(ENTRY_SIZE))

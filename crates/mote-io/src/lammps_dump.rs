@@ -65,6 +65,21 @@ impl DumpWriter {
         })
     }
 
+    /// Opens an existing dump to append frames (a resumed run); species get
+    /// type numbers in order of first appearance again.
+    pub fn append(path: &Path) -> Result<Self, IoError> {
+        let file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(|e| IoError::os(path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out: BufWriter::new(file),
+            types: Vec::new(),
+            exact: false,
+        })
+    }
+
     /// Writes every number so that it reads back bit for bit (for packings,
     /// whose contacts are gaps of 10⁻¹⁰ and less).
     pub fn exact(mut self) -> Self {
@@ -238,6 +253,36 @@ pub fn write_frame_as(
         writeln!(out, "{line}")?;
     }
     Ok(())
+}
+
+/// The time step and byte range of every frame of dump text (a frame
+/// starts at `ITEM: TIME` or `ITEM: TIMESTEP`): for keeping frames verbatim.
+pub fn frame_spans(text: &str) -> Vec<(u64, std::ops::Range<usize>)> {
+    let mut starts: Vec<(usize, u64)> = Vec::new();
+    let mut at = 0;
+    let mut pending: Option<usize> = None;
+    let mut lines = text.split_inclusive('\n').peekable();
+    while let Some(line) = lines.next() {
+        let here = at;
+        at += line.len();
+        match line.trim() {
+            "ITEM: TIME" => pending = Some(here),
+            "ITEM: TIMESTEP" => {
+                let step = lines
+                    .peek()
+                    .and_then(|l| l.trim().parse().ok())
+                    .unwrap_or(0);
+                starts.push((pending.take().unwrap_or(here), step));
+            }
+            _ => {}
+        }
+    }
+    (0..starts.len())
+        .map(|k| {
+            let end = starts.get(k + 1).map_or(text.len(), |s| s.0);
+            (starts[k].1, starts[k].0..end)
+        })
+        .collect()
 }
 
 /// Reads every frame of a LAMMPS dump text file. Columns are found by name

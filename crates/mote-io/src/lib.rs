@@ -15,6 +15,7 @@ pub mod lammps_dump;
 pub mod plist;
 pub mod png;
 pub mod system;
+pub mod trajectory;
 pub mod vtu;
 pub mod xyz;
 

@@ -1,11 +1,13 @@
-//! VTK XML unstructured grids (`.vtu`), one per frame, and the ParaView
-//! collection (`.pvd`) that lists them with their times.
+//! VTK XML unstructured grids (`.vtu`) or poly data (`.vtp`, which OVITO
+//! reads as particles), one per frame, and the ParaView collection (`.pvd`)
+//! that lists them with their times.
 //!
-//! Particles are points with one `VTK_VERTEX` cell each, so that ParaView shows
-//! them directly (Point Gaussian or Glyph filters use the `radius` array). Point
+//! Particles are points with one `VTK_VERTEX` cell (a vertex in `.vtp`) each,
+//! so that ParaView shows them directly (Point Gaussian or Glyph filters use the `radius` array). Point
 //! data: `radius`, `velocity` (3 components), `type` (species index from 0,
 //! names as NUL-terminated bytes in the field data `species`). Field data: `TIME`, `cell` (9 values,
-//! rows a, b, c), `origin`, `pbc`. Arrays are ASCII, so files are readable and
+//! rows a, b, c), `origin`, `pbc`. Arrays are ASCII in the shortest form that
+//! reads back bit for bit, so files are readable and
 //! [`read_vtu`] can read them back; meshio and VTK read them as well.
 
 use std::fs::File;
@@ -17,9 +19,23 @@ use crate::{IoError, ParseError, Provenance};
 
 /// Writes one frame as a `.vtu` file.
 pub fn write_vtu(path: &Path, frame: &Frame, provenance: &Provenance) -> Result<(), IoError> {
+    write_as(path, frame, provenance, false)
+}
+
+/// Writes one frame as a `.vtp` file (poly data of vertices: OVITO's particles).
+pub fn write_vtp(path: &Path, frame: &Frame, provenance: &Provenance) -> Result<(), IoError> {
+    write_as(path, frame, provenance, true)
+}
+
+fn write_as(
+    path: &Path,
+    frame: &Frame,
+    provenance: &Provenance,
+    poly: bool,
+) -> Result<(), IoError> {
     let file = File::create(path).map_err(|e| IoError::os(path, e))?;
     let mut out = BufWriter::new(file);
-    write_to(&mut out, frame, provenance)
+    write_to(&mut out, frame, provenance, poly)
         .and_then(|_| out.flush())
         .map_err(|e| IoError::os(path, e))
 }
@@ -32,8 +48,14 @@ fn xml_escape(s: &str) -> String {
         .replace("--", "- -")
 }
 
-fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::Result<()> {
+fn write_to(
+    out: &mut impl Write,
+    frame: &Frame,
+    prov: &Provenance,
+    poly: bool,
+) -> std::io::Result<()> {
     let n = frame.positions.len();
+    let kind = if poly { "PolyData" } else { "UnstructuredGrid" };
     let mut names: Vec<&str> = Vec::new();
     let types: Vec<usize> = frame
         .species
@@ -49,9 +71,9 @@ fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::
     writeln!(out, "<!-- {} -->", xml_escape(&prov.line()))?;
     writeln!(
         out,
-        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
+        "<VTKFile type=\"{kind}\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
     )?;
-    writeln!(out, "<UnstructuredGrid>")?;
+    writeln!(out, "<{kind}>")?;
     writeln!(out, "<FieldData>")?;
     writeln!(
         out,
@@ -96,14 +118,18 @@ fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::
     }
     writeln!(out, "\n</DataArray>")?;
     writeln!(out, "</FieldData>")?;
-    writeln!(out, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">")?;
+    if poly {
+        writeln!(out, "<Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\">")?;
+    } else {
+        writeln!(out, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">")?;
+    }
     writeln!(out, "<PointData Scalars=\"radius\" Vectors=\"velocity\">")?;
     writeln!(
         out,
         "<DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">"
     )?;
     for i in 0..n {
-        writeln!(out, "{:.10e}", frame.radii.get(i).copied().unwrap_or(0.0))?;
+        writeln!(out, "{:e}", frame.radii.get(i).copied().unwrap_or(0.0))?;
     }
     writeln!(out, "</DataArray>")?;
     writeln!(
@@ -112,7 +138,7 @@ fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::
     )?;
     for i in 0..n {
         let v = frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
-        writeln!(out, "{:.10e} {:.10e} {:.10e}", v[0], v[1], v[2])?;
+        writeln!(out, "{:e} {:e} {:e}", v[0], v[1], v[2])?;
     }
     writeln!(out, "</DataArray>")?;
     writeln!(
@@ -130,11 +156,11 @@ fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::
         "<DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">"
     )?;
     for p in &frame.positions {
-        writeln!(out, "{:.16e} {:.16e} {:.16e}", p[0], p[1], p[2])?;
+        writeln!(out, "{:e} {:e} {:e}", p[0], p[1], p[2])?;
     }
     writeln!(out, "</DataArray>")?;
     writeln!(out, "</Points>")?;
-    writeln!(out, "<Cells>")?;
+    writeln!(out, "{}", if poly { "<Verts>" } else { "<Cells>" })?;
     writeln!(
         out,
         "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
@@ -151,17 +177,21 @@ fn write_to(out: &mut impl Write, frame: &Frame, prov: &Provenance) -> std::io::
         writeln!(out, "{}", i + 1)?;
     }
     writeln!(out, "</DataArray>")?;
-    writeln!(
-        out,
-        "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
-    )?;
-    for _ in 0..n {
-        writeln!(out, "1")?;
+    if poly {
+        writeln!(out, "</Verts>")?;
+    } else {
+        writeln!(
+            out,
+            "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
+        )?;
+        for _ in 0..n {
+            writeln!(out, "1")?;
+        }
+        writeln!(out, "</DataArray>")?;
+        writeln!(out, "</Cells>")?;
     }
-    writeln!(out, "</DataArray>")?;
-    writeln!(out, "</Cells>")?;
     writeln!(out, "</Piece>")?;
-    writeln!(out, "</UnstructuredGrid>")?;
+    writeln!(out, "</{kind}>")?;
     writeln!(out, "</VTKFile>")?;
     Ok(())
 }
@@ -204,11 +234,13 @@ pub fn read_vtu(path: &Path) -> Result<Frame, IoError> {
 
 /// Parses `.vtu` text; `name` is used in error messages.
 pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
-    if !text.contains("<VTKFile") || !text.contains("UnstructuredGrid") {
+    if !text.contains("<VTKFile")
+        || !(text.contains("UnstructuredGrid") || text.contains("PolyData"))
+    {
         return Err(ParseError::new(
             name,
             1,
-            "not a VTK XML UnstructuredGrid file",
+            "not a VTK XML UnstructuredGrid or PolyData file",
         ));
     }
     let pts = numbers(text, name, "Points")?;
@@ -287,11 +319,19 @@ pub struct PvdWriter {
     stem: String,
     provenance: Provenance,
     entries: Vec<(f64, String)>,
+    /// Frames as `.vtp` poly data rather than `.vtu` grids.
+    poly: bool,
 }
 
 impl PvdWriter {
     /// `pvd_path` is the collection file, e.g. `out/traj.pvd`; frames go beside it.
     pub fn create(pvd_path: &Path, provenance: Provenance) -> Result<Self, IoError> {
+        let w = Self::create_empty(pvd_path, provenance)?;
+        w.write_pvd()?;
+        Ok(w)
+    }
+
+    fn create_empty(pvd_path: &Path, provenance: Provenance) -> Result<Self, IoError> {
         let dir = pvd_path
             .parent()
             .filter(|p| !p.as_os_str().is_empty())
@@ -308,21 +348,49 @@ impl PvdWriter {
                 ))
             })?
             .to_string();
-        let w = Self {
+        Ok(Self {
             dir,
             stem,
             provenance,
             entries: Vec::new(),
-        };
-        w.write_pvd()?;
+            poly: false,
+        })
+    }
+
+    /// Frames as `.vtp` poly data (OVITO's particles) instead of `.vtu`.
+    pub fn poly_data(mut self) -> Self {
+        self.poly = true;
+        self
+    }
+
+    /// Continues an existing collection (a resumed run): its data sets are
+    /// kept and new frames numbered after them.
+    pub fn append(pvd_path: &Path, provenance: Provenance) -> Result<Self, IoError> {
+        let mut w = Self::create_empty(pvd_path, provenance)?;
+        for (t, f) in read_pvd(pvd_path)? {
+            let name = f.file_name().map(|n| n.to_string_lossy().into_owned());
+            w.poly |= f.extension().is_some_and(|e| e == "vtp");
+            w.entries.push((t, name.unwrap_or_default()));
+        }
         Ok(w)
+    }
+
+    /// Keeps the data sets up to time `t` (and deletes the files of the
+    /// rest): the frames of a run resumed from a checkpoint at t.
+    pub fn keep_until(&mut self, t: f64) -> Result<(), IoError> {
+        for (_, f) in self.entries.iter().filter(|(s, _)| *s > t) {
+            let _ = std::fs::remove_file(self.dir.join(f));
+        }
+        self.entries.retain(|(s, _)| *s <= t);
+        self.write_pvd()
     }
 
     /// Writes the next frame and updates the collection; returns the frame's path.
     pub fn write(&mut self, frame: &Frame) -> Result<PathBuf, IoError> {
-        let file = format!("{}_{:05}.vtu", self.stem, self.entries.len());
+        let ext = if self.poly { "vtp" } else { "vtu" };
+        let file = format!("{}_{:05}.{ext}", self.stem, self.entries.len());
         let path = self.dir.join(&file);
-        write_vtu(&path, frame, &self.provenance)?;
+        write_as(&path, frame, &self.provenance, self.poly)?;
         self.entries.push((frame.time, file));
         self.write_pvd()?;
         Ok(path)
@@ -436,6 +504,9 @@ mod tests {
         .to_string();
         assert!(e.starts_with("p.vtu:2:") && e.contains("'x'"), "{e}");
         let e = parse_vtu("hello", "h.vtu").unwrap_err().to_string();
-        assert_eq!(e, "h.vtu:1: not a VTK XML UnstructuredGrid file");
+        assert_eq!(
+            e,
+            "h.vtu:1: not a VTK XML UnstructuredGrid or PolyData file"
+        );
     }
 }

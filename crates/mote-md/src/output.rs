@@ -5,7 +5,8 @@ use std::path::Path;
 
 use glam::DVec3;
 use mote_io::csv::CsvWriter;
-use mote_io::xyz::{Frame, XyzWriter};
+use mote_io::trajectory::{Format, TrajectoryWriter};
+use mote_io::xyz::Frame;
 use mote_io::Provenance;
 
 use crate::error::MdError;
@@ -132,24 +133,28 @@ impl Observer<Simulation> for ObservablesCsv {
     }
 }
 
-/// trajectory.xyz: every particle's position, velocity and radius.
-pub struct TrajectoryXyz {
-    writer: XyzWriter,
+/// The trajectory: every particle's position, velocity, radius, mass and
+/// (where present) spin and dipole, in any of mote's formats.
+pub struct Trajectory {
+    writer: TrajectoryWriter,
     every: u64,
 }
 
-impl TrajectoryXyz {
+impl Trajectory {
+    /// Writes `path` in `format` every `every` steps; `append` continues
+    /// the file of an interrupted run.
     pub fn create(
         path: &Path,
+        format: Format,
         provenance: Provenance,
         every: u64,
         append: bool,
     ) -> Result<Self, MdError> {
         Ok(Self {
             writer: if append {
-                XyzWriter::append(path, provenance)?
+                TrajectoryWriter::append(path, format, provenance, false)?
             } else {
-                XyzWriter::create(path, provenance)?
+                TrajectoryWriter::create(path, format, provenance, false)?
             },
             every,
         })
@@ -196,13 +201,13 @@ fn nonzero(v: &[DVec3]) -> Vec<[f64; 3]> {
     }
 }
 
-impl Observer<Simulation> for TrajectoryXyz {
+impl Observer<Simulation> for Trajectory {
     fn every(&self) -> u64 {
         self.every
     }
 
     fn observe(&mut self, sim: &Simulation, _obs: &Observables) -> Result<(), MdError> {
-        Ok(self.writer.write(&frame_of(&sim.system))?)
+        Ok(self.writer.write(sim.system.step, &frame_of(&sim.system))?)
     }
 
     fn files(&self) -> Vec<String> {

@@ -644,3 +644,77 @@ fn requests_too_large_for_the_machine_are_refused_at_once() {
         "{text}"
     );
 }
+
+/// `[output] trajectory_format` picks the file and its format; each reads
+/// back with the frames the XYZ has; a name it does not know is refused at
+/// its line.
+#[test]
+fn trajectory_format_chooses_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = include_str!("../../../examples/sun-earth.toml");
+    let mut frames_of = Vec::new();
+    for (format, file) in [
+        ("xyz", "trajectory.xyz"),
+        ("dump", "trajectory.dump"),
+        ("gsd", "trajectory.gsd"),
+        ("vtk", "trajectory.pvd"),
+    ] {
+        let scene = dir.path().join(format!("{format}.toml"));
+        std::fs::write(
+            &scene,
+            base.replace(
+                "trajectory_every = 20",
+                &format!("trajectory_every = 20\ntrajectory_format = \"{format}\""),
+            ),
+        )
+        .unwrap();
+        let out = format!("out_{format}");
+        let o = mote(
+            &[
+                "-q",
+                "run",
+                scene.to_str().unwrap(),
+                "--steps",
+                "100",
+                "-o",
+                &out,
+            ],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{format}: {}", stderr(&o));
+        let frames = mote_io::trajectory::read_frames(&dir.path().join(&out).join(file)).unwrap();
+        frames_of.push((format, frames));
+    }
+    let (_, xyz) = &frames_of[0];
+    assert_eq!(xyz.len(), 6);
+    for (format, frames) in &frames_of[1..] {
+        assert_eq!(frames.len(), xyz.len(), "{format}");
+        for (a, b) in frames.iter().zip(xyz) {
+            // GSD keeps f32 positions (about 1e-7 of an AU here).
+            for (p, q) in a.positions.iter().zip(&b.positions) {
+                for d in 0..3 {
+                    assert!((p[d] - q[d]).abs() < 1e-6, "{format}: {p:?} {q:?}");
+                }
+            }
+        }
+    }
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        base.replace(
+            "trajectory_every = 20",
+            "trajectory_every = 20\ntrajectory_format = \"hdf5\"",
+        ),
+    )
+    .unwrap();
+    let o = mote(
+        &["-q", "run", bad.to_str().unwrap(), "--steps", "10"],
+        dir.path(),
+    );
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("bad.toml:32:") && e.contains("'hdf5' is not one of xyz, dump, gsd, vtk"),
+        "{e}"
+    );
+}

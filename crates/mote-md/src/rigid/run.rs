@@ -10,7 +10,8 @@ use std::sync::Arc;
 use glam::DVec3;
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
-use mote_io::xyz::{Frame, XyzWriter};
+use mote_io::trajectory::TrajectoryWriter;
+use mote_io::xyz::Frame;
 use mote_io::{ParseError, Provenance};
 use mote_run::{Checkpoints, Driver, Observer, Propagator};
 
@@ -248,7 +249,7 @@ impl Observer<RigidDynamics> for RigidCsv {
 
 /// trajectory.xyz of a rigid run: the spheres of every body.
 pub struct SphereTrajectory {
-    writer: XyzWriter,
+    writer: TrajectoryWriter,
     every: u64,
 }
 
@@ -258,7 +259,7 @@ impl Observer<RigidDynamics> for SphereTrajectory {
     }
 
     fn observe(&mut self, d: &RigidDynamics, _: &RigidSample) -> Result<(), MdError> {
-        Ok(self.writer.write(&sphere_frame(&d.bodies))?)
+        Ok(self.writer.write(d.step, &sphere_frame(&d.bodies))?)
     }
 
     fn files(&self) -> Vec<String> {
@@ -391,12 +392,15 @@ pub fn run_rigid_scene(
         append,
     )?));
     if scene.output.trajectory_every > 0 {
-        let p = dir.join("trajectory.xyz");
+        let format = scene
+            .output
+            .trajectory_format(mote_io::Source::new(file_label, text))?;
+        let p = dir.join(format!("trajectory.{}", format.extension()));
         driver.observers.push(Box::new(SphereTrajectory {
             writer: if append {
-                XyzWriter::append(&p, provenance.clone())?
+                TrajectoryWriter::append(&p, format, provenance.clone(), false)?
             } else {
-                XyzWriter::create(&p, provenance.clone())?
+                TrajectoryWriter::create(&p, format, provenance.clone(), false)?
             },
             every: scene.output.trajectory_every,
         }));

@@ -5,6 +5,7 @@ use glam::DVec3;
 use serde::Deserialize;
 use toml::Spanned;
 
+use mote_io::trajectory::Format;
 use mote_io::{ParseError, Source};
 
 use super::all_free;
@@ -53,9 +54,12 @@ pub struct OutputSettings {
     /// Steps between rows of observables.csv; 0 turns it off.
     #[serde(default = "default_observables_every")]
     pub observables_every: u64,
-    /// Steps between frames of trajectory.xyz; 0 turns it off.
+    /// Steps between frames of the trajectory; 0 turns it off.
     #[serde(default = "default_trajectory_every")]
     pub trajectory_every: u64,
+    /// Format of the trajectory: `xyz` (default), `dump`, `gsd` or `vtk`;
+    /// the file is `trajectory.<xyz|dump|gsd|pvd>`.
+    pub trajectory_format: Option<Spanned<String>>,
     /// Per-particle quantities added to observables.csv, e.g. `["z[30]", "speed[1]"]`.
     #[serde(default)]
     pub inspect: Vec<Spanned<String>>,
@@ -74,6 +78,7 @@ impl Default for OutputSettings {
             dir: None,
             observables_every: default_observables_every(),
             trajectory_every: default_trajectory_every(),
+            trajectory_format: None,
             inspect: Vec::new(),
         }
     }
@@ -149,6 +154,23 @@ impl RunSettings {
 }
 
 impl OutputSettings {
+    /// The trajectory's format (`trajectory_format`, default extended XYZ).
+    pub fn trajectory_format(&self, src: Source) -> Result<Format, ParseError> {
+        match &self.trajectory_format {
+            None => Ok(Format::Xyz),
+            Some(f) => Format::named(f.get_ref()).ok_or_else(|| {
+                src.error(
+                    f.span(),
+                    format!(
+                        "trajectory_format '{}' is not one of {}",
+                        f.get_ref(),
+                        Format::NAMES
+                    ),
+                )
+            }),
+        }
+    }
+
     /// The per-particle columns of `inspect`, checked against the `n` particles.
     pub fn probes(&self, src: Source, n: usize) -> Result<Vec<Probe>, ParseError> {
         let mut probes = Vec::new();

@@ -74,8 +74,9 @@ pub struct PackArgs {
     /// 1000/max-pressure: force-bearing gaps are ~1/Z).
     #[arg(long)]
     tol: Option<f64>,
-    /// The packing, as extended XYZ with radii; also writes STEM.csv (φ and
-    /// pressure per window) and STEM.pov (POV-Ray scene) beside it.
+    /// The packing, in the format of the extension (.xyz extended XYZ, .dump
+    /// LAMMPS, .gsd HOOMD, .pvd VTK), numbers exact; also writes STEM.csv (φ
+    /// and pressure per window) and STEM.pov (POV-Ray scene) beside it.
     #[arg(long, short = 'o', value_name = "FILE")]
     output: Option<PathBuf>,
     /// Render the packing to this PNG.
@@ -198,7 +199,7 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
 
 fn analyse_cmd(global: &GlobalOpts, a: &AnalyseArgs) -> anyhow::Result<ExitCode> {
     let quiet = global.quiet;
-    let frames = mote_io::xyz::read_frames(&a.file)?;
+    let frames = mote_io::trajectory::read_frames(&a.file)?;
     let frame = frames
         .last()
         .with_context(|| format!("{}: no frame in the file", a.file.display()))?;

@@ -238,27 +238,7 @@ fn read_trajectory(path: &Path) -> anyhow::Result<Vec<Frame>> {
 }
 
 fn read_any(path: &Path) -> anyhow::Result<Vec<Frame>> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    Ok(match ext.as_str() {
-        "xyz" | "extxyz" => mote_io::xyz::read_frames(path)?,
-        "dump" | "lammpstrj" => mote_io::lammps_dump::read_frames(path)?
-            .into_iter()
-            .map(|d| d.frame)
-            .collect(),
-        "vtu" => vec![mote_io::vtu::read_vtu(path)?],
-        "pvd" => mote_io::vtu::read_pvd(path)?
-            .into_iter()
-            .map(|(_, p)| mote_io::vtu::read_vtu(&p))
-            .collect::<Result<_, _>>()?,
-        _ => bail!(
-            "{}: unknown trajectory format; expected .xyz, .dump, .lammpstrj, .vtu or .pvd",
-            path.display()
-        ),
-    })
+    Ok(mote_io::trajectory::read_frames(path)?)
 }
 
 /// `dir/name.png` → `dir/name_00042.png`.
