@@ -1,23 +1,76 @@
-//! LAMMPS data files of granular spheres (`atom_style sphere`): the header
-//! (atom count, box bounds) and the `Atoms # sphere` section, whose rows are
-//! `id type diameter density x y z` (optionally followed by image flags).
-//! Other sections (Velocities, ...) are read where mote uses them:
-//! `Velocities` rows `id vx vy vz wx wy wz`.
+//! LAMMPS data files: the header (atom count, box bounds), `Masses`,
+//! `Atoms` and `Velocities`. Atom styles (named by the comment after
+//! `Atoms`, as LAMMPS' `write_data` and OVITO write it):
+//!
+//! | style | columns |
+//! |---|---|
+//! | `atomic` | id type x y z |
+//! | `charge` | id type q x y z |
+//! | `molecular`, `bond`, `angle` | id mol type x y z |
+//! | `full` | id mol type q x y z |
+//! | `sphere` | id type diameter density x y z |
+//!
+//! each optionally followed by three image flags. Without the comment a row
+//! of 5 (or 8) values is `atomic` and one of 7 (or 10) `sphere`; other
+//! widths are refused with a message asking for the style. `Velocities`
+//! rows are `id vx vy vz`, with `wx wy wz` for spheres. mote's boxes are
+//! orthorhombic: tilt factors (`xy xz yz`) other than zero and general
+//! triclinic cells (`avec bvec cvec`) that are not axis-aligned are refused
+//! at their line, never read as a zero box.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use crate::ParseError;
 
-/// One sphere of a data file.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// One atom of a data file (fields a style lacks are 0, or `None`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SphereAtom {
     pub id: u64,
     pub kind: u32,
+    /// Sphere style: diameter and density.
     pub diameter: f64,
     pub density: f64,
+    /// From `Masses` for the point styles (0 where none is given).
+    pub mass: f64,
+    pub charge: f64,
+    pub molecule: Option<u64>,
     pub position: [f64; 3],
     pub velocity: [f64; 3],
     pub angular_velocity: [f64; 3],
+}
+
+/// An atom style mote reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AtomStyle {
+    Atomic,
+    Charge,
+    Molecular,
+    Full,
+    #[default]
+    Sphere,
+}
+
+impl AtomStyle {
+    fn named(name: &str) -> Option<Self> {
+        Some(match name {
+            "atomic" => AtomStyle::Atomic,
+            "charge" => AtomStyle::Charge,
+            "molecular" | "bond" | "angle" => AtomStyle::Molecular,
+            "full" => AtomStyle::Full,
+            "sphere" => AtomStyle::Sphere,
+            _ => return None,
+        })
+    }
+
+    /// Values of a row without image flags.
+    fn width(self) -> usize {
+        match self {
+            AtomStyle::Atomic => 5,
+            AtomStyle::Charge | AtomStyle::Molecular => 6,
+            AtomStyle::Full | AtomStyle::Sphere => 7,
+        }
+    }
 }
 
 /// The contents of a data file, atoms in the file's order.
@@ -25,6 +78,9 @@ pub struct SphereAtom {
 pub struct DataFile {
     pub lo: [f64; 3],
     pub hi: [f64; 3],
+    /// Whether the header gave the bounds of each axis.
+    pub bounded: [bool; 3],
+    pub style: AtomStyle,
     pub atoms: Vec<SphereAtom>,
 }
 
@@ -42,8 +98,12 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
     let mut data = DataFile::default();
     let mut expected: Option<usize> = None;
     let mut section = "";
+    let mut style: Option<AtomStyle> = None;
+    let mut masses: HashMap<u32, f64> = HashMap::new();
+    let mut general = [[0.0f64; 3]; 4];
+    let mut general_given = 0;
     let lines = text.lines().enumerate().skip(1); // the first line is a title
-    let mut ids = std::collections::HashMap::new();
+    let mut ids = HashMap::new();
     for (k, raw) in lines {
         let line_no = k + 1;
         let line = raw.split('#').next().unwrap_or("").trim();
@@ -63,18 +123,20 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
         {
             section = match words[0] {
                 "Atoms" => {
-                    if let Some(style) = raw.split('#').nth(1) {
-                        let style = style.trim();
-                        if !style.is_empty() && style != "sphere" {
-                            return Err(err(
-                                line_no,
-                                format!("Atoms are '{style}': mote reads atom_style sphere (id type diameter density x y z)"),
-                            ));
+                    if let Some(name) = raw.split('#').nth(1).map(str::trim) {
+                        if !name.is_empty() {
+                            style = Some(AtomStyle::named(name).ok_or_else(|| {
+                                err(
+                                    line_no,
+                                    format!("Atoms are '{name}': mote reads the styles atomic, charge, molecular, full and sphere"),
+                                )
+                            })?);
                         }
                     }
                     "atoms"
                 }
                 "Velocities" => "velocities",
+                "Masses" => "masses",
                 _ => "other",
             };
             continue;
@@ -95,35 +157,114 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
                 };
                 data.lo[k] = num(lo)?;
                 data.hi[k] = num(hi)?;
+                data.bounded[k] = true;
+            }
+            ("", [a, b, c, "xy", "xz", "yz"]) => {
+                let tilt = [num(a)?, num(b)?, num(c)?];
+                if tilt != [0.0; 3] {
+                    return Err(err(
+                        line_no,
+                        "a triclinic box (tilt factors xy xz yz not 0): mote's boxes are orthorhombic".into(),
+                    ));
+                }
+            }
+            ("", [x, y, z, which @ ("avec" | "bvec" | "cvec")]) => {
+                let row = match *which {
+                    "avec" => 0,
+                    "bvec" => 1,
+                    _ => 2,
+                };
+                general[row] = [num(x)?, num(y)?, num(z)?];
+                general_given += 1;
+                let axis_aligned = (0..3).all(|d| d == row || general[row][d] == 0.0);
+                if !axis_aligned {
+                    return Err(err(
+                        line_no,
+                        format!("a general triclinic box ({which} not along its axis): mote's boxes are orthorhombic"),
+                    ));
+                }
+            }
+            ("", [x, y, z, "abc", "origin"]) => {
+                general[3] = [num(x)?, num(y)?, num(z)?];
+                general_given += 1;
             }
             ("", _) => {}
+            ("masses", [t, m, ..]) => {
+                let t: u32 = t
+                    .parse()
+                    .map_err(|_| err(line_no, format!("'{t}' is not an atom type")))?;
+                masses.insert(t, num(m)?);
+            }
             ("atoms", w) => {
-                if w.len() < 7 {
+                let style = match style {
+                    Some(s) => s,
+                    None => {
+                        let inferred = match w.len() {
+                            5 | 8 => AtomStyle::Atomic,
+                            7 | 10 => AtomStyle::Sphere,
+                            n => {
+                                return Err(err(
+                                    line_no,
+                                    format!("an atom row of {n} values, and no style after 'Atoms #': name it (atomic, charge, molecular, full or sphere)"),
+                                ))
+                            }
+                        };
+                        *style.insert(inferred)
+                    }
+                };
+                let width = style.width();
+                if w.len() != width && w.len() != width + 3 {
                     return Err(err(
                         line_no,
                         format!(
-                            "an atom row needs 7 values (id type diameter density x y z), found {}",
+                            "an atom row of style {style:?} needs {width} values (or {} with image flags), found {}",
+                            width + 3,
                             w.len()
                         ),
                     ));
                 }
-                let id: u64 = w[0]
-                    .parse()
-                    .map_err(|_| err(line_no, format!("'{}' is not an atom id", w[0])))?;
-                let kind: u32 = w[1]
-                    .parse()
-                    .map_err(|_| err(line_no, format!("'{}' is not an atom type", w[1])))?;
-                let atom = SphereAtom {
-                    id,
-                    kind,
-                    diameter: num(w[2])?,
-                    density: num(w[3])?,
-                    position: [num(w[4])?, num(w[5])?, num(w[6])?],
-                    velocity: [0.0; 3],
-                    angular_velocity: [0.0; 3],
+                let whole = |w: &str, what: &str| -> Result<u64, ParseError> {
+                    w.parse()
+                        .map_err(|_| err(line_no, format!("'{w}' is not {what}")))
                 };
-                if atom.diameter <= 0.0 || atom.density <= 0.0 {
-                    return Err(err(line_no, "diameter and density must be positive".into()));
+                let id = whole(w[0], "an atom id")?;
+                let mut atom = SphereAtom {
+                    id,
+                    ..SphereAtom::default()
+                };
+                let xyz = |at: usize| -> Result<[f64; 3], ParseError> {
+                    Ok([num(w[at])?, num(w[at + 1])?, num(w[at + 2])?])
+                };
+                let kind_at = match style {
+                    AtomStyle::Molecular | AtomStyle::Full => {
+                        atom.molecule = Some(whole(w[1], "a molecule id")?);
+                        2
+                    }
+                    _ => 1,
+                };
+                atom.kind = whole(w[kind_at], "an atom type")? as u32;
+                match style {
+                    AtomStyle::Atomic => atom.position = xyz(2)?,
+                    AtomStyle::Charge => {
+                        atom.charge = num(w[2])?;
+                        atom.position = xyz(3)?;
+                    }
+                    AtomStyle::Molecular => atom.position = xyz(3)?,
+                    AtomStyle::Full => {
+                        atom.charge = num(w[3])?;
+                        atom.position = xyz(4)?;
+                    }
+                    AtomStyle::Sphere => {
+                        atom.diameter = num(w[2])?;
+                        atom.density = num(w[3])?;
+                        atom.position = xyz(4)?;
+                        if atom.diameter <= 0.0 || atom.density <= 0.0 {
+                            return Err(err(
+                                line_no,
+                                "diameter and density must be positive".into(),
+                            ));
+                        }
+                    }
                 }
                 if ids.insert(id, data.atoms.len()).is_some() {
                     return Err(err(line_no, format!("atom id {id} appears twice")));
@@ -131,10 +272,16 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
                 data.atoms.push(atom);
             }
             ("velocities", w) => {
-                if w.len() < 7 {
+                let sphere = style == Some(AtomStyle::Sphere);
+                let need = if sphere { 7 } else { 4 };
+                if w.len() < need {
                     return Err(err(
                         line_no,
-                        "a velocity row needs id vx vy vz wx wy wz".into(),
+                        if sphere {
+                            "a velocity row needs id vx vy vz wx wy wz".into()
+                        } else {
+                            "a velocity row needs id vx vy vz".into()
+                        },
                     ));
                 }
                 let id: u64 = w[0]
@@ -144,9 +291,25 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
                     .get(&id)
                     .ok_or_else(|| err(line_no, format!("velocity of unknown atom {id}")))?;
                 data.atoms[i].velocity = [num(w[1])?, num(w[2])?, num(w[3])?];
-                data.atoms[i].angular_velocity = [num(w[4])?, num(w[5])?, num(w[6])?];
+                if sphere {
+                    data.atoms[i].angular_velocity = [num(w[4])?, num(w[5])?, num(w[6])?];
+                }
             }
             _ => {}
+        }
+    }
+    if general_given > 0 {
+        if general_given != 4 {
+            return Err(err(
+                0,
+                "a general triclinic box needs avec, bvec, cvec and abc origin".into(),
+            ));
+        }
+        let origin = general[3];
+        for (d, edge) in general[..3].iter().enumerate() {
+            data.lo[d] = origin[d];
+            data.hi[d] = origin[d] + edge[d];
+            data.bounded[d] = true;
         }
     }
     if let Some(n) = expected {
@@ -162,6 +325,10 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
     }
     if data.atoms.is_empty() {
         return Err(err(0, "no Atoms section".into()));
+    }
+    data.style = style.unwrap_or_default();
+    for a in &mut data.atoms {
+        a.mass = masses.get(&a.kind).copied().unwrap_or(0.0);
     }
     Ok(data)
 }
@@ -179,6 +346,44 @@ mod tests {
         assert_eq!(d.hi, [0.1, 0.1, 0.15]);
         assert_eq!(d.atoms[1].position, [0.05, 0.05, 0.05]);
         assert_eq!(d.atoms[0].diameter, 0.004);
+    }
+
+    /// The point styles with their masses and velocities; triclinic boxes
+    /// refused at their line; OVITO's axis-aligned general box read (it
+    /// used to give a zero box).
+    #[test]
+    fn reads_common_styles_and_refuses_tilted_boxes() {
+        let head = "title\n\n2 atoms\n2 atom types\n\n-1 1 xlo xhi\n0 2 ylo yhi\n0 3 zlo zhi\n\nMasses\n\n1 39.948\n2 4.0\n\n";
+        for (style, rows) in [
+            ("atomic", "1 1 0.5 0.5 0.5\n2 2 0.25 1 2 0 0 0\n"),
+            ("charge", "1 1 -1 0.5 0.5 0.5\n2 2 1 0.25 1 2\n"),
+            ("full", "1 7 1 -1 0.5 0.5 0.5\n2 7 2 1 0.25 1 2\n"),
+        ] {
+            let text =
+                format!("{head}Atoms # {style}\n\n{rows}\nVelocities\n\n1 1 2 3\n2 0 0 -1\n");
+            let d = parse(&text, "s.data").unwrap();
+            assert_eq!((d.lo, d.hi), ([-1.0, 0.0, 0.0], [1.0, 2.0, 3.0]), "{style}");
+            assert_eq!(d.atoms[1].position, [0.25, 1.0, 2.0], "{style}");
+            assert_eq!((d.atoms[0].mass, d.atoms[1].mass), (39.948, 4.0), "{style}");
+            assert_eq!(d.atoms[0].velocity, [1.0, 2.0, 3.0], "{style}");
+            assert_eq!(d.atoms[1].kind, 2, "{style}");
+            if style != "atomic" {
+                assert_eq!(d.atoms[0].charge, -1.0, "{style}");
+            }
+        }
+        let tilted = TEXT.replace("0 0.15 zlo zhi\n", "0 0.15 zlo zhi\n0.01 0 0 xy xz yz\n");
+        let e = parse(&tilted, "t.data").unwrap_err();
+        assert_eq!(e.line, 9);
+        assert!(e.message.contains("triclinic"), "{}", e.message);
+        let general = "title\n\n1 atoms\n1 atom types\n\n2 0 0 avec\n0 3 0 bvec\n0 0 4 cvec\n-1 -1 -1 abc origin\n\nAtoms # atomic\n\n1 1 0 0 0\n";
+        let d = parse(general, "g.data").unwrap();
+        assert_eq!((d.lo, d.hi), ([-1.0; 3], [1.0, 2.0, 3.0]));
+        let skew = general.replace("0 3 0 bvec", "1 3 0 bvec");
+        let e = parse(&skew, "g.data").unwrap_err();
+        assert_eq!(e.line, 7);
+        let unnamed = "title\n\n1 atoms\n\nAtoms\n\n1 1 7 0 0 0\n";
+        let e = parse(unnamed, "u.data").unwrap_err();
+        assert!(e.message.contains("name it"), "{}", e.message);
     }
 
     #[test]

@@ -17,7 +17,8 @@
 //!
 //! Particles are numbered in this order: `[[particle]]` tables, then
 //! `[[lattice]]`, `[[ring]]`, `[[annulus]]`, `[[random_box]]`, `[[fcc]]`,
-//! `[[cloud]]` and `[[plummer]]` generators, then `[[lammps_data]]` files,
+//! `[[cloud]]` and `[[plummer]]` generators, then `[[lammps_data]]` and
+//! `[[from_file]]` files,
 //! each in file order.
 
 pub mod bath;
@@ -107,6 +108,8 @@ pub struct Scene {
     pub cloud: Vec<Spanned<CloudSpec>>,
     #[serde(default)]
     pub lammps_data: Vec<Spanned<DataSpec>>,
+    #[serde(default)]
+    pub from_file: Vec<Spanned<DataSpec>>,
     #[serde(default)]
     pub spring: Vec<Spanned<SpringSpec>>,
     #[serde(default)]

@@ -212,14 +212,173 @@ pub struct CloudSpec {
     pub props: Properties,
 }
 
-/// `[[lammps_data]]`: spheres from a LAMMPS data file (`atom_style sphere`:
-/// id type diameter density x y z), path relative to the scene file.
+/// `[[from_file]]` (and its older name `[[lammps_data]]`): particles from a
+/// file, path relative to the scene file: a LAMMPS data file (`.data`,
+/// `.lmp`: the styles of [`mote_io::lammps_data`]) or a frame of a
+/// trajectory (`.xyz`, `.dump`, `.gsd`, `.vtu`/`.vtp`/`.pvd`; the last
+/// frame unless `frame` says which, negative counting from the end).
+/// Positions, velocities, radii, masses and spins come from the file where
+/// it has them; `radius`, `mass` or `density` fill in what it lacks. A
+/// scene without `[box]` takes the box of a trajectory frame with periodic
+/// axes; a data file does not say which axes are periodic, so its box is
+/// taken only with `periodic = [..]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DataSpec {
     pub file: String,
+    pub frame: Option<i64>,
+    /// Take a data file's box, periodic on these axes.
+    pub periodic: Option<[bool; 3]>,
+    pub radius: Option<f64>,
+    pub mass: Option<f64>,
+    /// Masses from the radii, m = ρ 4π r³/3 (for files without masses).
+    pub density: Option<f64>,
     #[serde(default = "white")]
     pub color: [f64; 3],
+}
+
+/// The particles of one `[[from_file]]`, and the file's box if it has one.
+/// `data`: read it as a LAMMPS data file whatever its name (`[[lammps_data]]`).
+/// Errors in the file name its own lines; the others come back as
+/// messages for the scene's line (`at`).
+fn from_file(
+    s: &DataSpec,
+    path: &std::path::Path,
+    data: bool,
+    at: &dyn Fn(String) -> ParseError,
+) -> Result<(Vec<ParticleInit>, Option<crate::boundary::Boundary>), ParseError> {
+    let io = |e: mote_io::IoError| match e {
+        mote_io::IoError::Parse(p) if p.line > 0 => p,
+        other => at(other.to_string()),
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    // LAMMPS names data files data.NAME or NAME.data.
+    let data = data
+        || matches!(ext.as_str(), "data" | "lmp" | "lammps")
+        || path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| n.starts_with("data."));
+    let fill = |radius: f64, mass: f64| -> Result<(f64, f64), ParseError> {
+        let r = if radius > 0.0 {
+            radius
+        } else {
+            s.radius.unwrap_or(0.0)
+        };
+        let m = if mass > 0.0 {
+            mass
+        } else if let Some(m) = s.mass {
+            m
+        } else if let Some(rho) = s.density {
+            sphere_mass(rho, r)
+        } else {
+            return Err(at(format!(
+                "{}: the file gives no mass: set mass or density",
+                path.display()
+            )));
+        };
+        Ok((r, m))
+    };
+    if data {
+        let data = mote_io::lammps_data::read(path).map_err(|e| io(e.into()))?;
+        let mut out = Vec::with_capacity(data.atoms.len());
+        for a in &data.atoms {
+            let radius = 0.5 * a.diameter;
+            let mass = if a.density > 0.0 {
+                sphere_mass(a.density, radius)
+            } else {
+                a.mass
+            };
+            let (radius, mass) = fill(radius, mass)?;
+            out.push(ParticleInit {
+                position: DVec3::from(a.position),
+                velocity: DVec3::from(a.velocity),
+                angular_velocity: DVec3::from(a.angular_velocity),
+                mass,
+                radius,
+                charge: a.charge,
+                color: s.color,
+                ..ParticleInit::default()
+            });
+        }
+        let boundary = match s.periodic {
+            Some(periodic) if data.bounded.iter().all(|b| *b) => Some(crate::boundary::Boundary {
+                lo: DVec3::from(data.lo),
+                hi: DVec3::from(data.hi),
+                periodic,
+            }),
+            Some(_) => {
+                return Err(at(format!(
+                    "{}: periodic is set but the file gives no box (xlo xhi, ylo yhi, zlo zhi)",
+                    path.display()
+                )))
+            }
+            None => None,
+        };
+        return Ok((out, boundary));
+    }
+    let frames = mote_io::trajectory::read_frames(path).map_err(io)?;
+    let k = match s.frame {
+        None => frames.len() as i64 - 1,
+        Some(f) if f < 0 => frames.len() as i64 + f,
+        Some(f) => f,
+    };
+    let f = usize::try_from(k)
+        .ok()
+        .and_then(|k| frames.get(k))
+        .ok_or_else(|| {
+            at(format!(
+                "{}: no frame {} among its {} frames",
+                path.display(),
+                s.frame.unwrap_or(-1),
+                frames.len()
+            ))
+        })?;
+    let n = f.positions.len();
+    let get = |v: &Vec<[f64; 3]>, i: usize| {
+        if v.len() == n {
+            DVec3::from(v[i])
+        } else {
+            DVec3::ZERO
+        }
+    };
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let (radius, mass) = fill(
+            f.radii.get(i).copied().unwrap_or(0.0),
+            f.masses.get(i).copied().unwrap_or(0.0),
+        )?;
+        out.push(ParticleInit {
+            position: DVec3::from(f.positions[i]),
+            velocity: get(&f.velocities, i),
+            angular_velocity: get(&f.angular_velocities, i),
+            dipole: get(&f.dipoles, i),
+            mass,
+            radius,
+            color: s.color,
+            ..ParticleInit::default()
+        });
+    }
+    let c = f.cell;
+    let orthogonal = c[0][1] == 0.0
+        && c[0][2] == 0.0
+        && c[1][0] == 0.0
+        && c[1][2] == 0.0
+        && c[2][0] == 0.0
+        && c[2][1] == 0.0;
+    let boundary = (f.pbc.iter().any(|p| *p) && orthogonal).then(|| {
+        let lo = DVec3::from(f.origin);
+        crate::boundary::Boundary {
+            lo,
+            hi: lo + DVec3::new(c[0][0], c[1][1], c[2][2]),
+            periodic: f.pbc,
+        }
+    });
+    Ok((out, boundary))
 }
 
 /// `[[fcc]]`: a face-centred cubic crystal at a number density, with
@@ -584,36 +743,26 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
             displacements.push(DVec3::ZERO);
         }
     }
-    for spec in &scene.lammps_data {
+    let data_files = scene.lammps_data.iter().map(|s| (s, true));
+    for (spec, data) in data_files.chain(scene.from_file.iter().map(|s| (s, false))) {
         let s = spec.get_ref();
         let path = std::path::Path::new(file)
             .parent()
             .unwrap_or(std::path::Path::new("."))
             .join(&s.file);
-        let data = mote_io::lammps_data::read(&path).map_err(|e| {
-            if e.line == 0 && e.message.starts_with("cannot read") {
-                err(spec.span(), format!("{}: {}", path.display(), e.message))
-            } else {
-                e
-            }
-        })?;
-        for a in &data.atoms {
-            let radius = 0.5 * a.diameter;
-            inits.push(ParticleInit {
-                position: DVec3::from(a.position),
-                velocity: DVec3::from(a.velocity),
-                angular_velocity: DVec3::from(a.angular_velocity),
-                mass: sphere_mass(a.density, radius),
-                radius,
-                color: s.color,
-                ..ParticleInit::default()
-            });
+        let at = |m: String| err(spec.span(), m);
+        let (made, file_box) = from_file(s, &path, data, &at)?;
+        if fcc_box.is_none() {
+            fcc_box = file_box;
+        }
+        for p in made {
+            inits.push(p);
             displacements.push(DVec3::ZERO);
         }
     }
     let n = inits.len();
     if n == 0 {
-        return Err(src.whole("the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]], [[fcc]], [[cloud]], [[plummer]]) or [[lammps_data]]"));
+        return Err(src.whole("the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]], [[fcc]], [[cloud]], [[plummer]]) or [[from_file]]"));
     }
     for spec in &scene.spring {
         let s = spec.get_ref();

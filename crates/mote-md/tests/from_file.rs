@@ -1,0 +1,123 @@
+//! `[[from_file]]`: a scene starts from a file another program (or mote)
+//! wrote: a LAMMPS data file in a point style with `Masses`, or a frame of
+//! a GSD or XYZ trajectory; the box comes with it where the file says it
+//! is periodic. Before, `[[lammps_data]]` read only atom_style sphere and
+//! dropped the box.
+
+use mote_io::trajectory::{Format, TrajectoryWriter};
+use mote_io::xyz::Frame;
+use mote_io::Provenance;
+use mote_md::scene::Scene;
+use mote_md::DVec3;
+
+fn build(dir: &std::path::Path, text: &str) -> Result<mote_md::System, String> {
+    let label = dir.join("scene.toml");
+    let label = label.to_str().unwrap();
+    let scene = Scene::parse(text, label).map_err(|e| e.to_string())?;
+    let built = scene.build(text, label, 1).map_err(|e| e.to_string())?;
+    Ok(built.simulation.system)
+}
+
+const RUN: &str = "[run]\ndt = 0.001\nsteps = 1\n";
+
+#[test]
+fn a_lammps_data_file_in_atomic_style_with_its_box() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("argon.data"),
+        "LAMMPS data file\n\n2 atoms\n1 atom types\n\n0 10 xlo xhi\n0 10 ylo yhi\n-5 5 zlo zhi\n\n\
+         Masses\n\n1 39.948\n\nAtoms # atomic\n\n1 1 1 2 3\n2 1 4 5 -1 0 0 0\n\nVelocities\n\n1 0.5 0 0\n2 0 0 -0.5\n",
+    )
+    .unwrap();
+    let sys = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"argon.data\"\nradius = 0.5\nperiodic = [true, true, false]\n"),
+    )
+    .unwrap();
+    let p = &sys.particles;
+    assert_eq!(
+        p.position,
+        [DVec3::new(1.0, 2.0, 3.0), DVec3::new(4.0, 5.0, -1.0)]
+    );
+    assert_eq!(p.velocity[1], DVec3::new(0.0, 0.0, -0.5));
+    assert_eq!(p.mass, [39.948, 39.948]);
+    assert_eq!(p.radius, [0.5, 0.5]);
+    assert_eq!(sys.boundary.lo, DVec3::new(0.0, 0.0, -5.0));
+    assert_eq!(sys.boundary.hi, DVec3::new(10.0, 10.0, 5.0));
+    assert_eq!(sys.boundary.periodic, [true, true, false]);
+    // Without `periodic` the data file's box is not taken (it does not say
+    // which axes are periodic); without masses and `mass`, a message.
+    let sys = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"argon.data\"\n"),
+    )
+    .unwrap();
+    assert!(!sys.boundary.is_periodic());
+    std::fs::write(
+        dir.path().join("bare.data"),
+        "t\n\n1 atoms\n\nAtoms # atomic\n\n1 1 0 0 0\n",
+    )
+    .unwrap();
+    let e = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"bare.data\"\n"),
+    )
+    .unwrap_err();
+    assert!(e.contains("scene.toml:4:") && e.contains("no mass"), "{e}");
+    // An error inside the file names the file's line.
+    std::fs::write(
+        dir.path().join("bad.data"),
+        "t\n\n1 atoms\n\nAtoms # atomic\n\n1 1 0 zero 0\n",
+    )
+    .unwrap();
+    let e = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"bad.data\"\nmass = 1\n"),
+    )
+    .unwrap_err();
+    assert!(e.contains("bad.data:7:") && e.contains("'zero'"), "{e}");
+}
+
+#[test]
+fn a_frame_of_a_gsd_trajectory_with_its_periodic_box() {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = |t: f64| Frame {
+        time: t,
+        cell: [[4.0, 0.0, 0.0], [0.0, 5.0, 0.0], [0.0, 0.0, 6.0]],
+        origin: [-2.0, 0.0, 1.0],
+        pbc: [true; 3],
+        species: vec!["X".into(); 2],
+        positions: vec![[0.0, 1.0, 2.0], [1.0 + t, 3.0, 4.0]],
+        velocities: vec![[0.1, 0.0, 0.0], [0.0, 0.2, 0.0]],
+        radii: vec![0.5, 0.25],
+        masses: vec![2.0, 3.0],
+        ..Frame::default()
+    };
+    let path = dir.path().join("start.gsd");
+    let mut w = TrajectoryWriter::create(&path, Format::Gsd, Provenance::default(), true).unwrap();
+    w.write(0, &frame(0.0)).unwrap();
+    w.write(1, &frame(0.5)).unwrap();
+    drop(w);
+    for (frame_key, x) in [("", 1.5), ("frame = 0\n", 1.0), ("frame = -2\n", 1.0)] {
+        let sys = build(
+            dir.path(),
+            &format!("{RUN}[[from_file]]\nfile = \"start.gsd\"\n{frame_key}"),
+        )
+        .unwrap();
+        let p = &sys.particles;
+        assert_eq!(p.position[1], DVec3::new(x, 3.0, 4.0), "{frame_key}");
+        assert_eq!(
+            (p.mass.clone(), p.radius.clone()),
+            (vec![2.0, 3.0], vec![0.5, 0.25])
+        );
+        assert_eq!(sys.boundary.lo, DVec3::new(-2.0, 0.0, 1.0));
+        assert_eq!(sys.boundary.hi, DVec3::new(2.0, 5.0, 7.0));
+        assert_eq!(sys.boundary.periodic, [true; 3]);
+    }
+    let e = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"start.gsd\"\nframe = 5\n"),
+    )
+    .unwrap_err();
+    assert!(e.contains("no frame 5 among its 2 frames"), "{e}");
+}
