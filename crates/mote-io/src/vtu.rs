@@ -196,33 +196,179 @@ fn write_to(
     Ok(())
 }
 
-/// The numbers between `<DataArray ... Name="name" ...>` and `</DataArray>`, and
-/// the line where the array starts.
-fn array<'a>(text: &'a str, name: &str) -> Option<(usize, &'a str)> {
+/// The opening tag of `<DataArray ... Name="name" ...>`, the text up to
+/// `</DataArray>`, and the line where the array starts.
+fn array<'a>(text: &'a str, name: &str) -> Option<(usize, &'a str, &'a str)> {
     let key = format!("Name=\"{name}\"");
     let at = text.find(&key)?;
+    let tag_start = text[..at].rfind('<')?;
     let open = at + text[at..].find('>')? + 1;
     let close = open + text[open..].find("</DataArray>")?;
     let line = text[..at].matches('\n').count() + 1;
-    Some((line, &text[open..close]))
+    Some((line, &text[tag_start..open], &text[open..close]))
+}
+
+/// The value of `key="value"` in a tag.
+fn attribute<'a>(tag: &'a str, key: &str) -> Option<&'a str> {
+    let pat = format!(" {key}=\"");
+    let s = tag.find(&pat)? + pat.len();
+    Some(&tag[s..s + tag[s..].find('"')?])
+}
+
+/// Standard base64 (RFC 4648), whitespace ignored.
+fn base64(text: &str) -> Option<Vec<u8>> {
+    let value = |c: u8| -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => return None,
+        } as u32)
+    };
+    let chars: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
+    let mut out = Vec::with_capacity(chars.len() / 4 * 3);
+    for group in chars.chunks(4) {
+        let pad = group.iter().rev().take_while(|&&c| c == b'=').count();
+        if group.len() < 2 || pad > 2 {
+            return None;
+        }
+        let mut n = 0u32;
+        for (k, &c) in group.iter().enumerate() {
+            let v = if c == b'=' { 0 } else { value(c)? };
+            n |= v << (18 - 6 * k);
+        }
+        let bytes = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
+        out.extend_from_slice(&bytes[..group.len() - 1 - pad.min(group.len() - 1)]);
+    }
+    Some(out)
+}
+
+/// The bytes of a `format="binary"` array: a header (a byte count, or for
+/// zlib-compressed files the block table) and the data, base64-encoded
+/// together or separately (VTK does both).
+fn binary_bytes(body: &str, header: usize, zlib: bool) -> Result<Vec<u8>, String> {
+    let chars: String = body.chars().filter(|c| !c.is_whitespace()).collect();
+    let bad = || "bad base64".to_string();
+    let word = |b: &[u8], k: usize| -> usize {
+        let mut v = [0u8; 8];
+        v[..header].copy_from_slice(&b[k * header..(k + 1) * header]);
+        u64::from_le_bytes(v) as usize
+    };
+    let first = base64(chars.get(..(header.div_ceil(3) * 4)).ok_or_else(bad)?).ok_or_else(bad)?;
+    if first.len() < header {
+        return Err(bad());
+    }
+    let blocks = word(&first, 0);
+    if zlib && blocks > chars.len() {
+        return Err(format!(
+            "a header of {blocks} compressed blocks in {} characters",
+            chars.len()
+        ));
+    }
+    let words = if zlib { 3 + blocks } else { 1 };
+    let size = words * header;
+    let head_chars = size.div_ceil(3) * 4;
+    let separate = chars.as_bytes().get(head_chars.wrapping_sub(1)) == Some(&b'=');
+    let (head, data) = if separate {
+        let head = base64(chars.get(..head_chars).ok_or_else(bad)?).ok_or_else(bad)?;
+        let data = base64(&chars[head_chars..]).ok_or_else(bad)?;
+        (head, data)
+    } else {
+        let all = base64(&chars).ok_or_else(bad)?;
+        if all.len() < size {
+            return Err("binary array shorter than its header".into());
+        }
+        (all[..size].to_vec(), all[size..].to_vec())
+    };
+    if !zlib {
+        let n = word(&head, 0);
+        return data
+            .get(..n)
+            .map(<[u8]>::to_vec)
+            .ok_or_else(|| format!("binary array of {} bytes, header says {n}", data.len()));
+    }
+    if head.len() < size {
+        return Err(bad());
+    }
+    let mut out = Vec::new();
+    let mut at = 0usize;
+    for k in 0..blocks {
+        let csize = word(&head, 3 + k);
+        let end = at.checked_add(csize).filter(|&e| e <= data.len());
+        let block = end
+            .map(|e| &data[at..e])
+            .ok_or_else(|| "compressed block past the end of the array".to_string())?;
+        at += csize;
+        let mut z = flate2::read::ZlibDecoder::new(block);
+        std::io::Read::read_to_end(&mut z, &mut out).map_err(|e| format!("zlib: {e}"))?;
+    }
+    Ok(out)
+}
+
+/// Little-endian values of a VTK type as f64.
+fn decode(bytes: &[u8], kind: &str) -> Option<Vec<f64>> {
+    macro_rules! each {
+        ($t:ty) => {
+            bytes
+                .chunks_exact(std::mem::size_of::<$t>())
+                .map(|b| <$t>::from_le_bytes(b.try_into().unwrap_or_default()) as f64)
+                .collect()
+        };
+    }
+    Some(match kind {
+        "Float64" => each!(f64),
+        "Float32" => each!(f32),
+        "Int8" => each!(i8),
+        "UInt8" => each!(u8),
+        "Int16" => each!(i16),
+        "UInt16" => each!(u16),
+        "Int32" => each!(i32),
+        "UInt32" => each!(u32),
+        "Int64" => each!(i64),
+        "UInt64" => each!(u64),
+        _ => return None,
+    })
 }
 
 fn numbers(text: &str, fname: &str, name: &str) -> Result<Vec<f64>, ParseError> {
-    let (line, body) = array(text, name)
+    let (line, tag, body) = array(text, name)
         .ok_or_else(|| ParseError::new(fname, 0, format!("no DataArray named '{name}'")))?;
-    body.split_whitespace()
-        .map(|w| {
-            w.parse::<f64>().map_err(|_| {
-                ParseError::new(
-                    fname,
-                    line,
-                    format!(
-                        "'{w}' in DataArray '{name}' is not a number (only ASCII arrays are read)"
-                    ),
-                )
+    let err = |m: String| ParseError::new(fname, line, format!("DataArray '{name}': {m}"));
+    match attribute(tag, "format").unwrap_or("ascii") {
+        "ascii" => body
+            .split_whitespace()
+            .map(|w| {
+                w.parse::<f64>()
+                    .map_err(|_| err(format!("'{w}' is not a number")))
             })
-        })
-        .collect()
+            .collect(),
+        "binary" => {
+            let file = &text[text.find("<VTKFile").unwrap_or(0)..];
+            let file_tag = &file[..file.find('>').unwrap_or(file.len())];
+            if attribute(file_tag, "byte_order") == Some("BigEndian") {
+                return Err(err("big-endian files are not read".into()));
+            }
+            let header = match attribute(file_tag, "header_type") {
+                Some("UInt64") => 8,
+                _ => 4,
+            };
+            let zlib = match attribute(file_tag, "compressor") {
+                None => false,
+                Some("vtkZLibDataCompressor") => true,
+                Some(other) => {
+                    return Err(err(format!("compressor {other} is not read (zlib is)")))
+                }
+            };
+            let kind = attribute(tag, "type").unwrap_or("Float64");
+            let bytes = binary_bytes(body, header, zlib).map_err(err)?;
+            decode(&bytes, kind).ok_or_else(|| err(format!("type {kind} is not read")))
+        }
+        other => Err(err(format!(
+            "format '{other}' is not read (ascii and binary are)"
+        ))),
+    }
 }
 
 /// Reads a `.vtu` written by [`write_vtu`] back into a frame.
@@ -267,12 +413,19 @@ pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
             ))
         }
     };
-    let r = numbers(text, name, "radius")?;
-    check(&r, "radius", n)?;
-    frame.radii = r;
-    let v = numbers(text, name, "velocity")?;
-    check(&v, "velocity", 3 * n)?;
-    frame.velocities = v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    // Radii, velocities and types where the file has them.
+    let optional = |array: &str| match numbers(text, name, array) {
+        Err(e) if e.message.starts_with("no DataArray") => Ok(None),
+        other => other.map(Some),
+    };
+    if let Some(r) = optional("radius")? {
+        check(&r, "radius", n)?;
+        frame.radii = r;
+    }
+    if let Some(v) = optional("velocity")? {
+        check(&v, "velocity", 3 * n)?;
+        frame.velocities = v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    }
     if let Ok(t) = numbers(text, name, "TIME") {
         frame.time = t.first().copied().unwrap_or(0.0);
     }
@@ -296,15 +449,18 @@ pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
             .collect(),
         Err(_) => Vec::new(),
     };
-    let types = numbers(text, name, "type")?;
+    let types = optional("type")?.unwrap_or_else(|| vec![0.0; n]);
     check(&types, "type", n)?;
     frame.species = types
         .iter()
         .map(|&t| {
-            species
-                .get(t as usize)
-                .cloned()
-                .unwrap_or_else(|| format!("{t}"))
+            species.get(t as usize).cloned().unwrap_or_else(|| {
+                if species.is_empty() {
+                    "X".to_string()
+                } else {
+                    format!("{t}")
+                }
+            })
         })
         .collect();
     Ok(frame)

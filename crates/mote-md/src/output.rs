@@ -181,7 +181,11 @@ pub fn frame_of(sys: &System) -> Frame {
         cell,
         origin,
         pbc: b.periodic,
-        species: vec!["X".to_string(); p.len()],
+        species: if sys.species.len() == p.len() {
+            sys.species.clone()
+        } else {
+            vec!["X".to_string(); p.len()]
+        },
         positions,
         velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
         radii: p.radius.clone(),

@@ -111,6 +111,9 @@ pub struct System {
     /// The angular accelerations τ/I carried the same way (empty when no
     /// interaction exerts torques).
     pub carried_angular_acceleration: Vec<DVec3>,
+    /// The species name of each particle, written in trajectories (empty:
+    /// all `X`). Names only: no interaction reads them.
+    pub species: Vec<String>,
 }
 
 impl System {
@@ -122,6 +125,7 @@ impl System {
             step: 0,
             carried_acceleration: Vec::new(),
             carried_angular_acceleration: Vec::new(),
+            species: Vec::new(),
         }
     }
 

@@ -121,3 +121,38 @@ fn a_frame_of_a_gsd_trajectory_with_its_periodic_box() {
     .unwrap_err();
     assert!(e.contains("no frame 5 among its 2 frames"), "{e}");
 }
+
+/// Species names: given on any generator (`species = "Ar"`), taken from a
+/// trajectory file, written in every frame (ASE reads chemical symbols);
+/// a name with a space is refused at its line.
+#[test]
+fn species_names_travel_from_scene_and_file_to_trajectories() {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = Frame {
+        cell: [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]],
+        species: vec!["Fe".into(), "O".into()],
+        positions: vec![[0.0, 1.0, 2.0], [1.0, 3.0, 2.0]],
+        radii: vec![0.5, 0.25],
+        masses: vec![55.845, 15.999],
+        ..Frame::default()
+    };
+    let path = dir.path().join("oxide.xyz");
+    let mut w = TrajectoryWriter::create(&path, Format::Xyz, Provenance::default(), true).unwrap();
+    w.write(0, &frame).unwrap();
+    drop(w);
+    let sys = build(
+        dir.path(),
+        &format!(
+            "{RUN}[[particle]]\nposition = [3, 3, 3]\nspecies = \"Ar\"\n\n[[from_file]]\nfile = \"oxide.xyz\"\n"
+        ),
+    )
+    .unwrap();
+    let written = mote_md::output::frame_of(&sys);
+    assert_eq!(written.species, ["Ar", "Fe", "O"]);
+    let e = build(
+        dir.path(),
+        &format!("{RUN}[[particle]]\nposition = [3, 3, 3]\nspecies = \"Ar gon\"\n"),
+    )
+    .unwrap_err();
+    assert!(e.contains("scene.toml:4:") && e.contains("one word"), "{e}");
+}

@@ -143,6 +143,11 @@ fn fuzz_all(count: usize) -> usize {
     tried += fuzz("vtu", &vtu, count, |b| {
         let _ = mote_io::vtu::parse_vtu(&lossy(b), "fuzz.vtu");
     });
+    // VTU as meshio writes it: base64 + zlib.
+    let meshio = include_bytes!("../../mote-io/tests/data/meshio_default.vtu");
+    tried += fuzz("binary vtu", meshio, count, |b| {
+        let _ = mote_io::vtu::parse_vtu(&lossy(b), "fuzz.vtu");
+    });
     // GSD (binary: mutated bytes, never a panic or a huge allocation).
     let gsd_path = dir.path().join("seed.gsd");
     let mut g = mote_io::gsd::GsdWriter::create(&gsd_path).unwrap();

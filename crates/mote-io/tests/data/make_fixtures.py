@@ -38,3 +38,14 @@ second.particles.position = [[-1.25, 0.5, 2.0], [0.25, -1.75, -2.5], [1.0, 1.0, 
 with gsd.hoomd.open("gsd_hoomd.gsd", "w") as f:
     f.append(first)
     f.append(second)
+
+# VTU files as meshio writes them by default (binary, zlib-compressed) and
+# uncompressed: three vertices with a radius array.
+import meshio
+import numpy as np
+
+points = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 3.5], [-0.25, 0.5, 1e-3]])
+cells = [("vertex", np.array([[0], [1], [2]]))]
+mesh = meshio.Mesh(points, cells, point_data={"radius": np.array([0.5, 0.25, 0.125])})
+mesh.write("meshio_default.vtu")
+mesh.write("meshio_uncompressed.vtu", compression=None)

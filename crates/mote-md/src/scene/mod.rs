@@ -199,6 +199,7 @@ impl Scene {
         let (integrator, dt, length) = self.run.schedule(src)?;
         let probes = self.output.probes(src, b.particles.len())?;
         let mut system = System::new(b.particles);
+        system.species = made.species;
         system.boundary = b.boundary;
         system.wrap_positions();
         if self.run.centre_of_mass {

@@ -36,6 +36,9 @@ pub struct Properties {
     /// Per axis: may the particle move? (MPPphys `vfix` 1 1 1 = all free.)
     #[serde(default = "all_free")]
     pub free: [bool; 3],
+    /// The name written in trajectories (a chemical symbol reads in ASE;
+    /// default `X`, ASE's dummy element).
+    pub species: Option<String>,
 }
 
 impl Default for Properties {
@@ -48,6 +51,7 @@ impl Default for Properties {
             dipole: [0.0; 3],
             color: white(),
             free: all_free(),
+            species: None,
         }
     }
 }
@@ -233,20 +237,29 @@ pub struct DataSpec {
     pub mass: Option<f64>,
     /// Masses from the radii, m = ρ 4π r³/3 (for files without masses).
     pub density: Option<f64>,
+    /// The species of every particle (default: the file's names, else `X`).
+    pub species: Option<String>,
     #[serde(default = "white")]
     pub color: [f64; 3],
 }
 
-/// The particles of one `[[from_file]]`, and the file's box if it has one.
-/// `data`: read it as a LAMMPS data file whatever its name (`[[lammps_data]]`).
-/// Errors in the file name its own lines; the others come back as
-/// messages for the scene's line (`at`).
+/// The particles of a file, their species, and the file's box if it has one.
+type FromFile = (
+    Vec<ParticleInit>,
+    Vec<String>,
+    Option<crate::boundary::Boundary>,
+);
+
+/// The particles of one `[[from_file]]`, their species and the file's box
+/// if it has one. `data`: read it as a LAMMPS data file whatever its name
+/// (`[[lammps_data]]`). Errors in the file name its own lines; the others
+/// come back as messages for the scene's line (`at`).
 fn from_file(
     s: &DataSpec,
     path: &std::path::Path,
     data: bool,
     at: &dyn Fn(String) -> ParseError,
-) -> Result<(Vec<ParticleInit>, Option<crate::boundary::Boundary>), ParseError> {
+) -> Result<FromFile, ParseError> {
     let io = |e: mote_io::IoError| match e {
         mote_io::IoError::Parse(p) if p.line > 0 => p,
         other => at(other.to_string()),
@@ -319,7 +332,8 @@ fn from_file(
             }
             None => None,
         };
-        return Ok((out, boundary));
+        let names = vec![s.species.clone().unwrap_or_else(|| "X".to_string()); out.len()];
+        return Ok((out, names, boundary));
     }
     let frames = mote_io::trajectory::read_frames(path).map_err(io)?;
     let k = match s.frame {
@@ -378,7 +392,14 @@ fn from_file(
             periodic: f.pbc,
         }
     });
-    Ok((out, boundary))
+    let names = (0..n)
+        .map(|i| match (&s.species, f.species.get(i)) {
+            (Some(name), _) => name.clone(),
+            (None, Some(name)) if !name.is_empty() => name.clone(),
+            _ => "X".to_string(),
+        })
+        .collect();
+    Ok((out, names, boundary))
 }
 
 /// `[[fcc]]`: a face-centred cubic crystal at a number density, with
@@ -417,6 +438,8 @@ pub struct PlummerSpec {
 /// an `[[fcc]]` crystal sets.
 pub struct Made {
     pub particles: Particles,
+    /// The species of each particle.
+    pub species: Vec<String>,
     pub springs: Vec<Spring>,
     pub fcc_box: Option<Boundary>,
 }
@@ -469,10 +492,20 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         .and_then(|g| g.get_ref().g)
         .unwrap_or(scene.units.gravitational_constant());
     let mut inits: Vec<ParticleInit> = Vec::new();
+    let mut species: Vec<String> = Vec::new();
+    let name = |p: &Properties| p.species.clone().unwrap_or_else(|| "X".to_string());
     let mut displacements: Vec<DVec3> = Vec::new();
     let mut springs: Vec<Spring> = Vec::new();
 
     let check_props = |p: &Properties, span: std::ops::Range<usize>| -> Result<(), ParseError> {
+        if let Some(name) = &p.species {
+            if name.is_empty() || name.contains(char::is_whitespace) {
+                return Err(err(
+                    span,
+                    format!("species '{name}' must be one word (no spaces)"),
+                ));
+            }
+        }
         if !p.mass.is_finite() || p.mass <= 0.0 {
             return Err(err(
                 span,
@@ -504,6 +537,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         p.velocity = DVec3::from(s.velocity);
         inits.push(p);
         displacements.push(DVec3::from(s.displacement));
+        species.push(name(&s.props));
     }
     for spec in &scene.lattice {
         let s = spec.get_ref();
@@ -559,6 +593,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
             }
             inits.push(site);
             displacements.push(d);
+            species.push(name(&s.props));
         }
         springs.extend(lat.springs.into_iter().map(|sp| Spring {
             i: sp.i + offset,
@@ -604,6 +639,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         ) {
             inits.push(p);
             displacements.push(DVec3::ZERO);
+            species.push(name(&s.props));
         }
     }
     for spec in &scene.annulus {
@@ -629,6 +665,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         ) {
             inits.push(p);
             displacements.push(DVec3::ZERO);
+            species.push(name(&s.props));
         }
     }
     for spec in &scene.random_box {
@@ -651,6 +688,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         ) {
             inits.push(p);
             displacements.push(DVec3::ZERO);
+            species.push(name(&s.props));
         }
     }
     let mut fcc_box: Option<crate::boundary::Boundary> = None;
@@ -675,6 +713,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         for p in lat.0 {
             inits.push(p);
             displacements.push(DVec3::ZERO);
+            species.push(name(&s.props));
         }
     }
     for spec in &scene.cloud {
@@ -711,6 +750,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
             }
             inits.push(p);
             displacements.push(DVec3::ZERO);
+            species.push(name(&s.props));
         }
     }
     for spec in &scene.plummer {
@@ -741,6 +781,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         for p in sphere.particles(&template, rng) {
             inits.push(p);
             displacements.push(DVec3::ZERO);
+            species.push("X".to_string());
         }
     }
     let data_files = scene.lammps_data.iter().map(|s| (s, true));
@@ -751,13 +792,14 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
             .unwrap_or(std::path::Path::new("."))
             .join(&s.file);
         let at = |m: String| err(spec.span(), m);
-        let (made, file_box) = from_file(s, &path, data, &at)?;
+        let (made, names, file_box) = from_file(s, &path, data, &at)?;
         if fcc_box.is_none() {
             fcc_box = file_box;
         }
-        for p in made {
+        for (p, n) in made.into_iter().zip(names) {
             inits.push(p);
             displacements.push(DVec3::ZERO);
+            species.push(n);
         }
     }
     let n = inits.len();
@@ -802,6 +844,7 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
 
     Ok(Made {
         particles,
+        species,
         springs,
         fcc_box,
     })

@@ -53,6 +53,7 @@ impl Scene {
                         dipole: [0.0; 3],
                         color: p.color,
                         free: p.free,
+                        species: None,
                     },
                 },
             ));
