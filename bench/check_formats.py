@@ -4,11 +4,13 @@
 Usage: check_formats.py DIR
 
 DIR holds what crates/mote-io/tests/formats.rs writes: t.xyz (extended XYZ),
-t.dump (LAMMPS dump text), t.gsd (HOOMD's GSD), t.vtu (VTK XML) and expected.json (positions,
+t.dump (LAMMPS dump text), t.gsd (HOOMD's GSD), t.vtu and t.vtp (VTK XML) and expected.json (positions,
 velocities, cell vectors and origin of every frame). The extended XYZ is read with ASE, the dump
-with MDAnalysis and the VTU with meshio; positions and box must agree to 1e-6
+and GSD with MDAnalysis, the GSD with gsd, the VTU with meshio, and all but the
+VTU with OVITO; positions and box must agree to 1e-6
 (relative). Exit status: 0 all agree, 1 a mismatch, 77 skipped (a package is
-missing: `pip install ase MDAnalysis meshio`).
+missing: `pip install ase MDAnalysis meshio`; gsd and ovito are checked
+where they import).
 """
 import json
 import os
@@ -79,7 +81,7 @@ def main():
     # relative to the box centre, box lengths, types, velocities.
     try:
         import gsd.hoomd
-    except ImportError:
+    except Exception:  # noqa: BLE001
         gsd = None
         print("note: the gsd package is not importable (pip install gsd); t.gsd not checked")
     if gsd is not None:
@@ -95,6 +97,39 @@ def main():
                 check(f"gsd frame {k} types {fr.particles.types}", list(fr.particles.types) == ["Fe", "O"])
         u = MDAnalysis.Universe(os.path.join(d, "t.gsd"))
         check(f"MDAnalysis reads {len(want)} frames of t.gsd", len(u.trajectory) == len(want))
+
+    # OVITO (pip install ovito): every format mote writes, as particles.
+    try:
+        from ovito.io import import_file
+    except Exception as e:  # noqa: BLE001 - a missing library is as good as a missing package
+        import_file = None
+        print(f"note: ovito is not importable ({e}); OVITO not checked")
+    if import_file is not None:
+        for fname in ["t.xyz", "t.dump", "t.gsd", "t.vtp"]:
+            try:
+                pipe = import_file(os.path.join(d, fname))
+                n_frames = pipe.source.num_frames
+                data = pipe.compute(n_frames - 1)
+            except Exception as e:  # noqa: BLE001 - report any reader failure
+                check(f"OVITO reads {fname} ({e})", False)
+                continue
+            w = want[-1]
+            pos = np.asarray(data.particles.positions)
+            exp = np.asarray(w["positions"])
+            if fname == "t.xyz":  # periodic cell written from the origin (Shift=)
+                exp = exp - np.asarray(w["origin"])
+            if fname == "t.gsd":  # HOOMD's box is centred on the origin
+                lengths = np.array([w["cell"][0][0], w["cell"][1][1], w["cell"][2][2]])
+                exp = exp - np.asarray(w["origin"]) - 0.5 * lengths
+            check(f"OVITO {fname}: {n_frames} frame(s), positions", close(pos.ravel(), exp.ravel(), 1e-5))
+            if "Radius" in data.particles:
+                check(f"OVITO {fname}: radii", close(np.asarray(data.particles["Radius"]), [0.5, 0.75], 1e-6))
+            else:
+                check(f"OVITO {fname}: radii (no Radius property)", False)
+            if "Velocity" in data.particles:
+                check(f"OVITO {fname}: velocities", close(np.asarray(data.particles["Velocity"]).ravel(), flat(w["velocities"]), 1e-6))
+            else:
+                check(f"OVITO {fname}: velocities (no Velocity property)", False)
 
     # VTU with meshio: points, and the cell stored as field data.
     m = meshio.read(os.path.join(d, "t.vtu"))

@@ -73,6 +73,36 @@ impl AtomStyle {
     }
 }
 
+/// The first words of LAMMPS data file section headers.
+const SECTIONS: &[&str] = &[
+    "Atoms",
+    "Velocities",
+    "Masses",
+    "Ellipsoids",
+    "Lines",
+    "Triangles",
+    "Bodies",
+    "Bonds",
+    "Angles",
+    "Dihedrals",
+    "Impropers",
+    "Pair",
+    "PairIJ",
+    "Bond",
+    "Angle",
+    "Dihedral",
+    "Improper",
+    "BondBond",
+    "BondAngle",
+    "MiddleBondTorsion",
+    "EndBondTorsion",
+    "AngleTorsion",
+    "AngleAngleTorsion",
+    "BondBond13",
+    "AngleAngle",
+    "Atom",
+];
+
 /// The contents of a data file, atoms in the file's order.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct DataFile {
@@ -82,6 +112,8 @@ pub struct DataFile {
     pub bounded: [bool; 3],
     pub style: AtomStyle,
     pub atoms: Vec<SphereAtom>,
+    /// Names of atom types from `Atom Type Labels` (LAMMPS 2022 and later).
+    pub type_labels: HashMap<u32, String>,
 }
 
 /// Reads a data file from disk.
@@ -115,12 +147,9 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
             w.parse::<f64>()
                 .map_err(|_| err(line_no, format!("'{w}' is not a number")))
         };
-        // Section headers stand alone on their line.
-        if words[0]
-            .chars()
-            .next()
-            .is_some_and(|c| c.is_ascii_alphabetic())
-        {
+        // Section headers stand alone on their line (type labels, which
+        // may start rows of Masses, are not among them).
+        if SECTIONS.contains(&words[0]) {
             section = match words[0] {
                 "Atoms" => {
                     if let Some(name) = raw.split('#').nth(1).map(str::trim) {
@@ -137,6 +166,7 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
                 }
                 "Velocities" => "velocities",
                 "Masses" => "masses",
+                "Atom" if words.get(1..3) == Some(&["Type", "Labels"][..]) => "labels",
                 _ => "other",
             };
             continue;
@@ -189,10 +219,25 @@ pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
                 general_given += 1;
             }
             ("", _) => {}
-            ("masses", [t, m, ..]) => {
+            ("labels", [t, label, ..]) => {
                 let t: u32 = t
                     .parse()
                     .map_err(|_| err(line_no, format!("'{t}' is not an atom type")))?;
+                data.type_labels.insert(t, label.to_string());
+            }
+            ("masses", [t, m, ..]) => {
+                // A type number, or a label defined above.
+                let t: u32 = match t.parse() {
+                    Ok(t) => t,
+                    Err(_) => {
+                        *data
+                            .type_labels
+                            .iter()
+                            .find(|(_, l)| l.as_str() == *t)
+                            .ok_or_else(|| err(line_no, format!("'{t}' is not an atom type")))?
+                            .0
+                    }
+                };
                 masses.insert(t, num(m)?);
             }
             ("atoms", w) => {
@@ -381,6 +426,10 @@ mod tests {
         let skew = general.replace("0 3 0 bvec", "1 3 0 bvec");
         let e = parse(&skew, "g.data").unwrap_err();
         assert_eq!(e.line, 7);
+        let labelled = "t\n\n2 atoms\n2 atom types\n\nAtom Type Labels\n\n1 Ar\n2 Fe\n\nMasses\n\nAr 39.948\n2 55.845\n\nAtoms # atomic\n\n1 1 0 0 0\n2 2 1 1 1\n";
+        let d = parse(labelled, "l.data").unwrap();
+        assert_eq!(d.type_labels[&1], "Ar");
+        assert_eq!((d.atoms[0].mass, d.atoms[1].mass), (39.948, 55.845));
         let unnamed = "title\n\n1 atoms\n\nAtoms\n\n1 1 7 0 0 0\n";
         let e = parse(unnamed, "u.data").unwrap_err();
         assert!(e.message.contains("name it"), "{}", e.message);

@@ -4,7 +4,7 @@
 //!
 //! Particles are points with one `VTK_VERTEX` cell (a vertex in `.vtp`) each,
 //! so that ParaView shows them directly (Point Gaussian or Glyph filters use the `radius` array). Point
-//! data: `radius`, `velocity` (3 components), `type` (species index from 0,
+//! data: `radius`, `Velocity` (3 components; OVITO's name), `type` (species index from 0,
 //! names as NUL-terminated bytes in the field data `species`). Field data: `TIME`, `cell` (9 values,
 //! rows a, b, c), `origin`, `pbc`. Arrays are ASCII in the shortest form that
 //! reads back bit for bit, so files are readable and
@@ -68,62 +68,20 @@ fn write_to(
         })
         .collect();
     writeln!(out, "<?xml version=\"1.0\"?>")?;
-    writeln!(out, "<!-- {} -->", xml_escape(&prov.line()))?;
+    // The provenance comment comes after the root tag: OVITO recognises
+    // the file by the VTKFile tag on its second line.
     writeln!(
         out,
         "<VTKFile type=\"{kind}\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
     )?;
+    writeln!(out, "<!-- {} -->", xml_escape(&prov.line()))?;
     writeln!(out, "<{kind}>")?;
-    writeln!(out, "<FieldData>")?;
-    writeln!(
-        out,
-        "<DataArray type=\"Float64\" Name=\"TIME\" NumberOfTuples=\"1\" format=\"ascii\">{:e}</DataArray>",
-        frame.time
-    )?;
-    let c = frame.cell;
-    write!(
-        out,
-        "<DataArray type=\"Float64\" Name=\"cell\" NumberOfComponents=\"9\" NumberOfTuples=\"1\" format=\"ascii\">"
-    )?;
-    for row in c {
-        for v in row {
-            write!(out, "{v:e} ")?;
-        }
-    }
-    writeln!(out, "</DataArray>")?;
-    let o = frame.origin;
-    writeln!(
-        out,
-        "<DataArray type=\"Float64\" Name=\"origin\" NumberOfComponents=\"3\" NumberOfTuples=\"1\" format=\"ascii\">{:e} {:e} {:e}</DataArray>",
-        o[0], o[1], o[2]
-    )?;
-    writeln!(
-        out,
-        "<DataArray type=\"Int32\" Name=\"pbc\" NumberOfComponents=\"3\" NumberOfTuples=\"1\" format=\"ascii\">{} {} {}</DataArray>",
-        frame.pbc[0] as i32, frame.pbc[1] as i32, frame.pbc[2] as i32
-    )?;
-    // Species names as NUL-terminated bytes (meshio reads no String arrays).
-    let mut bytes: Vec<u8> = Vec::new();
-    for s in &names {
-        bytes.extend(s.bytes());
-        bytes.push(0);
-    }
-    writeln!(
-        out,
-        "<DataArray type=\"UInt8\" Name=\"species\" NumberOfTuples=\"{}\" format=\"ascii\">",
-        bytes.len()
-    )?;
-    for b in bytes {
-        write!(out, "{b} ")?;
-    }
-    writeln!(out, "\n</DataArray>")?;
-    writeln!(out, "</FieldData>")?;
     if poly {
         writeln!(out, "<Piece NumberOfPoints=\"{n}\" NumberOfVerts=\"{n}\">")?;
     } else {
         writeln!(out, "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">")?;
     }
-    writeln!(out, "<PointData Scalars=\"radius\" Vectors=\"velocity\">")?;
+    writeln!(out, "<PointData Scalars=\"radius\" Vectors=\"Velocity\">")?;
     writeln!(
         out,
         "<DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">"
@@ -134,7 +92,7 @@ fn write_to(
     writeln!(out, "</DataArray>")?;
     writeln!(
         out,
-        "<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">"
+        "<DataArray type=\"Float64\" Name=\"Velocity\" NumberOfComponents=\"3\" format=\"ascii\">"
     )?;
     for i in 0..n {
         let v = frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
@@ -191,6 +149,52 @@ fn write_to(
         writeln!(out, "</Cells>")?;
     }
     writeln!(out, "</Piece>")?;
+    // Field data after the piece: OVITO does not recognise a file that
+    // opens with it.
+    writeln!(out, "<FieldData>")?;
+    writeln!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"TIME\" NumberOfTuples=\"1\" format=\"ascii\">{:e}</DataArray>",
+        frame.time
+    )?;
+    let c = frame.cell;
+    write!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"cell\" NumberOfComponents=\"9\" NumberOfTuples=\"1\" format=\"ascii\">"
+    )?;
+    for row in c {
+        for v in row {
+            write!(out, "{v:e} ")?;
+        }
+    }
+    writeln!(out, "</DataArray>")?;
+    let o = frame.origin;
+    writeln!(
+        out,
+        "<DataArray type=\"Float64\" Name=\"origin\" NumberOfComponents=\"3\" NumberOfTuples=\"1\" format=\"ascii\">{:e} {:e} {:e}</DataArray>",
+        o[0], o[1], o[2]
+    )?;
+    writeln!(
+        out,
+        "<DataArray type=\"Int32\" Name=\"pbc\" NumberOfComponents=\"3\" NumberOfTuples=\"1\" format=\"ascii\">{} {} {}</DataArray>",
+        frame.pbc[0] as i32, frame.pbc[1] as i32, frame.pbc[2] as i32
+    )?;
+    // Species names as NUL-terminated bytes (meshio reads no String arrays).
+    let mut bytes: Vec<u8> = Vec::new();
+    for s in &names {
+        bytes.extend(s.bytes());
+        bytes.push(0);
+    }
+    writeln!(
+        out,
+        "<DataArray type=\"UInt8\" Name=\"species\" NumberOfTuples=\"{}\" format=\"ascii\">",
+        bytes.len()
+    )?;
+    for b in bytes {
+        write!(out, "{b} ")?;
+    }
+    writeln!(out, "\n</DataArray>")?;
+    writeln!(out, "</FieldData>")?;
     writeln!(out, "</{kind}>")?;
     writeln!(out, "</VTKFile>")?;
     Ok(())
@@ -422,7 +426,7 @@ pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
         check(&r, "radius", n)?;
         frame.radii = r;
     }
-    if let Some(v) = optional("velocity")? {
+    if let Some(v) = optional("Velocity")?.or(optional("velocity")?) {
         check(&v, "velocity", 3 * n)?;
         frame.velocities = v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     }

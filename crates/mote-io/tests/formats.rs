@@ -74,6 +74,7 @@ fn other_programs_read_the_same_positions_and_box() {
         w.write(k, &f).unwrap();
         g.write(k, &f).unwrap();
         vtu::write_vtu(&d.join("t.vtu"), &f, &Provenance::default()).unwrap();
+        vtu::write_vtp(&d.join("t.vtp"), &f, &Provenance::default()).unwrap();
         let rows = |v: &[[f64; 3]]| {
             let r: Vec<String> = v
                 .iter()

@@ -49,3 +49,24 @@ cells = [("vertex", np.array([[0], [1], [2]]))]
 mesh = meshio.Mesh(points, cells, point_data={"radius": np.array([0.5, 0.25, 0.125])})
 mesh.write("meshio_default.vtu")
 mesh.write("meshio_uncompressed.vtu", compression=None)
+
+# OVITO 3.17 (pip install ovito): XYZ, a dump with BOX BOUNDS abc origin and
+# a data file with an avec/bvec/cvec box, a cell whose corner is not the origin.
+from ovito.data import DataCollection
+from ovito.io import export_file
+from ovito.pipeline import StaticSource, Pipeline
+data = DataCollection()
+cell = data.create_cell([[4.0, 0, 0], [0, 5.0, 0], [0, 0, 6.0]], pbc=(True, True, True))
+m = np.array(data.cell_[...])
+m[:, 3] = (-1.0, 0.5, 2.0)
+data.cell_[...] = m
+p = data.create_particles(count=3)
+p.create_property("Position", data=[[0.0, 1.0, 2.5], [1.5, 2.25, 3.0], [2.5, 5.0, 7.5]])
+p.create_property("Velocity", data=[[0.5, 0.0, -0.25], [0.0, 1.0, 0.0], [0.125, 0.0, 2.0]])
+p.create_property("Radius", data=[0.5, 0.25, 0.75])
+t = p.create_property("Particle Type", data=[1, 2, 1])
+p.create_property("Particle Identifier", data=[1, 2, 3])
+pipe = Pipeline(source=StaticSource(data=data))
+export_file(pipe, "ovito.xyz", "xyz", columns=["Position.X", "Position.Y", "Position.Z", "Velocity.X", "Velocity.Y", "Velocity.Z", "Radius"])
+export_file(pipe, "ovito.dump", "lammps/dump", columns=["Particle Identifier", "Particle Type", "Position.X", "Position.Y", "Position.Z", "Velocity.X", "Velocity.Y", "Velocity.Z", "Radius"])
+export_file(pipe, "ovito.data", "lammps/data", atom_style="atomic")

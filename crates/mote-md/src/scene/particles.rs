@@ -237,7 +237,8 @@ pub struct DataSpec {
     pub mass: Option<f64>,
     /// Masses from the radii, m = ρ 4π r³/3 (for files without masses).
     pub density: Option<f64>,
-    /// The species of every particle (default: the file's names, else `X`).
+    /// The species of every particle (default: the file's names, a data
+    /// file's `Atom Type Labels`, else `X`).
     pub species: Option<String>,
     #[serde(default = "white")]
     pub color: [f64; 3],
@@ -332,7 +333,15 @@ fn from_file(
             }
             None => None,
         };
-        let names = vec![s.species.clone().unwrap_or_else(|| "X".to_string()); out.len()];
+        let names = data
+            .atoms
+            .iter()
+            .map(|a| match (&s.species, data.type_labels.get(&a.kind)) {
+                (Some(name), _) => name.clone(),
+                (None, Some(label)) => label.clone(),
+                (None, None) => "X".to_string(),
+            })
+            .collect();
         return Ok((out, names, boundary));
     }
     let frames = mote_io::trajectory::read_frames(path).map_err(io)?;
