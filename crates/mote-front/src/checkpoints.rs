@@ -96,6 +96,7 @@ pub(crate) fn restore(
         solver: get("solver"),
         output: get("output").map(PathBuf::from),
         picture: given.picture.clone(),
+        trajectory_format: get("trajectory-format"),
         seed: Some(cp.seed),
         threads: given.threads,
     };

@@ -48,6 +48,7 @@ pub(crate) fn resume(
         checkpoint_every: get("checkpoint-every").and_then(|v| v.parse().ok()),
         output: get("output").map(PathBuf::from),
         picture: given.picture.clone(),
+        trajectory_format: get("trajectory-format"),
         seed: Some(cp.seed),
         threads: given.threads,
         ..RunOptions::default()
@@ -104,6 +105,12 @@ fn run_events(
         }
         scene.time = t;
     }
+    if let (Some(t), Some(_)) = (&scene.trajectory, &options.trajectory_format) {
+        // The file keeps its name; the extension says the format.
+        let format = options.trajectory_format(mote_io::trajectory::Format::Xyz)?;
+        let renamed = std::path::Path::new(t).with_extension(format.extension());
+        scene.trajectory = Some(renamed.to_string_lossy().into_owned());
+    }
     if words.no_output {
         scene.trajectory = None;
         scene.observables = None;
@@ -142,6 +149,14 @@ fn run_events(
                 ("checkpoint-every".into(), every.to_string()),
                 ("time".into(), hex(scene.time)),
                 ("output".into(), dir.display().to_string()),
+                (
+                    "trajectory-format".into(),
+                    scene
+                        .trajectory
+                        .as_deref()
+                        .and_then(|t| std::path::Path::new(t).extension())
+                        .map_or("xyz".into(), |e| e.to_string_lossy().into_owned()),
+                ),
             ],
             input_label: input.label.clone(),
             input_text: input.text.clone(),

@@ -49,6 +49,9 @@ pub struct RunOptions {
     pub output: Option<PathBuf>,
     /// Ray-trace the final state into this PNG.
     pub picture: Option<PathBuf>,
+    /// Trajectory format (`xyz`, `dump`, `gsd`, `vtk`), replacing the
+    /// scene's `[output] trajectory_format`.
+    pub trajectory_format: Option<String>,
     /// Seed (default: the scene's, else chosen and printed).
     pub seed: Option<u64>,
     /// Worker threads the caller asked for. The caller sets up the rayon
@@ -57,6 +60,24 @@ pub struct RunOptions {
 }
 
 impl RunOptions {
+    /// The trajectory format: `--trajectory-format` if given, else the
+    /// scene's (`scene`).
+    pub(crate) fn trajectory_format(
+        &self,
+        scene: mote_io::trajectory::Format,
+    ) -> Result<mote_io::trajectory::Format, FrontError> {
+        use mote_io::trajectory::Format;
+        match &self.trajectory_format {
+            None => Ok(scene),
+            Some(f) => Format::named(f).ok_or_else(|| {
+                FrontError::request(format!(
+                    "--trajectory-format {f}: expected one of {}",
+                    Format::NAMES
+                ))
+            }),
+        }
+    }
+
     /// Refuses the options an engine does not have, naming each and why.
     fn refuse(&self, engine: &str, refused: &[(bool, &str, &str)]) -> Result<(), FrontError> {
         let named: Vec<String> = refused

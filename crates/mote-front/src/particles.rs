@@ -165,7 +165,9 @@ pub(crate) fn run(
         )?));
     }
     if out.trajectory_every > 0 {
-        let format = out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?;
+        let format = args.trajectory_format(
+            out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
+        )?;
         driver.observers.push(Box::new(Trajectory::create(
             &dir.join(format!("trajectory.{}", format.extension())),
             format,
@@ -186,6 +188,14 @@ pub(crate) fn run(
             ("checkpoint-every".to_string(), every.to_string()),
             ("dt".to_string(), hex(sim.dt)),
             ("output".to_string(), dir.display().to_string()),
+            (
+                "trajectory-format".to_string(),
+                args.trajectory_format(
+                    out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
+                )?
+                .extension()
+                .to_string(),
+            ),
         ];
         if let Some(s) = &args.solver {
             options.push(("solver".to_string(), s.clone()));

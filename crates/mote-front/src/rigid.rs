@@ -53,6 +53,11 @@ fn run_with(
     std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
     let _lock = crate::lock::FolderLock::take(&dir)?;
     let provenance = crate::provenance(&input.label, seed);
+    let format = options.trajectory_format(
+        scene
+            .output
+            .trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
+    )?;
     let checkpoints = options.checkpoint_every.map(|every| mote_run::Checkpoints {
         every: every.max(1),
         path: dir.join("checkpoint.mote"),
@@ -65,6 +70,7 @@ fn run_with(
                 ("plist".into(), "false".into()),
                 ("checkpoint-every".into(), every.to_string()),
                 ("output".into(), dir.display().to_string()),
+                ("trajectory-format".into(), format.extension().to_string()),
             ],
             input_label: input.label.clone(),
             input_text: input.text.clone(),
@@ -82,6 +88,7 @@ fn run_with(
         until: options.until,
         checkpoints,
         resume: resumed.cloned(),
+        trajectory_format: Some(format),
     };
     monitor.start(&format!(
         "mote run {}: rigid clumps (FRBI) with dt = {}, {}, {}",

@@ -718,3 +718,74 @@ fn trajectory_format_chooses_the_file() {
         "{e}"
     );
 }
+
+/// `--trajectory-format` replaces the scene's, for every engine, and a
+/// resumed run keeps the format of the run it continues.
+#[test]
+fn trajectory_format_on_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    // Event-driven runs have no steps: they get a time instead.
+    for (example, length) in [
+        ("example:sun-earth", ["--steps", "40"]),
+        ("example:magnet-in-field", ["--steps", "40"]),
+        ("example:cradle", ["--until", "1"]),
+    ] {
+        let out = format!("out_{}", &example[8..]);
+        let mut args = vec![
+            "-q",
+            "run",
+            example,
+            "--trajectory-format",
+            "gsd",
+            "-o",
+            &out,
+        ];
+        args.extend(length);
+        let o = mote(&args, dir.path());
+        assert!(o.status.success(), "{example}: {}", stderr(&o));
+        let path = dir.path().join(&out).join("trajectory.gsd");
+        let frames = mote_io::trajectory::read_frames(&path).unwrap();
+        assert!(!frames.is_empty(), "{example}");
+    }
+    let o = mote(
+        &[
+            "-q",
+            "run",
+            "example:sun-earth",
+            "--trajectory-format",
+            "hdf5",
+            "--steps",
+            "5",
+        ],
+        dir.path(),
+    );
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("--trajectory-format hdf5: expected one of xyz, dump, gsd, vtk"),
+        "{}",
+        stderr(&o)
+    );
+    // A checkpointed run in GSD, resumed: the GSD goes on (no XYZ appears).
+    let o = mote(
+        &[
+            "-q",
+            "run",
+            "example:sun-earth",
+            "--trajectory-format",
+            "gsd",
+            "--steps",
+            "60",
+            "--checkpoint-every",
+            "20",
+            "-o",
+            "cp",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = mote(&["-q", "run", "--resume", "cp/checkpoint.mote"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!dir.path().join("cp/trajectory.xyz").exists());
+    let frames = mote_io::trajectory::read_frames(&dir.path().join("cp/trajectory.gsd")).unwrap();
+    assert_eq!(frames.len(), 4, "steps 0, 20, 40, 60");
+}

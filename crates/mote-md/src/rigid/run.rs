@@ -40,6 +40,8 @@ pub struct RigidRun {
     /// Continue this checkpoint's run (its scene, seed, dt and length must
     /// be those given), appending to the files an earlier run wrote.
     pub resume: Option<Checkpoint>,
+    /// Replaces `[output] trajectory_format`.
+    pub trajectory_format: Option<mote_io::trajectory::Format>,
 }
 
 /// Rigid bodies moved by the FRBI with a fixed step.
@@ -392,9 +394,12 @@ pub fn run_rigid_scene(
         append,
     )?));
     if scene.output.trajectory_every > 0 {
-        let format = scene
-            .output
-            .trajectory_format(mote_io::Source::new(file_label, text))?;
+        let format = match options.trajectory_format {
+            Some(f) => f,
+            None => scene
+                .output
+                .trajectory_format(mote_io::Source::new(file_label, text))?,
+        };
         let p = dir.join(format!("trajectory.{}", format.extension()));
         driver.observers.push(Box::new(SphereTrajectory {
             writer: if append {

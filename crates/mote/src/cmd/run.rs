@@ -41,6 +41,10 @@ pub struct RunArgs {
     /// Ray-trace the final state into this PNG (1920×1080, shadows, box drawn).
     #[arg(long, value_name = "FILE.png")]
     pub picture: Option<PathBuf>,
+    /// Trajectory format: xyz, dump, gsd or vtk (overrides the scene's
+    /// [output] trajectory_format).
+    #[arg(long, value_name = "FORMAT", conflicts_with = "resume")]
+    pub trajectory_format: Option<String>,
 }
 
 impl RunArgs {
@@ -56,6 +60,7 @@ impl RunArgs {
             solver: self.solver,
             output: self.output,
             picture: self.picture,
+            trajectory_format: self.trajectory_format,
             seed: global.seed,
             threads: global.threads,
         }
