@@ -141,6 +141,13 @@ pub struct Scene {
     /// Initial state from the last frame of a trajectory file (.xyz, .dump,
     /// .gsd, .vtu/.vtp/.pvd), relative to the scene file.
     pub file: Option<String>,
+    /// `[[from_file]]`, the key time-stepped scenes use: one file, and
+    /// `frame` to pick one (negative counts from the end).
+    #[serde(default)]
+    from_file: Vec<FileStart>,
+    /// The frame of `file` (default the last).
+    #[serde(skip)]
+    pub file_frame: Option<i64>,
     /// Check for overlaps at every output (exact, O(N)); default true.
     #[serde(default = "yes")]
     pub check_overlaps: bool,
@@ -159,6 +166,14 @@ pub struct RunSection {
     dt: Option<toml::Value>,
     steps: Option<toml::Value>,
     integrator: Option<toml::Value>,
+}
+
+/// `[[from_file]]` in an event-driven scene.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileStart {
+    file: String,
+    frame: Option<i64>,
 }
 
 /// `[output]` of an event-driven scene. Files go to `dir` (default
@@ -375,6 +390,26 @@ impl Scene {
             line: key_line(text, key),
             message,
         };
+        match self.from_file.as_slice() {
+            [] => {}
+            [start] if self.file.is_none() => {
+                self.file = Some(start.file.clone());
+                self.file_frame = start.frame;
+            }
+            [_] => {
+                return Err(err(
+                    "from_file",
+                    "give the initial file once: [[from_file]] or [event_driven] file, not both"
+                        .into(),
+                ))
+            }
+            _ => {
+                return Err(err(
+                    "from_file",
+                    "an event-driven scene starts from one file: one [[from_file]]".into(),
+                ))
+            }
+        }
         let stepped = [
             ("dt", self.run.dt.is_some(), "[run] until = (end time)"),
             (
@@ -682,9 +717,22 @@ impl Scene {
         } else if let Some(f) = &self.file {
             let path = base.join(f);
             let frames = mote_io::trajectory::read_frames(&path)?;
-            let fr = frames
-                .last()
-                .ok_or_else(|| EdmdError::Invalid(format!("{}: no frames", path.display())))?;
+            let k = match self.file_frame {
+                None => frames.len() as i64 - 1,
+                Some(f) if f < 0 => frames.len() as i64 + f,
+                Some(f) => f,
+            };
+            let fr = usize::try_from(k)
+                .ok()
+                .and_then(|k| frames.get(k))
+                .ok_or_else(|| {
+                    EdmdError::Invalid(format!(
+                        "{}: no frame {} among its {} frames",
+                        path.display(),
+                        self.file_frame.unwrap_or(-1),
+                        frames.len()
+                    ))
+                })?;
             let mut size = [0.0; D];
             for d in 0..D {
                 size[d] = fr.cell[d][d];
