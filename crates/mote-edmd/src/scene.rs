@@ -717,22 +717,8 @@ impl Scene {
         } else if let Some(f) = &self.file {
             let path = base.join(f);
             let frames = mote_io::trajectory::read_frames(&path)?;
-            let k = match self.file_frame {
-                None => frames.len() as i64 - 1,
-                Some(f) if f < 0 => frames.len() as i64 + f,
-                Some(f) => f,
-            };
-            let fr = usize::try_from(k)
-                .ok()
-                .and_then(|k| frames.get(k))
-                .ok_or_else(|| {
-                    EdmdError::Invalid(format!(
-                        "{}: no frame {} among its {} frames",
-                        path.display(),
-                        self.file_frame.unwrap_or(-1),
-                        frames.len()
-                    ))
-                })?;
+            let fr = mote_io::trajectory::pick(&frames, self.file_frame, &path)
+                .map_err(EdmdError::Invalid)?;
             let mut size = [0.0; D];
             for d in 0..D {
                 size[d] = fr.cell[d][d];

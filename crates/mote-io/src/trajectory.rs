@@ -166,6 +166,27 @@ pub fn keep_until(path: &Path, format: Format, step: u64, t: f64) -> Result<(), 
     }
 }
 
+/// Frame `frame` of `frames` (default the last; negative counts from the
+/// end), or a message naming the file and how many frames it has.
+pub fn pick<'a>(frames: &'a [Frame], frame: Option<i64>, path: &Path) -> Result<&'a Frame, String> {
+    let k = match frame {
+        None => frames.len() as i64 - 1,
+        Some(f) if f < 0 => frames.len() as i64 + f,
+        Some(f) => f,
+    };
+    usize::try_from(k)
+        .ok()
+        .and_then(|k| frames.get(k))
+        .ok_or_else(|| {
+            format!(
+                "{}: no frame {} among its {} frames",
+                path.display(),
+                frame.unwrap_or(-1),
+                frames.len()
+            )
+        })
+}
+
 /// Every frame of a trajectory, by its extension: `.xyz`/`.extxyz`,
 /// `.dump`/`.lammpstrj`, `.gsd`, `.vtu`/`.vtp` (one frame), `.pvd`.
 pub fn read_frames(path: &Path) -> Result<Vec<Frame>, IoError> {

@@ -345,22 +345,7 @@ fn from_file(
         return Ok((out, names, boundary));
     }
     let frames = mote_io::trajectory::read_frames(path).map_err(io)?;
-    let k = match s.frame {
-        None => frames.len() as i64 - 1,
-        Some(f) if f < 0 => frames.len() as i64 + f,
-        Some(f) => f,
-    };
-    let f = usize::try_from(k)
-        .ok()
-        .and_then(|k| frames.get(k))
-        .ok_or_else(|| {
-            at(format!(
-                "{}: no frame {} among its {} frames",
-                path.display(),
-                s.frame.unwrap_or(-1),
-                frames.len()
-            ))
-        })?;
+    let f = mote_io::trajectory::pick(&frames, s.frame, path).map_err(at)?;
     let n = f.positions.len();
     let get = |v: &Vec<[f64; 3]>, i: usize| {
         if v.len() == n {
