@@ -410,6 +410,10 @@ fn chunks(step: u64, f: &Frame, exact: bool) -> Result<Vec<Chunk>, String> {
         let d: Vec<f64> = f.radii.iter().map(|r| 2.0 * r).collect();
         out.push(f32s("particles/diameter", 1, &d));
     }
+    if has(f.orientations.len()) {
+        let q: Vec<f64> = f.orientations.iter().flatten().copied().collect();
+        out.push(f32s("particles/orientation", 4, &q));
+    }
     if has(f.bodies.len()) {
         let b: Vec<i32> = f.bodies.iter().map(|&b| b as i32).collect();
         out.push(chunk("particles/body", Kind::I32, 1, &b, |x| {
@@ -691,6 +695,9 @@ fn frame(
     if let Some(v) = rows("log/particles/mote_mass", 1)?.or(rows("particles/mass", 1)?) {
         f.masses = v;
     }
+    if let Some(v) = rows("particles/orientation", 4)? {
+        f.orientations = v.chunks(4).map(|q| [q[0], q[1], q[2], q[3]]).collect();
+    }
     if let Some(v) = rows("particles/body", 1)? {
         if v.iter().any(|&b| b >= 0.0) {
             f.bodies = v.iter().map(|&b| b.max(0.0) as u64).collect();
@@ -748,6 +755,11 @@ mod tests {
             radii: vec![0.5, 0.25, 1.0 / 3.0],
             masses: vec![1.0, 2.0, 3.0],
             bodies: vec![0, 0, 1],
+            orientations: vec![
+                [1.0, 0.0, 0.0, 0.0],
+                [0.5, 0.5, -0.5, 0.5],
+                [0.0, 1.0, 0.0, 0.0],
+            ],
             ..Frame::default()
         }
     }
@@ -785,6 +797,7 @@ mod tests {
                 );
                 assert_eq!(b.species, want.species);
                 assert_eq!(b.bodies, want.bodies);
+                assert_eq!(b.orientations, want.orientations);
                 if exact {
                     assert_eq!(b.positions, want.positions);
                     assert_eq!(b.velocities, want.velocities);

@@ -28,7 +28,8 @@
 //! one line per cell vector with the origin's component as a fourth number.
 //!
 //! Columns written: `id type x y z`, then `vx vy vz`, `radius`, `mass`,
-//! `omegax omegay omegaz`, `mux muy muz` and `mol` (rigid body) where the
+//! `omegax omegay omegaz`, `mux muy muz`, `quatw quati quatj quatk` and `mol`
+//! (rigid body) where the
 //! frame has them; numbers with 11 significant digits, or in exact mode
 //! ([`DumpWriter::exact`]) the shortest form that reads back bit for bit.
 
@@ -208,6 +209,9 @@ pub fn write_frame_as(
             header = header + " " + names;
         }
     }
+    if has(frame.orientations.len()) {
+        header += " quatw quati quatj quatk";
+    }
     if has(frame.bodies.len()) {
         header += " mol";
     }
@@ -244,6 +248,11 @@ pub fn write_frame_as(
                 for x in v[i] {
                     num(&mut line, x);
                 }
+            }
+        }
+        if has(frame.orientations.len()) {
+            for x in frame.orientations[i] {
+                num(&mut line, x);
             }
         }
         if has(frame.bodies.len()) {
@@ -464,6 +473,10 @@ fn atoms<'a>(
     let vel = triple("vx", "vy", "vz");
     let omega = triple("omegax", "omegay", "omegaz");
     let mu = triple("mux", "muy", "muz");
+    let quat = match (col("quatw"), col("quati"), col("quatj"), col("quatk")) {
+        (Some(w), Some(i), Some(j), Some(k)) => Some([w, i, j, k]),
+        _ => None,
+    };
     let (id_col, type_col) = (col("id"), col("type"));
     let (radius_col, diameter_col, mass_col, mol_col) =
         (col("radius"), col("diameter"), col("mass"), col("mol"));
@@ -528,6 +541,11 @@ fn atoms<'a>(
         if let Some(c) = mu {
             frame.dipoles.push(vec3(c)?);
         }
+        if let Some(c) = quat {
+            frame
+                .orientations
+                .push([num(c[0])?, num(c[1])?, num(c[2])?, num(c[3])?]);
+        }
         if let Some(c) = mol_col {
             let m = whole(c, "a molecule id")?;
             frame.bodies.push(m.saturating_sub(1));
@@ -554,6 +572,7 @@ fn atoms<'a>(
     permute(&mut frame.angular_velocities, &order);
     permute(&mut frame.dipoles, &order);
     permute(&mut frame.bodies, &order);
+    permute(&mut frame.orientations, &order);
     if id_col.is_some() {
         frame.ids = rows.iter().map(|r| r.0).collect();
     }
@@ -682,6 +701,7 @@ mod tests {
             angular_velocities: vec![[0.3, 0.0, 0.1], [1.0, 2.0, 3.0]],
             dipoles: vec![[0.0, 0.6, 0.8], [1.0, 0.0, 0.0]],
             bodies: vec![0, 4],
+            orientations: vec![[1.0, 0.0, 0.0, 0.0], [0.6, 0.0, 0.8, 1.0 / 3.0]],
             species: vec!["1".into(), "2".into()],
             ..frame([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
         };
@@ -698,6 +718,7 @@ mod tests {
         want.angular_velocities.swap(0, 1);
         want.dipoles.swap(0, 1);
         want.bodies.swap(0, 1);
+        want.orientations.swap(0, 1);
         want.species.swap(0, 1);
         want.time = back.time;
         assert_eq!(back, want);

@@ -8,7 +8,7 @@
 //! mote writes `species:S:1:pos:R:3:velo:R:3:radius:R:1:id:I:1`, then
 //! `masses:R:1:momenta:R:3` where masses are known (ASE takes velocities
 //! from momenta and masses, not from `velo`, which OVITO reads), then
-//! `omega`, `dipole` and `body` where present. A periodic box whose lower
+//! `omega`, `dipole`, `orientation` (w, x, y, z) and `body` where present. A periodic box whose lower
 //! corner is not the origin is written shifted to it (ASE ignores
 //! `Origin=`), with the shift in `Shift="x y z"`; mote adds it back on
 //! reading. Open boxes, and exact files (whose numbers must read back bit
@@ -50,6 +50,9 @@ pub struct Frame {
     pub dipoles: Vec<[f64; 3]>,
     /// The rigid body each sphere belongs to.
     pub bodies: Vec<u64>,
+    /// Orientations as unit quaternions (w, x, y, z) (rigid bodies: each
+    /// sphere carries its body's).
+    pub orientations: Vec<[f64; 4]>,
 }
 
 impl Frame {
@@ -195,6 +198,7 @@ pub fn write_frame_as(
     for (len, name) in [
         (frame.angular_velocities.len(), ":omega:R:3"),
         (frame.dipoles.len(), ":dipole:R:3"),
+        (frame.orientations.len(), ":orientation:R:4"),
         (frame.bodies.len(), ":body:I:1"),
     ] {
         if has(len) {
@@ -279,6 +283,11 @@ pub fn write_frame_as(
                 }
             }
         }
+        if has(frame.orientations.len()) {
+            for x in frame.orientations[i] {
+                number(&mut line, x, exact, 11);
+            }
+        }
         if has(frame.bodies.len()) {
             line += &format!(" {}", frame.bodies[i]);
         }
@@ -308,6 +317,7 @@ enum Role {
     Id,
     Omega,
     Dipole,
+    Orientation,
     Body,
     Skip,
 }
@@ -336,6 +346,9 @@ impl Column {
                 Role::Omega
             }
             "dipole" | "dipoles" | "dipole orientation" | "mu" if r && three => Role::Dipole,
+            "orientation" | "orientations" | "quaternion" if r && self.count == 4 => {
+                Role::Orientation
+            }
             "body" | "body_id" | "molecule" | "molecule identifier" if i && self.count == 1 => {
                 Role::Body
             }
@@ -540,6 +553,11 @@ fn parse_frame(
                 }
                 Role::Omega => frame.angular_velocities.push(vec3(v)?),
                 Role::Dipole => frame.dipoles.push(vec3(v)?),
+                Role::Orientation => {
+                    frame
+                        .orientations
+                        .push([num(v[0])?, num(v[1])?, num(v[2])?, num(v[3])?])
+                }
                 Role::Body => {
                     let b = int(v[0])?;
                     frame.bodies.push(u64::try_from(b).map_err(|_| {

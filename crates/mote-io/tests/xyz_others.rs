@@ -114,6 +114,7 @@ fn frame() -> Frame {
         angular_velocities: vec![[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]],
         dipoles: vec![[0.0, 1.0, 0.0], [0.0, 0.0, -1.0]],
         bodies: vec![0, 0],
+        orientations: vec![[1.0, 0.0, 0.0, 0.0], [0.5, -0.5, 0.5, 0.5]],
     }
 }
 

@@ -138,3 +138,36 @@ fn run_scene_file() {
         println!("wall {name}: {f}");
     }
 }
+
+/// Trajectory frames carry each sphere's body and that body's orientation
+/// as a unit quaternion (1, r)/√(1 + r²) of its rotation vector r: rotating
+/// the template's sphere centres by it and adding the body's position gives
+/// the spheres' world positions written beside it.
+#[test]
+fn frames_carry_bodies_and_orientations() {
+    let text = example("clumps-settling.toml");
+    let built = RigidScene::parse(&text, "clumps-settling.toml")
+        .unwrap()
+        .build(&text, "clumps-settling.toml", None)
+        .unwrap();
+    let b = &built.bodies;
+    let f = mote_md::rigid::scene::sphere_frame(b);
+    let n = f.positions.len();
+    assert_eq!((f.bodies.len(), f.orientations.len()), (n, n));
+    let mut next = vec![0usize; b.position.len()];
+    for i in 0..n {
+        let k = f.bodies[i] as usize;
+        let [w, x, y, z] = f.orientations[i];
+        assert!(((w * w + x * x + y * y + z * z) - 1.0).abs() < 1e-14);
+        let q = glam::DQuat::from_xyzw(x, y, z, w);
+        let t = &b.templates[b.kind[k] as usize];
+        let offset = q * t.centres[next[k]];
+        next[k] += 1;
+        let want = b.position[k] + offset;
+        let got = glam::DVec3::from(f.positions[i]);
+        assert!(
+            (got - want).length() < 1e-12 * (1.0 + want.length()),
+            "sphere {i}: {got} vs {want}"
+        );
+    }
+}

@@ -310,6 +310,17 @@ pub fn sphere_frame(b: &RigidBodies) -> Frame {
         species: vec!["X".to_string(); positions.len()],
         masses: sphere_masses(b, &world),
         bodies: world.sphere_body.iter().map(|&k| u64::from(k)).collect(),
+        // The body's orientation: rotation vector r = n tan(φ/2) as the
+        // unit quaternion (cos φ/2, n sin φ/2) = (1, r)/√(1 + r²).
+        orientations: world
+            .sphere_body
+            .iter()
+            .map(|&k| {
+                let r = b.rotation[k as usize];
+                let c = 1.0 / (1.0 + r.length_squared()).sqrt();
+                [c, r.x * c, r.y * c, r.z * c]
+            })
+            .collect(),
         positions,
         velocities,
         radii: world.sphere_radius.clone(),
