@@ -99,11 +99,22 @@ def main():
         check(f"MDAnalysis reads {len(want)} frames of t.gsd", len(u.trajectory) == len(want))
 
     # OVITO (pip install ovito): every format mote writes, as particles.
+    # Probe the import in a child first: a wheel that cannot load its
+    # libraries may crash the interpreter rather than raise.
+    import subprocess
     try:
-        from ovito.io import import_file
-    except Exception as e:  # noqa: BLE001 - a missing library is as good as a missing package
-        import_file = None
-        print(f"note: ovito is not importable ({e}); OVITO not checked")
+        probe = subprocess.run([sys.executable, "-c", "import ovito.io"], capture_output=True, timeout=300)
+        importable = probe.returncode == 0
+    except Exception:  # noqa: BLE001
+        importable = False
+    import_file = None
+    if importable:
+        try:
+            from ovito.io import import_file
+        except Exception as e:  # noqa: BLE001 - a missing library is as good as a missing package
+            print(f"note: ovito is not importable ({e}); OVITO not checked")
+    else:
+        print("note: ovito is not importable (pip install ovito); OVITO not checked")
     if import_file is not None:
         for fname in ["t.xyz", "t.dump", "t.gsd", "t.vtp"]:
             try:
