@@ -52,7 +52,8 @@ pub enum AtomStyle {
 }
 
 impl AtomStyle {
-    fn named(name: &str) -> Option<Self> {
+    /// A style by its LAMMPS name.
+    pub fn named(name: &str) -> Option<Self> {
         Some(match name {
             "atomic" => AtomStyle::Atomic,
             "charge" => AtomStyle::Charge,
@@ -118,19 +119,34 @@ pub struct DataFile {
 
 /// Reads a data file from disk.
 pub fn read(path: &Path) -> Result<DataFile, ParseError> {
+    read_as(path, None)
+}
+
+/// Reads a data file whose `Atoms` section may not name its style
+/// (MDAnalysis writes none): `style` is taken then.
+pub fn read_as(path: &Path, style: Option<AtomStyle>) -> Result<DataFile, ParseError> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path)
         .map_err(|e| ParseError::new(&name, 0, format!("cannot read the data file: {e}")))?;
-    parse(&text, &name)
+    parse_as(&text, &name, style)
 }
 
 /// Parses the text of a data file; `file` names it in errors.
 pub fn parse(text: &str, file: &str) -> Result<DataFile, ParseError> {
+    parse_as(text, file, None)
+}
+
+/// [`parse`], with the style for an `Atoms` section that names none.
+pub fn parse_as(
+    text: &str,
+    file: &str,
+    default_style: Option<AtomStyle>,
+) -> Result<DataFile, ParseError> {
     let err = |line: usize, msg: String| ParseError::new(file, line, msg);
     let mut data = DataFile::default();
     let mut expected: Option<usize> = None;
     let mut section = "";
-    let mut style: Option<AtomStyle> = None;
+    let mut style: Option<AtomStyle> = default_style;
     let mut masses: HashMap<u32, f64> = HashMap::new();
     let mut general = [[0.0f64; 3]; 4];
     let mut general_given = 0;

@@ -156,3 +156,44 @@ fn species_names_travel_from_scene_and_file_to_trajectories() {
     .unwrap_err();
     assert!(e.contains("scene.toml:4:") && e.contains("one word"), "{e}");
 }
+
+/// Files MDAnalysis 2.11 writes (fixtures in mote-io/tests/data): a data
+/// file whose `Atoms` line names no style (id mol type x y z: refused
+/// without `atom_style`, read with it) and a plain XYZ.
+#[test]
+fn mdanalysis_files_start_a_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mote-io/tests/data");
+    for f in ["mdanalysis.data", "mdanalysis.xyz"] {
+        std::fs::copy(fixtures.join(f), dir.path().join(f)).unwrap();
+    }
+    let e = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"mdanalysis.data\"\n"),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("mdanalysis.data:") && e.contains("name it"),
+        "{e}"
+    );
+    let sys = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"mdanalysis.data\"\natom_style = \"molecular\"\nradius = 0.5\nperiodic = [true, true, true]\n"),
+    )
+    .unwrap();
+    let want = [
+        DVec3::new(0.5, 1.0, 1.5),
+        DVec3::new(2.25, 0.125, 3.0),
+        DVec3::new(3.5, 4.75, 5.5),
+    ];
+    assert_eq!(sys.particles.position, want);
+    assert_eq!(sys.particles.mass, [39.948, 55.845, 39.948]);
+    assert_eq!(sys.boundary.hi, DVec3::new(4.0, 5.0, 6.0));
+    let sys = build(
+        dir.path(),
+        &format!("{RUN}[[from_file]]\nfile = \"mdanalysis.xyz\"\nmass = 1\n"),
+    )
+    .unwrap();
+    assert_eq!(sys.particles.position, want);
+    assert_eq!(sys.species, ["Ar", "Fe", "Ar"]);
+}

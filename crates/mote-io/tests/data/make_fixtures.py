@@ -70,3 +70,22 @@ pipe = Pipeline(source=StaticSource(data=data))
 export_file(pipe, "ovito.xyz", "xyz", columns=["Position.X", "Position.Y", "Position.Z", "Velocity.X", "Velocity.Y", "Velocity.Z", "Radius"])
 export_file(pipe, "ovito.dump", "lammps/dump", columns=["Particle Identifier", "Particle Type", "Position.X", "Position.Y", "Position.Z", "Velocity.X", "Velocity.Y", "Velocity.Z", "Radius"])
 export_file(pipe, "ovito.data", "lammps/data", atom_style="atomic")
+
+# MDAnalysis 2.11: a LAMMPS data file (an Atoms section without a style
+# comment: id mol type x y z) and a plain XYZ.
+import warnings
+
+import MDAnalysis as mda
+
+warnings.filterwarnings("ignore")
+u = mda.Universe.empty(3, trajectory=True, atom_resindex=[0, 0, 0], residue_segindex=[0])
+u.add_TopologyAttr("type", ["1", "2", "1"])
+u.add_TopologyAttr("name", ["Ar", "Fe", "Ar"])
+u.add_TopologyAttr("masses", [39.948, 55.845, 39.948])
+u.add_TopologyAttr("ids", [1, 2, 3])
+for attr in ["bonds", "angles", "dihedrals", "impropers"]:
+    u.add_TopologyAttr(attr, [])
+u.atoms.positions = np.array([[0.5, 1.0, 1.5], [2.25, 0.125, 3.0], [3.5, 4.75, 5.5]])
+u.dimensions = [4.0, 5.0, 6.0, 90, 90, 90]
+u.atoms.write("mdanalysis.data")
+u.atoms.write("mdanalysis.xyz")

@@ -233,6 +233,9 @@ pub struct DataSpec {
     pub frame: Option<i64>,
     /// Take a data file's box, periodic on these axes.
     pub periodic: Option<[bool; 3]>,
+    /// The atom style of a data file whose `Atoms` line names none
+    /// (MDAnalysis writes none): atomic, charge, molecular, full, sphere.
+    pub atom_style: Option<String>,
     pub radius: Option<f64>,
     pub mass: Option<f64>,
     /// Masses from the radii, m = ρ 4π r³/3 (for files without masses).
@@ -298,7 +301,15 @@ fn from_file(
         Ok((r, m))
     };
     if data {
-        let data = mote_io::lammps_data::read(path).map_err(|e| io(e.into()))?;
+        let style = match &s.atom_style {
+            None => None,
+            Some(name) => Some(mote_io::lammps_data::AtomStyle::named(name).ok_or_else(|| {
+                at(format!(
+                    "atom_style '{name}' is not one of atomic, charge, molecular, full, sphere"
+                ))
+            })?),
+        };
+        let data = mote_io::lammps_data::read_as(path, style).map_err(|e| io(e.into()))?;
         let mut out = Vec::with_capacity(data.atoms.len());
         for a in &data.atoms {
             let radius = 0.5 * a.diameter;
