@@ -523,7 +523,11 @@ impl Layout {
             let size = size_of(e.kind)
                 .checked_mul(e.n)
                 .and_then(|s| s.checked_mul(u64::from(e.m)));
-            if e.location < 0 || size.is_none_or(|s| !inside(e.location as u64, s)) {
+            // An unknown type has size 0 and would pass the bounds check.
+            if e.location < 0
+                || size_of(e.kind) == 0
+                || size.is_none_or(|s| !inside(e.location as u64, s))
+            {
                 return Err(bad(format!(
                     "index entry {k} points past the end of the file (truncated?) or has an unknown type"
                 )));
@@ -835,6 +839,14 @@ mod tests {
         std::fs::write(&path, &bytes).unwrap();
         let e = read_frames(&path).unwrap_err().to_string();
         assert!(e.contains("bad.gsd") && e.contains("truncated"), "{e}");
+        // An index entry of unknown type (0) claiming 2⁶⁰ rows: refused,
+        // not allocated.
+        let mut typeless = std::fs::read(&good).unwrap();
+        let at = u64::from_le_bytes(typeless[8..16].try_into().unwrap()) as usize;
+        typeless[at + 8..at + 16].copy_from_slice(&(1u64 << 60).to_le_bytes());
+        typeless[at + 30] = 0;
+        let e = parse(&typeless, "t.gsd").unwrap_err().to_string();
+        assert!(e.contains("unknown type"), "{e}");
         bytes[0] = 0;
         let e = parse(&bytes, "x.gsd").unwrap_err().to_string();
         assert!(e.contains("magic"), "{e}");

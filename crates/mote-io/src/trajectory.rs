@@ -66,28 +66,20 @@ pub enum TrajectoryWriter {
 
 impl TrajectoryWriter {
     /// A new file; `exact`: numbers that read back bit for bit (all
-    /// formats but VTK, whose positions have 17 digits anyway).
+    /// formats but VTK, whose ASCII numbers are exact anyway).
     pub fn create(
         path: &Path,
         format: Format,
         provenance: Provenance,
         exact: bool,
     ) -> Result<Self, IoError> {
-        Ok(match format {
-            Format::Xyz => {
-                let w = XyzWriter::create(path, provenance)?;
-                TrajectoryWriter::Xyz(if exact { w.exact() } else { w })
-            }
-            Format::Dump => {
-                let w = DumpWriter::create(path)?;
-                TrajectoryWriter::Dump(if exact { w.exact() } else { w })
-            }
-            Format::Gsd => {
-                let w = GsdWriter::create(path)?;
-                TrajectoryWriter::Gsd(if exact { w.exact() } else { w })
-            }
+        let w = match format {
+            Format::Xyz => TrajectoryWriter::Xyz(XyzWriter::create(path, provenance)?),
+            Format::Dump => TrajectoryWriter::Dump(DumpWriter::create(path)?),
+            Format::Gsd => TrajectoryWriter::Gsd(GsdWriter::create(path)?),
             Format::Vtk => TrajectoryWriter::Vtk(PvdWriter::create(path, provenance)?.poly_data()),
-        })
+        };
+        Ok(if exact { w.exact() } else { w })
     }
 
     /// Continues a file an interrupted run wrote (frames past its
@@ -98,21 +90,23 @@ impl TrajectoryWriter {
         provenance: Provenance,
         exact: bool,
     ) -> Result<Self, IoError> {
-        Ok(match format {
-            Format::Xyz => {
-                let w = XyzWriter::append(path, provenance)?;
-                TrajectoryWriter::Xyz(if exact { w.exact() } else { w })
-            }
-            Format::Dump => {
-                let w = DumpWriter::append(path)?;
-                TrajectoryWriter::Dump(if exact { w.exact() } else { w })
-            }
-            Format::Gsd => {
-                let w = GsdWriter::append(path)?;
-                TrajectoryWriter::Gsd(if exact { w.exact() } else { w })
-            }
+        let w = match format {
+            Format::Xyz => TrajectoryWriter::Xyz(XyzWriter::append(path, provenance)?),
+            Format::Dump => TrajectoryWriter::Dump(DumpWriter::append(path)?),
+            Format::Gsd => TrajectoryWriter::Gsd(GsdWriter::append(path)?),
             Format::Vtk => TrajectoryWriter::Vtk(PvdWriter::append(path, provenance)?.poly_data()),
-        })
+        };
+        Ok(if exact { w.exact() } else { w })
+    }
+
+    /// The writer in exact mode (VTK is always exact).
+    fn exact(self) -> Self {
+        match self {
+            TrajectoryWriter::Xyz(w) => TrajectoryWriter::Xyz(w.exact()),
+            TrajectoryWriter::Dump(w) => TrajectoryWriter::Dump(w.exact()),
+            TrajectoryWriter::Gsd(w) => TrajectoryWriter::Gsd(w.exact()),
+            vtk @ TrajectoryWriter::Vtk(_) => vtk,
+        }
     }
 
     /// Appends the frame of step `step`.
