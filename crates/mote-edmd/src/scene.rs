@@ -148,6 +148,10 @@ pub struct Scene {
     /// The frame of `file` (default the last).
     #[serde(skip)]
     pub file_frame: Option<i64>,
+    /// Where the scene names the file (scene file, line), for messages
+    /// about the file that are not about one of its own lines.
+    #[serde(skip)]
+    file_named_at: Option<(String, usize)>,
     /// Check for overlaps at every output (exact, O(N)); default true.
     #[serde(default = "yes")]
     pub check_overlaps: bool,
@@ -390,6 +394,12 @@ impl Scene {
             line: key_line(text, key),
             message,
         };
+        let key = if self.from_file.is_empty() {
+            "file"
+        } else {
+            "from_file"
+        };
+        self.file_named_at = Some((file.to_string(), key_line(text, key)));
         match self.from_file.as_slice() {
             [] => {}
             [start] if self.file.is_none() => {
@@ -716,9 +726,21 @@ impl Scene {
             (size, pos, radii, masses, Some(vel))
         } else if let Some(f) = &self.file {
             let path = base.join(f);
-            let frames = mote_io::trajectory::read_frames(&path)?;
-            let fr = mote_io::trajectory::pick(&frames, self.file_frame, &path)
-                .map_err(EdmdError::Invalid)?;
+            // A message about the file as a whole points at the scene line
+            // that names it; one about a line of the file names that line.
+            let at = |message: String| match &self.file_named_at {
+                Some((file, line)) => EdmdError::Scene {
+                    file: file.clone(),
+                    line: *line,
+                    message,
+                },
+                None => EdmdError::Invalid(message),
+            };
+            let frames = mote_io::trajectory::read_frames(&path).map_err(|e| match e {
+                mote_io::IoError::Parse(p) if p.line > 0 => EdmdError::Io(p.into()),
+                other => at(other.to_string()),
+            })?;
+            let fr = mote_io::trajectory::pick(&frames, self.file_frame, &path).map_err(at)?;
             let mut size = [0.0; D];
             for d in 0..D {
                 size[d] = fr.cell[d][d];

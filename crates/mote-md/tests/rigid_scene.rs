@@ -171,3 +171,126 @@ fn frames_carry_bodies_and_orientations() {
         );
     }
 }
+
+/// The scene text without its `[[rigid.random]]` tables.
+fn without_random(text: &str) -> String {
+    let mut out = String::new();
+    let mut skip = false;
+    for line in text.lines() {
+        if line.starts_with('[') {
+            skip = line.starts_with("[[rigid.random]]");
+        }
+        if !skip {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// A rigid run's last frame, in each format that keeps radii and body ids,
+/// starts a new scene: every body comes back as the template it was, with
+/// its spheres where the file has them and their velocities.
+#[test]
+fn bodies_start_from_a_rigid_runs_frame() {
+    let text = example("clumps-settling.toml")
+        .replace("until = 0.5", "steps = 60")
+        .replace("trajectory_every = 400", "trajectory_every = 60");
+    let original = RigidScene::parse(&text, "s.toml")
+        .unwrap()
+        .build(&text, "s.toml", None)
+        .unwrap();
+    for (format, name) in [
+        (mote_io::trajectory::Format::Xyz, "trajectory.xyz"),
+        (mote_io::trajectory::Format::Dump, "trajectory.dump"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        run_rigid_scene(
+            &text,
+            "s.toml",
+            &RigidRun {
+                out_dir: Some(dir.path().to_path_buf()),
+                trajectory_format: Some(format),
+                ..RigidRun::default()
+            },
+            |_, _, _| {},
+        )
+        .unwrap();
+        let file = dir.path().join(name);
+        let frames = mote_io::trajectory::read_frames(&file).unwrap();
+        let last = frames.last().unwrap();
+        assert!(last.time > 0.0);
+        let again = without_random(&text).replace(
+            "[rigid.fields]",
+            &format!(
+                "[[rigid.from_file]]\nfile = {:?}\n\n[rigid.fields]",
+                file.display().to_string()
+            ),
+        );
+        let built = RigidScene::parse(&again, "again.toml")
+            .unwrap()
+            .build(&again, "again.toml", None)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(built.bodies.kind, original.bodies.kind, "{name}");
+        let frame = mote_md::rigid::run::sphere_frame(&built.bodies);
+        let scale = 40e-3;
+        for (a, b) in frame.positions.iter().zip(&last.positions) {
+            for d in 0..3 {
+                assert!((a[d] - b[d]).abs() < 1e-10 * scale, "{name}: {a:?} {b:?}");
+            }
+        }
+        let speed = last
+            .velocities
+            .iter()
+            .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        assert!(speed > 0.0);
+        for (a, b) in frame.velocities.iter().zip(&last.velocities) {
+            for d in 0..3 {
+                assert!((a[d] - b[d]).abs() < 1e-9 * speed, "{name}: {a:?} {b:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_file_whose_bodies_fit_no_template_names_the_scene_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("f.xyz");
+    std::fs::write(
+        &file,
+        "2\nProperties=species:S:1:pos:R:3:radius:R:1:body:I:1\nX 0 0 0 1.0 0\nX 3 0 0 1.0 0\n",
+    )
+    .unwrap();
+    let text = format!(
+        "[rigid]\n[[rigid.template]]\nname = \"a\"\ngenerator = \"dumbbell\"\nradius = 1.0\ndistance = 1.5\ndensity = 1.0\n\n[[rigid.from_file]]\nfile = {:?}\n\n[run]\ndt = 0.1\nsteps = 1\n",
+        file.display().to_string()
+    );
+    let e = RigidScene::parse(&text, "s.toml")
+        .unwrap()
+        .build(&text, "s.toml", None)
+        .err()
+        .unwrap();
+    assert_eq!(e.line, 9, "{e}");
+    assert!(
+        e.to_string().contains("body 0") && e.to_string().contains("misses by"),
+        "{e}"
+    );
+    // Moved to the dumbbell's distance, the spheres are one body of it.
+    std::fs::write(
+        &file,
+        "2\nProperties=species:S:1:pos:R:3:radius:R:1:body:I:1\nX 0 0 0 1.0 0\nX 0 1.5 0 1.0 0\n",
+    )
+    .unwrap();
+    let built = RigidScene::parse(&text, "s.toml")
+        .unwrap()
+        .build(&text, "s.toml", None)
+        .unwrap();
+    assert_eq!(built.bodies.len(), 1);
+    // (To the error of the template's integrated centre of mass.)
+    let x = built.bodies.position[0];
+    assert!(
+        (x - glam::DVec3::new(0.0, 0.75, 0.0)).length() < 1e-5,
+        "{x}"
+    );
+}

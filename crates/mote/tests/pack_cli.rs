@@ -353,4 +353,19 @@ fn a_jammed_packing_in_every_format_starts_an_event_driven_run() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
+    // A frame the file lacks, or a file that is missing, is named at the
+    // scene's line.
+    for (key, name) in [("frame = 7", "jammed.gsd"), ("", "absent.gsd")] {
+        let scene = dir.path().join("bad.toml");
+        std::fs::write(
+            &scene,
+            format!("title = \"bad\"\n[[from_file]]\nfile = \"{name}\"\n{key}\n[event_driven]\ntemperature = 1.0\n"),
+        )
+        .unwrap();
+        let out = mote().args(["-q", "edmd"]).arg(&scene).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(err.contains("bad.toml:2: "), "{err}");
+        assert!(err.contains(name), "{err}");
+    }
 }

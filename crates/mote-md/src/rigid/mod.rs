@@ -22,6 +22,7 @@ pub mod bodies;
 pub mod contacts;
 pub mod frbi;
 mod free8;
+pub mod from_file;
 pub mod interaction;
 pub mod run;
 pub mod scene;

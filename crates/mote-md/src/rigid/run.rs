@@ -310,6 +310,11 @@ pub fn sphere_frame(b: &RigidBodies) -> Frame {
         species: vec!["X".to_string(); positions.len()],
         masses: sphere_masses(b, &world),
         bodies: world.sphere_body.iter().map(|&k| u64::from(k)).collect(),
+        angular_velocities: world
+            .sphere_body
+            .iter()
+            .map(|&k| b.omega[k as usize].to_array())
+            .collect(),
         // The body's orientation: rotation vector r = n tan(φ/2) as the
         // unit quaternion (cos φ/2, n sin φ/2) = (1, r)/√(1 + r²).
         orientations: world

@@ -121,6 +121,9 @@ pub struct RigidSettings {
     pub lattice: Vec<Spanned<PlacementSpec>>,
     #[serde(default)]
     pub random: Vec<Spanned<PlacementSpec>>,
+    /// `[[rigid.from_file]]`: bodies from a frame of their spheres.
+    #[serde(default)]
+    pub from_file: Vec<Spanned<FileSpec>>,
     #[serde(default)]
     pub fields: Option<Spanned<FieldSettings>>,
     #[serde(default)]
@@ -186,6 +189,29 @@ pub struct BodySpec {
     pub velocity: [f64; 3],
     #[serde(default)]
     pub omega: [f64; 3],
+}
+
+/// `[[rigid.from_file]]`: the bodies of a trajectory frame (`.xyz`,
+/// `.dump`, `.gsd`, `.vtp`/`.vtu`/`.pvd`; path relative to the scene file;
+/// the last frame unless `frame` says which, negative counting from the
+/// end), as a rigid run writes them: one row per sphere with its radius and
+/// body id (a LAMMPS dump's `mol`), and where present the orientation
+/// quaternion and angular velocity. Each body is matched to a template by
+/// its spheres (see [`super::from_file`]).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FileSpec {
+    pub file: String,
+    #[serde(default)]
+    pub frame: Option<i64>,
+    /// Only these templates (default: all the scene's, in order).
+    #[serde(default)]
+    pub templates: Option<Vec<String>>,
+    /// The largest misfit of a sphere centre, as a fraction of the
+    /// template's bounding radius (default 1e-6; files of few digits need
+    /// more).
+    #[serde(default)]
+    pub tolerance: Option<f64>,
 }
 
 /// `[[rigid.lattice]]` / `[[rigid.random]]`.
@@ -436,6 +462,39 @@ impl RigidScene {
                 DE::new(DVec3::from(bs.omega), DVec3::from(bs.velocity)),
             );
         }
+        for f in &rigid.from_file {
+            let (span, fs) = (f.span(), f.get_ref());
+            let at = |m: String| err(span.clone(), m);
+            let candidates: Vec<(String, u32)> = match &fs.templates {
+                None => names.clone(),
+                Some(list) => list
+                    .iter()
+                    .map(|n| Ok((n.clone(), kind_of(n, span.clone())?)))
+                    .collect::<Result<_, ParseError>>()?,
+            };
+            let tolerance = fs.tolerance.unwrap_or(1e-6);
+            if !positive(tolerance) {
+                return Err(at("tolerance must be positive".into()));
+            }
+            let path = std::path::Path::new(file)
+                .parent()
+                .unwrap_or(std::path::Path::new("."))
+                .join(&fs.file);
+            let frames = mote_io::trajectory::read_frames(&path).map_err(|e| match e {
+                mote_io::IoError::Parse(p) if p.line > 0 => p,
+                other => at(other.to_string()),
+            })?;
+            let frame = mote_io::trajectory::pick(&frames, fs.frame, &path).map_err(at)?;
+            let templates: Vec<_> = candidates
+                .iter()
+                .map(|(n, k)| (n.clone(), bodies.templates[*k as usize].clone()))
+                .collect();
+            let placed = super::from_file::place_bodies(frame, &templates, tolerance)
+                .map_err(|m| at(format!("{}: {m}", path.display())))?;
+            for p in placed {
+                bodies.push(candidates[p.template].1, p.placement, p.velocity);
+            }
+        }
         for (random, list) in [(false, &rigid.lattice), (true, &rigid.random)] {
             for p in list {
                 let (span, ps) = (p.span(), p.get_ref());
@@ -474,7 +533,7 @@ impl RigidScene {
         if bodies.is_empty() {
             return Err(src.error(
                 self.rigid.span(),
-                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]] or [[rigid.random]]",
+                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]] or [[rigid.from_file]]",
             ));
         }
 
