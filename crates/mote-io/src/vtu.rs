@@ -207,9 +207,14 @@ fn array<'a>(text: &'a str, name: &str) -> Option<(usize, &'a str, &'a str)> {
     let at = text.find(&key)?;
     let tag_start = text[..at].rfind('<')?;
     let open = at + text[at..].find('>')? + 1;
-    let close = open + text[open..].find("</DataArray>")?;
     let line = text[..at].matches('\n').count() + 1;
-    Some((line, &text[tag_start..open], &text[open..close]))
+    let tag = &text[tag_start..open];
+    if tag.ends_with("/>") {
+        // `<DataArray ... format="appended" offset="N"/>`: no body.
+        return Some((line, tag, ""));
+    }
+    let close = open + text[open..].find("</DataArray>")?;
+    Some((line, tag, &text[open..close]))
 }
 
 /// The value of `key="value"` in a tag.
@@ -249,66 +254,148 @@ fn base64(text: &str) -> Option<Vec<u8>> {
     Some(out)
 }
 
-/// The bytes of a `format="binary"` array: a header (a byte count, or for
-/// zlib-compressed files the block table) and the data, base64-encoded
-/// together or separately (VTK does both).
-fn binary_bytes(body: &str, header: usize, zlib: bool) -> Result<Vec<u8>, String> {
-    let chars: String = body.chars().filter(|c| !c.is_whitespace()).collect();
-    let bad = || "bad base64".to_string();
-    let word = |b: &[u8], k: usize| -> usize {
+/// How a file's binary arrays are compressed (`compressor` of `<VTKFile>`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Compressor {
+    None,
+    Zlib,
+    Lz4,
+}
+
+/// The appended block of a file (`<AppendedData>`): the bytes after its
+/// `_` marker, raw or base64 text.
+struct Appended<'a> {
+    data: &'a [u8],
+    raw: bool,
+}
+
+/// How binary arrays are laid out: header word size (`header_type`) and
+/// compressor.
+#[derive(Clone, Copy)]
+struct Layout {
+    header: usize,
+    compressor: Compressor,
+}
+
+impl Layout {
+    fn word(&self, b: &[u8], k: usize) -> Option<usize> {
         let mut v = [0u8; 8];
-        v[..header].copy_from_slice(&b[k * header..(k + 1) * header]);
-        u64::from_le_bytes(v) as usize
-    };
-    let first = base64(chars.get(..(header.div_ceil(3) * 4)).ok_or_else(bad)?).ok_or_else(bad)?;
-    if first.len() < header {
-        return Err(bad());
+        v[..self.header].copy_from_slice(b.get(k * self.header..(k + 1) * self.header)?);
+        usize::try_from(u64::from_le_bytes(v)).ok()
     }
-    let blocks = word(&first, 0);
-    if zlib && blocks > chars.len() {
-        return Err(format!(
-            "a header of {blocks} compressed blocks in {} characters",
-            chars.len()
-        ));
-    }
-    let words = if zlib { 3 + blocks } else { 1 };
-    let size = words * header;
-    let head_chars = size.div_ceil(3) * 4;
-    let separate = chars.as_bytes().get(head_chars.wrapping_sub(1)) == Some(&b'=');
-    let (head, data) = if separate {
-        let head = base64(chars.get(..head_chars).ok_or_else(bad)?).ok_or_else(bad)?;
-        let data = base64(&chars[head_chars..]).ok_or_else(bad)?;
-        (head, data)
-    } else {
-        let all = base64(&chars).ok_or_else(bad)?;
-        if all.len() < size {
-            return Err("binary array shorter than its header".into());
+
+    /// Header words of an array: 1 (the byte count), or for compressed
+    /// arrays 3 + the number of blocks (blocks, block size, last block
+    /// size, compressed sizes), from the first word.
+    fn words(&self, first: usize) -> usize {
+        match self.compressor {
+            Compressor::None => 1,
+            _ => first.saturating_add(3),
         }
-        (all[..size].to_vec(), all[size..].to_vec())
-    };
-    if !zlib {
-        let n = word(&head, 0);
-        return data
-            .get(..n)
-            .map(<[u8]>::to_vec)
-            .ok_or_else(|| format!("binary array of {} bytes, header says {n}", data.len()));
     }
-    if head.len() < size {
-        return Err(bad());
+
+    /// The data of an array from its header and the bytes that follow it.
+    fn data(&self, head: &[u8], data: &[u8]) -> Result<Vec<u8>, String> {
+        let bad = || "header shorter than it says".to_string();
+        let first = self.word(head, 0).ok_or_else(bad)?;
+        if self.compressor == Compressor::None {
+            return data.get(..first).map(<[u8]>::to_vec).ok_or_else(|| {
+                format!("binary array of {} bytes, header says {first}", data.len())
+            });
+        }
+        let blocks = first;
+        let block_size = self.word(head, 1).ok_or_else(bad)?;
+        let last_size = self.word(head, 2).ok_or_else(bad)?;
+        let mut out = Vec::new();
+        let mut at = 0usize;
+        for k in 0..blocks {
+            let csize = self.word(head, 3 + k).ok_or_else(bad)?;
+            let end = at.checked_add(csize).filter(|&e| e <= data.len());
+            let block = end
+                .map(|e| &data[at..e])
+                .ok_or_else(|| "compressed block past the end of the array".to_string())?;
+            at += csize;
+            let size = if k + 1 == blocks && last_size > 0 {
+                last_size
+            } else {
+                block_size
+            };
+            match self.compressor {
+                Compressor::Zlib => {
+                    // At most the block's size: a corrupt block cannot
+                    // inflate without bound.
+                    let z = flate2::read::ZlibDecoder::new(block);
+                    std::io::Read::read_to_end(&mut std::io::Read::take(z, size as u64), &mut out)
+                        .map_err(|e| format!("zlib: {e}"))?;
+                }
+                Compressor::Lz4 => {
+                    // A block is never larger than the header's block size:
+                    // a corrupt header cannot ask for more.
+                    if size > block.len().saturating_mul(255).saturating_add(16) {
+                        return Err(format!("an LZ4 block of {csize} bytes cannot hold {size}"));
+                    }
+                    let start = out.len();
+                    out.resize(start + size, 0);
+                    let n = lz4_flex::block::decompress_into(block, &mut out[start..])
+                        .map_err(|e| format!("lz4: {e}"))?;
+                    out.truncate(start + n);
+                }
+                Compressor::None => unreachable!(),
+            }
+        }
+        Ok(out)
     }
-    let mut out = Vec::new();
-    let mut at = 0usize;
-    for k in 0..blocks {
-        let csize = word(&head, 3 + k);
-        let end = at.checked_add(csize).filter(|&e| e <= data.len());
-        let block = end
-            .map(|e| &data[at..e])
-            .ok_or_else(|| "compressed block past the end of the array".to_string())?;
-        at += csize;
-        let mut z = flate2::read::ZlibDecoder::new(block);
-        std::io::Read::read_to_end(&mut z, &mut out).map_err(|e| format!("zlib: {e}"))?;
+
+    /// The bytes of an appended array stored raw at the start of `bytes`.
+    fn raw(&self, bytes: &[u8]) -> Result<Vec<u8>, String> {
+        let first = self
+            .word(bytes, 0)
+            .ok_or("appended array past the end of the file")?;
+        let words = self.words(first);
+        if self.compressor != Compressor::None && first > bytes.len() {
+            return Err(format!(
+                "a header of {first} compressed blocks in {} bytes",
+                bytes.len()
+            ));
+        }
+        let size = words * self.header;
+        let head = bytes
+            .get(..size)
+            .ok_or("appended header past the end of the file")?;
+        self.data(head, &bytes[size..])
     }
-    Ok(out)
+
+    /// The bytes of a base64 array (inline `format="binary"`, or appended
+    /// with `encoding="base64"`): header and data encoded together or
+    /// separately (VTK does both).
+    fn base64(&self, body: &str) -> Result<Vec<u8>, String> {
+        let chars: String = body.chars().filter(|c| !c.is_whitespace()).collect();
+        let bad = || "bad base64".to_string();
+        let first =
+            base64(chars.get(..(self.header.div_ceil(3) * 4)).ok_or_else(bad)?).ok_or_else(bad)?;
+        let blocks = self.word(&first, 0).ok_or_else(bad)?;
+        if self.compressor != Compressor::None && blocks > chars.len() {
+            return Err(format!(
+                "a header of {blocks} compressed blocks in {} characters",
+                chars.len()
+            ));
+        }
+        let size = self.words(blocks) * self.header;
+        let head_chars = size.div_ceil(3) * 4;
+        let separate = chars.as_bytes().get(head_chars.wrapping_sub(1)) == Some(&b'=');
+        let (head, data) = if separate {
+            let head = base64(chars.get(..head_chars).ok_or_else(bad)?).ok_or_else(bad)?;
+            let data = base64(&chars[head_chars..]).ok_or_else(bad)?;
+            (head, data)
+        } else {
+            let all = base64(&chars).ok_or_else(bad)?;
+            if all.len() < size {
+                return Err("binary array shorter than its header".into());
+            }
+            (all[..size].to_vec(), all[size..].to_vec())
+        };
+        self.data(&head, &data)
+    }
 }
 
 /// Little-endian values of a VTK type as f64.
@@ -336,54 +423,137 @@ fn decode(bytes: &[u8], kind: &str) -> Option<Vec<f64>> {
     })
 }
 
-fn numbers(text: &str, fname: &str, name: &str) -> Result<Vec<f64>, ParseError> {
+fn numbers(
+    text: &str,
+    appended: Option<&Appended>,
+    fname: &str,
+    name: &str,
+) -> Result<Vec<f64>, ParseError> {
     let (line, tag, body) = array(text, name)
         .ok_or_else(|| ParseError::new(fname, 0, format!("no DataArray named '{name}'")))?;
     let err = |m: String| ParseError::new(fname, line, format!("DataArray '{name}': {m}"));
-    match attribute(tag, "format").unwrap_or("ascii") {
-        "ascii" => body
+    let format = attribute(tag, "format").unwrap_or("ascii");
+    if format == "ascii" {
+        return body
             .split_whitespace()
             .map(|w| {
                 w.parse::<f64>()
                     .map_err(|_| err(format!("'{w}' is not a number")))
             })
-            .collect(),
-        "binary" => {
-            let file = &text[text.find("<VTKFile").unwrap_or(0)..];
-            let file_tag = &file[..file.find('>').unwrap_or(file.len())];
-            if attribute(file_tag, "byte_order") == Some("BigEndian") {
-                return Err(err("big-endian files are not read".into()));
-            }
-            let header = match attribute(file_tag, "header_type") {
-                Some("UInt64") => 8,
-                _ => 4,
-            };
-            let zlib = match attribute(file_tag, "compressor") {
-                None => false,
-                Some("vtkZLibDataCompressor") => true,
-                Some(other) => {
-                    return Err(err(format!("compressor {other} is not read (zlib is)")))
-                }
-            };
-            let kind = attribute(tag, "type").unwrap_or("Float64");
-            let bytes = binary_bytes(body, header, zlib).map_err(err)?;
-            decode(&bytes, kind).ok_or_else(|| err(format!("type {kind} is not read")))
-        }
-        other => Err(err(format!(
-            "format '{other}' is not read (ascii and binary are)"
-        ))),
+            .collect();
     }
+    if !matches!(format, "binary" | "appended") {
+        return Err(err(format!(
+            "format '{format}' is not read (ascii, binary and appended are)"
+        )));
+    }
+    let file = &text[text.find("<VTKFile").unwrap_or(0)..];
+    let file_tag = &file[..file.find('>').unwrap_or(file.len())];
+    if attribute(file_tag, "byte_order") == Some("BigEndian") {
+        return Err(err("big-endian files are not read".into()));
+    }
+    let layout = Layout {
+        header: match attribute(file_tag, "header_type") {
+            Some("UInt64") => 8,
+            _ => 4,
+        },
+        compressor: match attribute(file_tag, "compressor") {
+            None | Some("") => Compressor::None,
+            Some("vtkZLibDataCompressor") => Compressor::Zlib,
+            Some("vtkLZ4DataCompressor") => Compressor::Lz4,
+            Some(other) => {
+                return Err(err(format!(
+                    "compressor {other} is not read (zlib and LZ4 are)"
+                )))
+            }
+        },
+    };
+    let kind = attribute(tag, "type").unwrap_or("Float64");
+    let bytes = if format == "binary" {
+        layout.base64(body)
+    } else {
+        let a = appended
+            .ok_or_else(|| err("format 'appended' but the file has no <AppendedData>".into()))?;
+        let offset = attribute(tag, "offset")
+            .and_then(|o| o.trim().parse::<usize>().ok())
+            .ok_or_else(|| err("an appended array needs offset=\"N\"".into()))?;
+        let at = a
+            .data
+            .get(offset..)
+            .ok_or_else(|| err(format!("offset {offset} past the end of the appended data")))?;
+        if a.raw {
+            layout.raw(at)
+        } else {
+            std::str::from_utf8(at)
+                .map_err(|_| "base64 appended data is not text".to_string())
+                .and_then(|t| layout.base64(t.split('<').next().unwrap_or(t)))
+        }
+    }
+    .map_err(err)?;
+    decode(&bytes, kind).ok_or_else(|| err(format!("type {kind} is not read")))
+}
+
+/// Splits a VTK XML file into its text and its appended block, if any.
+fn split_appended<'a>(
+    bytes: &'a [u8],
+    name: &str,
+) -> Result<(&'a str, Option<Appended<'a>>), ParseError> {
+    let find = |hay: &[u8], needle: &[u8]| hay.windows(needle.len()).position(|w| w == needle);
+    let not_text = |upto: usize| {
+        let line = bytes[..upto].iter().filter(|&&b| b == b'\n').count() + 1;
+        ParseError::new(
+            name,
+            line,
+            "not UTF-8 text (a VTK XML file is text up to <AppendedData>)",
+        )
+    };
+    let Some(start) = find(bytes, b"<AppendedData") else {
+        let text = std::str::from_utf8(bytes).map_err(|e| not_text(e.valid_up_to()))?;
+        return Ok((text, None));
+    };
+    let head_end = start + find(&bytes[start..], b">").ok_or_else(|| not_text(start))? + 1;
+    let text = std::str::from_utf8(&bytes[..head_end]).map_err(|e| not_text(e.valid_up_to()))?;
+    let tag = &text[start..];
+    let raw = match attribute(tag, "encoding") {
+        Some("raw") => true,
+        Some("base64") | None => false,
+        Some(other) => {
+            let line = text.matches('\n').count() + 1;
+            return Err(ParseError::new(
+                name,
+                line,
+                format!("AppendedData encoding '{other}' is not read (raw and base64 are)"),
+            ));
+        }
+    };
+    // The data start after the `_` that follows the tag.
+    let marker = find(&bytes[head_end..], b"_").map(|k| head_end + k + 1);
+    let data = match marker {
+        Some(k) => &bytes[k..],
+        None => &[][..],
+    };
+    Ok((text, Some(Appended { data, raw })))
 }
 
 /// Reads a `.vtu` written by [`write_vtu`] back into a frame.
 pub fn read_vtu(path: &Path) -> Result<Frame, IoError> {
-    let text = std::fs::read_to_string(path).map_err(|e| IoError::os(path, e))?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::os(path, e))?;
     let name = path.display().to_string();
-    parse_vtu(&text, &name).map_err(IoError::from)
+    parse_vtu_bytes(&bytes, &name).map_err(IoError::from)
 }
 
 /// Parses `.vtu` text; `name` is used in error messages.
 pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
+    parse_vtu_bytes(text.as_bytes(), name)
+}
+
+/// Parses a `.vtu` or `.vtp` file's bytes: ASCII, inline binary (base64)
+/// and appended (raw or base64) arrays, uncompressed or compressed with
+/// zlib or LZ4 (the VTK and ParaView writers' choices); `name` is used in
+/// error messages.
+pub fn parse_vtu_bytes(bytes: &[u8], name: &str) -> Result<Frame, ParseError> {
+    let (text, appended) = split_appended(bytes, name)?;
+    let appended = appended.as_ref();
     if !text.contains("<VTKFile")
         || !(text.contains("UnstructuredGrid") || text.contains("PolyData"))
     {
@@ -393,7 +563,7 @@ pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
             "not a VTK XML UnstructuredGrid or PolyData file",
         ));
     }
-    let pts = numbers(text, name, "Points")?;
+    let pts = numbers(text, appended, name, "Points")?;
     if pts.len() % 3 != 0 {
         return Err(ParseError::new(
             name,
@@ -418,7 +588,7 @@ pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
         }
     };
     // Radii, velocities and types where the file has them.
-    let optional = |array: &str| match numbers(text, name, array) {
+    let optional = |array: &str| match numbers(text, appended, name, array) {
         Err(e) if e.message.starts_with("no DataArray") => Ok(None),
         other => other.map(Some),
     };
@@ -430,22 +600,22 @@ pub fn parse_vtu(text: &str, name: &str) -> Result<Frame, ParseError> {
         check(&v, "velocity", 3 * n)?;
         frame.velocities = v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     }
-    if let Ok(t) = numbers(text, name, "TIME") {
+    if let Ok(t) = numbers(text, appended, name, "TIME") {
         frame.time = t.first().copied().unwrap_or(0.0);
     }
-    if let Ok(c) = numbers(text, name, "cell") {
+    if let Ok(c) = numbers(text, appended, name, "cell") {
         check(&c, "cell", 9)?;
         frame.cell = [[c[0], c[1], c[2]], [c[3], c[4], c[5]], [c[6], c[7], c[8]]];
     }
-    if let Ok(o) = numbers(text, name, "origin") {
+    if let Ok(o) = numbers(text, appended, name, "origin") {
         check(&o, "origin", 3)?;
         frame.origin = [o[0], o[1], o[2]];
     }
-    if let Ok(p) = numbers(text, name, "pbc") {
+    if let Ok(p) = numbers(text, appended, name, "pbc") {
         check(&p, "pbc", 3)?;
         frame.pbc = [p[0] != 0.0, p[1] != 0.0, p[2] != 0.0];
     }
-    let species: Vec<String> = match numbers(text, name, "species") {
+    let species: Vec<String> = match numbers(text, appended, name, "species") {
         Ok(bytes) => bytes
             .split(|b| *b == 0.0)
             .filter(|s| !s.is_empty())

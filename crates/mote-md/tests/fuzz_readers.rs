@@ -148,6 +148,21 @@ fn fuzz_all(count: usize) -> usize {
     tried += fuzz("binary vtu", meshio, count, |b| {
         let _ = mote_io::vtu::parse_vtu(&lossy(b), "fuzz.vtu");
     });
+    // VTP as VTK/ParaView write it: appended raw bytes, zlib and LZ4.
+    for (name, seed) in [
+        (
+            "appended zlib vtp",
+            &include_bytes!("../../mote-io/tests/data/vtk_raw_zlib.vtp")[..],
+        ),
+        (
+            "appended lz4 vtp",
+            &include_bytes!("../../mote-io/tests/data/vtk_raw_lz4.vtp")[..],
+        ),
+    ] {
+        tried += fuzz(name, seed, count, |b| {
+            let _ = mote_io::vtu::parse_vtu_bytes(b, "fuzz.vtp");
+        });
+    }
     // GSD (binary: mutated bytes, never a panic or a huge allocation).
     let gsd_path = dir.path().join("seed.gsd");
     let mut g = mote_io::gsd::GsdWriter::create(&gsd_path).unwrap();

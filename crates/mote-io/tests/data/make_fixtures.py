@@ -89,3 +89,48 @@ u.atoms.positions = np.array([[0.5, 1.0, 1.5], [2.25, 0.125, 3.0], [3.5, 4.75, 5
 u.dimensions = [4.0, 5.0, 6.0, 90, 90, 90]
 u.atoms.write("mdanalysis.data")
 u.atoms.write("mdanalysis.xyz")
+
+# VTK 9.7 (pip install vtk), the writer ParaView uses: appended data, raw
+# (ParaView's default) and base64 (VTK's), zlib-compressed and not, and LZ4;
+# three vertices with radius and velocity arrays (Float32 velocity).
+import vtk
+from vtk.util.numpy_support import numpy_to_vtk
+
+def poly():
+    pd = vtk.vtkPolyData()
+    pts = vtk.vtkPoints()
+    pts.SetDataTypeToDouble()
+    for p in [[0.0, 0.0, 0.0], [1.0, 2.0, 3.5], [-0.25, 0.5, 1e-3]]:
+        pts.InsertNextPoint(p)
+    pd.SetPoints(pts)
+    verts = vtk.vtkCellArray()
+    for i in range(3):
+        verts.InsertNextCell(1)
+        verts.InsertCellPoint(i)
+    pd.SetVerts(verts)
+    r = numpy_to_vtk(np.array([0.5, 0.25, 0.125]), deep=True)
+    r.SetName("radius")
+    pd.GetPointData().AddArray(r)
+    v = numpy_to_vtk(np.array([[1.0, 0.0, -0.5], [0.0, 2.0, 0.0], [0.25, 0.0, 4.0]], dtype=np.float32), deep=True)
+    v.SetName("Velocity")
+    pd.GetPointData().AddArray(v)
+    return pd
+
+for name, raw, compressor in [
+    ("vtk_raw_zlib.vtp", True, "zlib"),
+    ("vtk_raw.vtp", True, None),
+    ("vtk_base64_zlib.vtp", False, "zlib"),
+    ("vtk_raw_lz4.vtp", True, "lz4"),
+]:
+    w = vtk.vtkXMLPolyDataWriter()
+    w.SetFileName(name)
+    w.SetInputData(poly())
+    w.SetDataModeToAppended()
+    w.SetEncodeAppendedData(0 if raw else 1)
+    if compressor == "zlib":
+        w.SetCompressorTypeToZLib()
+    elif compressor == "lz4":
+        w.SetCompressorTypeToLZ4()
+    else:
+        w.SetCompressorTypeToNone()
+    w.Write()
