@@ -160,6 +160,20 @@ pub struct PackSettings {
     /// growth at Γ to the end.
     pub finish: Option<Finish>,
     pub seed: u64,
+    /// Grow from these spheres instead of a random start (`n`, `sizes` and
+    /// `phi_start` are then ignored).
+    pub start: Option<PackStart>,
+}
+
+/// A start given by the caller (a frame of a file): the box's side lengths,
+/// positions measured from its lower corner, radii. Units are the caller's:
+/// growth, pressure and every tolerance are relative, so the packing is the
+/// same at any scale.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PackStart {
+    pub size: Vec<f64>,
+    pub positions: Vec<Vec<f64>>,
+    pub radii: Vec<f64>,
 }
 
 /// The quasi-static finish for jammed packings (the protocol of spheropack's
@@ -205,6 +219,7 @@ impl Default for PackSettings {
             rescale_every: 10.0,
             finish: None,
             seed: 1,
+            start: None,
         }
     }
 }
@@ -299,8 +314,9 @@ impl<const D: usize> Packer<D> {
     pub fn new(settings: PackSettings) -> Result<Self, EdmdError> {
         let invalid = |m: String| EdmdError::Invalid(m);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(settings.seed);
-        let n = match &settings.sizes {
-            SizeSpec::Radii(r) => r.len(),
+        let n = match (&settings.start, &settings.sizes) {
+            (Some(s), _) => s.radii.len(),
+            (None, SizeSpec::Radii(r)) => r.len(),
             _ => settings.n,
         };
         if n < 2 {
@@ -312,13 +328,13 @@ impl<const D: usize> Packer<D> {
                 settings.rate
             )));
         }
-        if !(settings.phi_start > 0.0 && settings.phi_start < 0.3) {
+        if settings.start.is_none() && !(settings.phi_start > 0.0 && settings.phi_start < 0.3) {
             return Err(invalid(format!(
                 "starting packing fraction {} must lie in (0, 0.3)",
                 settings.phi_start
             )));
         }
-        if let Some(t) = settings.target_phi {
+        if let Some(t) = settings.target_phi.filter(|_| settings.start.is_none()) {
             if !(t > settings.phi_start && t < 1.0) {
                 return Err(invalid(format!(
                     "target packing fraction {t} must lie between the start {} and 1",
@@ -335,43 +351,55 @@ impl<const D: usize> Packer<D> {
                 settings.max_pressure
             )));
         }
-        let d = settings.sizes.diameters(n, &mut rng);
-        if let Some(k) = d.iter().position(|x| !(*x > 0.0 && x.is_finite())) {
-            return Err(invalid(format!(
-                "radius {} (particle {k}) must be positive and finite",
-                d[k] / 2.0
-            )));
-        }
-        // box for ⟨d⟩ ≈ 1 near jamming
-        let mean_d = d.iter().sum::<f64>() / n as f64;
-        let vol: f64 = d.iter().map(|x| ball_volume(D, 0.5 * x / mean_d)).sum();
-        let phi_guess = if D == 2 { 0.84 } else { 0.64 };
-        let side = (vol / phi_guess).powf(1.0 / D as f64);
-        let scale = (settings.phi_start / phi_guess).powf(1.0 / D as f64) / mean_d;
-        let radii: Vec<f64> = d.iter().map(|x| 0.5 * x * scale).collect();
         let mut walls = [false; D];
         for (k, w) in settings.walls.iter().enumerate().take(D) {
             walls[k] = *w;
         }
-        let simbox = SimBox {
-            size: [side; D],
-            boundary: walls.map(|w| {
-                if w {
-                    Boundary::Wall
-                } else {
-                    Boundary::Periodic
+        let boundary = walls.map(|w| {
+            if w {
+                Boundary::Wall
+            } else {
+                Boundary::Periodic
+            }
+        });
+        let phi_guess = if D == 2 { 0.84 } else { 0.64 };
+        let (simbox, pos, radii) = match &settings.start {
+            Some(start) => Self::given_start(start, boundary, settings.target_phi)?,
+            None => {
+                let d = settings.sizes.diameters(n, &mut rng);
+                if let Some(k) = d.iter().position(|x| !(*x > 0.0 && x.is_finite())) {
+                    return Err(invalid(format!(
+                        "radius {} (particle {k}) must be positive and finite",
+                        d[k] / 2.0
+                    )));
                 }
-            }),
+                // box for ⟨d⟩ ≈ 1 near jamming
+                let mean_d = d.iter().sum::<f64>() / n as f64;
+                let vol: f64 = d.iter().map(|x| ball_volume(D, 0.5 * x / mean_d)).sum();
+                let side = (vol / phi_guess).powf(1.0 / D as f64);
+                let scale = (settings.phi_start / phi_guess).powf(1.0 / D as f64) / mean_d;
+                let radii: Vec<f64> = d.iter().map(|x| 0.5 * x * scale).collect();
+                let simbox = SimBox {
+                    size: [side; D],
+                    boundary,
+                };
+                let pos =
+                    random_placement(&radii, simbox.size, walls.map(|w| !w), &mut rng, 100_000)
+                        .ok_or_else(|| invalid("could not place the particles at random".into()))?;
+                (simbox, pos, radii)
+            }
         };
-        let largest = radii.iter().cloned().fold(0.0, f64::max) / scale;
-        if 2.0 * largest >= 0.3 * side {
+        // The largest diameter when grown to φ ≈ φ_J, against the box.
+        let phi_now = radii.iter().map(|r| ball_volume(D, *r)).sum::<f64>() / simbox.volume();
+        let growth = (phi_guess / phi_now).powf(1.0 / D as f64);
+        let side = simbox.size.iter().cloned().fold(f64::INFINITY, f64::min);
+        let largest = 2.0 * radii.iter().cloned().fold(0.0, f64::max) * growth;
+        if largest >= 0.3 * side {
             return Err(invalid(format!(
                 "{n} particles are too few for the largest diameter ({:.3} of the box side at jamming): use more particles or a narrower distribution",
-                2.0 * largest / side
+                largest / side
             )));
         }
-        let pos = random_placement(&radii, simbox.size, walls.map(|w| !w), &mut rng, 100_000)
-            .ok_or_else(|| invalid("could not place the particles at random".into()))?;
         let masses = vec![1.0; n];
         let vel = thermal_velocities::<D, _>(&masses, 1.0, &mut rng);
         let ke_target = 0.5 * D as f64 * n as f64;
@@ -397,6 +425,61 @@ impl<const D: usize> Packer<D> {
             last_pressure: f64::NAN,
             history: Vec::new(),
         })
+    }
+
+    /// The box, positions and radii of a given start, checked: finite,
+    /// positive, inside the box, a target φ above the start's.
+    #[allow(clippy::type_complexity)]
+    fn given_start(
+        start: &PackStart,
+        boundary: [Boundary; D],
+        target_phi: Option<f64>,
+    ) -> Result<(SimBox<D>, Vec<[f64; D]>, Vec<f64>), EdmdError> {
+        let invalid = |m: String| EdmdError::Invalid(m);
+        if start.size.len() < D || start.size[..D].iter().any(|l| !(*l > 0.0 && l.is_finite())) {
+            return Err(invalid(format!(
+                "the start's box {:?} needs {D} positive side lengths",
+                start.size
+            )));
+        }
+        if start.positions.len() != start.radii.len() {
+            return Err(invalid("the start has as many positions as radii".into()));
+        }
+        let mut size = [0.0; D];
+        size.copy_from_slice(&start.size[..D]);
+        let simbox = SimBox { size, boundary };
+        let mut pos = Vec::with_capacity(start.radii.len());
+        for (k, (p, r)) in start.positions.iter().zip(&start.radii).enumerate() {
+            if !(*r > 0.0 && r.is_finite()) {
+                return Err(invalid(format!(
+                    "radius {r} (particle {k}) must be positive and finite"
+                )));
+            }
+            let mut x = [0.0; D];
+            for d in 0..D {
+                let v = p.get(d).copied().unwrap_or(f64::NAN);
+                if !v.is_finite() {
+                    return Err(invalid(format!(
+                        "particle {k}: position {p:?} is not finite"
+                    )));
+                }
+                // Periodic axes wrap; walls must hold the sphere.
+                x[d] = match boundary[d] {
+                    Boundary::Periodic => v.rem_euclid(size[d]),
+                    Boundary::Wall => v,
+                };
+            }
+            pos.push(x);
+        }
+        let phi = start.radii.iter().map(|r| ball_volume(D, *r)).sum::<f64>() / simbox.volume();
+        if let Some(t) = target_phi {
+            if !(t > phi && t < 1.0) {
+                return Err(invalid(format!(
+                    "target packing fraction {t} must lie between the start's {phi:.6} and 1"
+                )));
+            }
+        }
+        Ok((simbox, pos, start.radii.clone()))
     }
 
     /// A system growing at d⟨d⟩/dt = Γ v_th (v_th = 1) from the given state,

@@ -57,6 +57,11 @@ pub struct PackingSpec {
     /// Relative gap tolerance of contacts in the summary (default
     /// 1000/max_pressure).
     pub tol: Option<f64>,
+    /// Grow from the last frame of this trajectory (`.xyz`, `.dump`,
+    /// `.gsd`, `.vtp`/`.vtu`/`.pvd`, relative to the scene's folder): its
+    /// positions, radii and orthogonal box (`n`, `dist` and `phi_start` are
+    /// then ignored).
+    pub start: Option<String>,
 }
 
 impl Default for PackingSpec {
@@ -78,6 +83,7 @@ impl Default for PackingSpec {
             jam_relax: 4,
             phi_start: 0.1,
             tol: None,
+            start: None,
         }
     }
 }
@@ -124,7 +130,7 @@ impl PackingSpec {
         base: &Path,
     ) -> Result<PackSettings, FrontError> {
         let said = |key: &str, value: &dyn std::fmt::Display| {
-            naming.said(key, value, matches!(key, "dist" | "walls"))
+            naming.said(key, value, matches!(key, "dist" | "walls" | "start"))
         };
         if self.dimension != 2 && self.dimension != 3 {
             refuse!("{}: must be 2 or 3", said("dimension", &self.dimension));
@@ -136,6 +142,13 @@ impl PackingSpec {
             self.n as f64 * 300.0,
         )
         .map_err(FrontError::request)?;
+        let start = match &self.start {
+            Some(file) => Some(
+                read_start(&base.join(file), self.dimension)
+                    .map_err(|e| FrontError::request(format!("{}: {e}", said("start", &file))))?,
+            ),
+            None => None,
+        };
         let sizes = match self.dist.strip_prefix("file:") {
             Some(p) => SizeSpec::Radii(read_radii(&base.join(p))?),
             None => SizeSpec::parse(&self.dist)
@@ -182,8 +195,38 @@ impl PackingSpec {
                 step: self.jam_step,
             }),
             seed,
+            start,
         })
     }
+}
+
+/// The start of a packing from a trajectory's last frame: positions from
+/// the box's lower corner, radii, side lengths.
+fn read_start(path: &Path, dimension: usize) -> Result<mote_edmd::pack::PackStart, String> {
+    let frames = mote_io::trajectory::read_frames(path).map_err(|e| e.to_string())?;
+    let f = mote_io::trajectory::pick(&frames, None, path)?;
+    let n = f.positions.len();
+    if f.radii.len() != n || n == 0 {
+        return Err(format!("{}: the frame gives no radii", path.display()));
+    }
+    let c = f.cell;
+    let skew = (0..3).any(|i| (0..3).any(|j| i != j && c[i][j] != 0.0));
+    let size: Vec<f64> = (0..dimension).map(|d| c[d][d]).collect();
+    if skew || size.iter().any(|l| *l <= 0.0) {
+        return Err(format!(
+            "{}: the frame's box must be orthogonal with positive sides (cell {c:?})",
+            path.display()
+        ));
+    }
+    Ok(mote_edmd::pack::PackStart {
+        size,
+        positions: f
+            .positions
+            .iter()
+            .map(|p| (0..dimension).map(|d| p[d] - f.origin[d]).collect())
+            .collect(),
+        radii: f.radii.clone(),
+    })
 }
 
 /// Reads one radius per line (`#` starts a comment); errors as `file:line: ...`.

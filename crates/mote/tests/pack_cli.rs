@@ -369,3 +369,102 @@ fn a_jammed_packing_in_every_format_starts_an_event_driven_run() {
         assert!(err.contains(name), "{err}");
     }
 }
+
+/// A packing grows from a file's spheres (`--start`, `[packing] start`):
+/// the same spheres, the file's box, denser at the end; a missing file is
+/// named with the option or the scene line.
+#[test]
+fn a_packing_grows_from_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let dilute = dir.path().join("dilute.gsd");
+    let out = mote()
+        .args([
+            "-q",
+            "--seed",
+            "2",
+            "pack",
+            "--n",
+            "200",
+            "--dist",
+            "lognormal:0.1",
+            "--phi",
+            "0.3",
+            "-o",
+        ])
+        .arg(&dilute)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let first = mote_io::trajectory::read_frames(&dilute)
+        .unwrap()
+        .pop()
+        .unwrap();
+    let denser = dir.path().join("denser.xyz");
+    let out = mote()
+        .args(["-q", "pack", "--start"])
+        .arg(&dilute)
+        .args(["--phi", "0.5", "-o"])
+        .arg(&denser)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let last = mote_io::trajectory::read_frames(&denser)
+        .unwrap()
+        .pop()
+        .unwrap();
+    assert_eq!(last.positions.len(), 200);
+    assert_eq!(last.cell, first.cell);
+    // Every radius grew by the same factor: the size distribution is kept.
+    let g = last.radii[0] / first.radii[0];
+    assert!(g > 1.1, "{g}");
+    for (a, b) in last.radii.iter().zip(&first.radii) {
+        assert!((a / b - g).abs() < 1e-9 * g, "{a} {b} {g}");
+    }
+    let volume: f64 = last
+        .radii
+        .iter()
+        .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+        .sum();
+    let phi = volume / (last.cell[0][0] * last.cell[1][1] * last.cell[2][2]);
+    assert!((phi - 0.5).abs() < 1e-9, "{phi}");
+    // The scene key, relative to the scene file.
+    let scene = dir.path().join("grow.toml");
+    std::fs::write(&scene, "[packing]\nstart = \"dilute.gsd\"\nphi = 0.4\n").unwrap();
+    let out = mote()
+        .args(["-q", "run"])
+        .arg(&scene)
+        .arg("-o")
+        .arg(dir.path().join("grown"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::write(&scene, "[packing]\nphi = 0.4\nstart = \"absent.xyz\"\n").unwrap();
+    let out = mote().args(["-q", "run"]).arg(&scene).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("grow.toml:3: [packing] start = \"absent.xyz\""),
+        "{err}"
+    );
+    let out = mote()
+        .args(["-q", "pack", "--start", "absent.xyz"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--start absent.xyz"),
+        "{err}"
+    );
+}

@@ -23,9 +23,13 @@ use crate::progress::Terminal;
 pub struct PackArgs {
     #[command(subcommand)]
     command: Option<PackCommand>,
-    /// Number of particles (ignored with --dist file:PATH).
+    /// Number of particles (ignored with --dist file:PATH or --start).
     #[arg(long, short = 'n', default_value_t = 1000)]
     n: usize,
+    /// Grow from the last frame of this trajectory (xyz, dump, gsd, vtp/pvd):
+    /// its positions, radii and box, instead of a random start.
+    #[arg(long, value_name = "FILE")]
+    start: Option<String>,
     /// Dimension: 3 (spheres) or 2 (disks).
     #[arg(long, default_value_t = 3)]
     dim: usize,
@@ -142,6 +146,7 @@ impl PackArgs {
             jam_relax: self.jam_relax,
             phi_start: self.phi_start,
             tol: self.tol,
+            start: self.start.clone(),
         }
     }
 }
@@ -153,11 +158,13 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     let spec = a.spec();
     let (seed, chosen) = mote_front::seed::resolve(global.seed, None);
     let settings = spec.settings(seed, Naming::Options, Path::new("."))?;
+    let start = match &a.start {
+        Some(file) => format!("--start {file}"),
+        None => format!("--n {} --dist {}", a.n, a.dist),
+    };
     let label = format!(
-        "mote pack --dim {} --n {} --dist {} --rate {} --max-pressure {:e}{}",
+        "mote pack --dim {} {start} --rate {} --max-pressure {:e}{}",
         a.dim,
-        a.n,
-        a.dist,
         a.rate,
         a.max_pressure,
         if a.no_jam { " --no-jam" } else { "" }
