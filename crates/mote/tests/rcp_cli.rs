@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::process::{Command, Output, Stdio};
 
-fn mote(args: &[&str], stdin: &str) -> Output {
+fn mote(args: &[&str], stdin: impl AsRef<[u8]>) -> Output {
     let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
         .arg("rcp")
         .args(args)
@@ -18,7 +18,7 @@ fn mote(args: &[&str], stdin: &str) -> Output {
         .stdin
         .take()
         .expect("stdin")
-        .write_all(stdin.as_bytes())
+        .write_all(stdin.as_ref())
         .expect("write stdin");
     child.wait_with_output().expect("mote finishes")
 }
@@ -33,7 +33,7 @@ fn ok(args: &[&str], stdin: &str) -> String {
     String::from_utf8(out.stdout).expect("utf-8")
 }
 
-fn fails(args: &[&str], stdin: &str, message: &str) {
+fn fails(args: &[&str], stdin: impl AsRef<[u8]>, message: &str) {
     let out = mote(args, stdin);
     assert_eq!(
         out.status.code(),
@@ -213,17 +213,24 @@ fn errors_on_input() {
     fails(
         &["-p", "2"],
         "1 1\n2 x\n",
-        "Error: 'x' in the input is not a number (expected the volume of population 2).",
+        "Error: standard input:2: 'x' is not a number (expected the volume of population 2).",
     );
     fails(
         &["-l"],
         "nan 1\n",
-        "Error: d43 must be a finite number, got 'nan'.",
+        "Error: standard input:1: d43 must be a finite number, got 'nan'.",
     );
     fails(
         &["-i"],
         "two\n",
-        "Error: expected the number of populations as the first item of the input, found 'two'.",
+        "Error: standard input:1: expected the number of populations as the first item of the input, found 'two'.",
+    );
+    // Bytes that are not UTF-8 are an item that is not a number (it was
+    // an I/O error with exit status 1: found by fuzzing).
+    fails(
+        &["-p", "2"],
+        b"1 1\n\n2 \xff\n",
+        "Error: standard input:3: '\u{fffd}' is not a number (expected the volume of population 2).",
     );
     fails(
         &["-i"],

@@ -80,37 +80,53 @@ enum Mode {
     LogSigma,
 }
 
-/// Whitespace-separated items from standard input, read a line at a time so that the
-/// prompts of `-v` work interactively.
+/// Whitespace-separated items from standard input with their line numbers,
+/// read a line at a time so that the prompts of `-v` work interactively.
+/// Bytes that are not UTF-8 become U+FFFD, so such an item is "not a
+/// number" with its line, like any other.
 struct Items<'a, R: BufRead> {
     input: &'a mut R,
-    pending: std::collections::VecDeque<String>,
+    pending: std::collections::VecDeque<(usize, String)>,
+    lines: usize,
 }
 
-impl<R: BufRead> Items<'_, R> {
-    fn next_item(&mut self) -> Result<Option<String>, Exit> {
+impl<'a, R: BufRead> Items<'a, R> {
+    fn new(input: &'a mut R) -> Self {
+        Items {
+            input,
+            pending: Default::default(),
+            lines: 0,
+        }
+    }
+
+    fn next_item(&mut self) -> Result<Option<(usize, String)>, Exit> {
         while self.pending.is_empty() {
-            let mut line = String::new();
-            if self.input.read_line(&mut line)? == 0 {
+            let mut line = Vec::new();
+            if self.input.read_until(b'\n', &mut line)? == 0 {
                 return Ok(None);
             }
-            self.pending
-                .extend(line.split_whitespace().map(str::to_string));
+            self.lines += 1;
+            let n = self.lines;
+            self.pending.extend(
+                String::from_utf8_lossy(&line)
+                    .split_whitespace()
+                    .map(|w| (n, w.to_string())),
+            );
         }
         Ok(self.pending.pop_front())
     }
 
     fn number(&mut self, what: &str) -> Result<f64, Exit> {
-        let Some(item) = self.next_item()? else {
+        let Some((line, item)) = self.next_item()? else {
             return err(format!("Error: the input ended early: expected {what}."));
         };
         match item.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
             Ok(_) => err(format!(
-                "Error: {what} must be a finite number, got '{item}'."
+                "Error: standard input:{line}: {what} must be a finite number, got '{item}'."
             )),
             Err(_) => err(format!(
-                "Error: '{item}' in the input is not a number (expected {what})."
+                "Error: standard input:{line}: '{item}' is not a number (expected {what})."
             )),
         }
     }
@@ -289,10 +305,7 @@ fn classic<R: BufRead, W: Write>(
     } else {
         ErfcFlavour::Accurate
     };
-    let mut items = Items {
-        input,
-        pending: Default::default(),
-    };
+    let mut items = Items::new(input);
     if iflag {
         if verbose {
             let kind = if mode == Mode::Delta {
@@ -306,12 +319,12 @@ fn classic<R: BufRead, W: Write>(
             )?;
             out.flush()?;
         }
-        let Some(item) = items.next_item()? else {
+        let Some((line, item)) = items.next_item()? else {
             return err("Error: the input ended early: expected the number of populations.");
         };
         let v: i64 = item.parse().or_else(|_| {
             err(format!(
-                "Error: expected the number of populations as the first item of the input, found '{item}'."
+                "Error: standard input:{line}: expected the number of populations as the first item of the input, found '{item}'."
             ))
         })?;
         if v < 1 {

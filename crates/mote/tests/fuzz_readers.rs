@@ -4,7 +4,10 @@
 //! doubled or dropped) and handed to the reader, which must answer Ok or a
 //! `file:line` error: never panic, never take more than a second. A short
 //! run belongs to the suite; the long one is
-//! `cargo test --release -p mote-md --test fuzz_readers -- --ignored --nocapture`.
+//! `cargo test --release -p mote --test fuzz_readers -- --ignored --nocapture`.
+//! `mote rcp`'s standard input is fuzzed through the program itself (its
+//! reader is the command's): every mutated input must end in under five
+//! seconds with status 0 or spherepack1d's 255 and no panic.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -212,15 +215,92 @@ fn fuzz_all(count: usize) -> usize {
     tried
 }
 
+/// `mote rcp ARGS` with `input` on its standard input: the status, or a
+/// failure when it panics or runs past five seconds.
+fn rcp_with(args: &[&str], input: &[u8]) -> Result<i32, String> {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .arg("rcp")
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // A reader may stop before the end of the input: a broken pipe is fine.
+    let _ = child.stdin.take().unwrap().write_all(input);
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            let out = child.wait_with_output().unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            return match status.code() {
+                Some(c @ (0 | 255)) if !err.contains("panicked") => Ok(c),
+                _ => Err(format!("{status}: {err}")),
+            };
+        }
+        if start.elapsed() > Duration::from_secs(5) {
+            child.kill().unwrap();
+            return Err("ran past five seconds".into());
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+/// Mutated size distributions on `mote rcp`'s standard input, in each of
+/// its input styles.
+fn fuzz_rcp(count: usize) -> usize {
+    let seeds: [(&[&str], &[u8]); 4] = [
+        (
+            &["-d", "-p", "3", "-N", "20000"],
+            b"1.0 0.5\n2.0 0.3\n0.5 0.2\n",
+        ),
+        (
+            &["-l", "-i", "-N", "20000"],
+            b"2\n2.0 1.5 0.6\n1.0 0.9 0.4\n",
+        ),
+        (&["-w", "-N", "20000"], b"0.25\n"),
+        (
+            &["-d", "-i", "-u", "-N", "20000"],
+            b"3\n1 0.2\n2 0.5\n4 0.3\n",
+        ),
+    ];
+    let mut tried = 0;
+    let mut errors = 0;
+    for (k, (args, seed)) in seeds.iter().enumerate() {
+        assert_eq!(
+            rcp_with(args, seed),
+            Ok(0),
+            "the seed input {k} must be valid"
+        );
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x4c9 + k as u64);
+        for _ in 0..count {
+            let input = mutate(seed, &mut rng);
+            match rcp_with(args, &input) {
+                Ok(c) => errors += usize::from(c != 0),
+                Err(e) => panic!(
+                    "mote rcp {}: {e}\ninput:\n{}",
+                    args.join(" "),
+                    String::from_utf8_lossy(&input)
+                ),
+            }
+            tried += 1;
+        }
+    }
+    println!("rcp: {tried} mutated inputs, {errors} refused with a message, none panicked or hung");
+    tried
+}
+
 #[test]
 fn readers_survive_mutated_inputs() {
-    let tried = fuzz_all(400);
+    let tried = fuzz_all(400) + fuzz_rcp(100);
     println!("{tried} mutated inputs, no panic, none over a second");
 }
 
 #[test]
 #[ignore = "long fuzz run"]
 fn readers_survive_many_mutated_inputs() {
-    let tried = fuzz_all(50_000);
+    let tried = fuzz_all(50_000) + fuzz_rcp(5_000);
     println!("{tried} mutated inputs, no panic, none over a second");
 }

@@ -1,0 +1,149 @@
+//! A full disk and an unwritable output folder end every engine's run with
+//! a message naming the file and the reason, never a panic (issue 23).
+//!
+//! A full disk is `/dev/full` (every write fails with ENOSPC) behind a
+//! symbolic link with an output file's name; an unwritable folder is one
+//! under `/sys`, which even root cannot create. The test machines run as
+//! root, which ignores read-only permissions, and mounting a small tmpfs
+//! needs rights a test suite should not assume.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn mote() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_mote"))
+}
+
+fn have_dev_full() -> bool {
+    if Path::new("/dev/full").exists() {
+        true
+    } else {
+        eprintln!("skipped: no /dev/full on this machine");
+        false
+    }
+}
+
+/// A refusal: exit status 1 or 2 (not a panic's 101 or a signal), and the
+/// message names `what` and `why`.
+fn assert_refused(out: &Output, what: &str, why: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        matches!(out.status.code(), Some(1 | 2)),
+        "{:?}: {err}",
+        out.status
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains(what) && err.contains(why), "{err}");
+}
+
+/// An output folder whose file `name` is the full device.
+fn full_folder(name: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("/dev/full", dir.path().join(name)).unwrap();
+    dir
+}
+
+const FULL: &str = "No space left on device";
+
+#[test]
+fn a_full_disk_ends_a_time_stepped_run_with_the_file_named() {
+    if !have_dev_full() {
+        return;
+    }
+    for file in ["trajectory.xyz", "observables.csv"] {
+        let dir = full_folder(file);
+        let out = mote()
+            .args(["-q", "run", "example:sun-earth", "-o"])
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert_refused(&out, file, FULL);
+    }
+    // The same with checkpoints on: the run stops at the first write that
+    // fails, and a checkpoint, if one was written, is whole.
+    let dir = full_folder("trajectory.xyz");
+    let out = mote()
+        .args([
+            "-q",
+            "run",
+            "example:sun-earth",
+            "--checkpoint-every",
+            "10",
+            "-o",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_refused(&out, "trajectory.xyz", FULL);
+    let cp = dir.path().join("checkpoint.mote");
+    if cp.exists() {
+        mote_io::checkpoint::read(&cp).unwrap();
+    }
+}
+
+#[test]
+fn a_full_disk_ends_rigid_event_driven_and_packing_runs() {
+    if !have_dev_full() {
+        return;
+    }
+    let dir = full_folder("observables.csv");
+    let out = mote()
+        .args([
+            "-q",
+            "run",
+            "example:magnet-in-field",
+            "--steps",
+            "50",
+            "-o",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_refused(&out, "observables.csv", FULL);
+    let dir = full_folder("observables.csv");
+    let out = mote()
+        .args(["-q", "edmd", "example:cube", "--out-dir"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_refused(&out, "observables.csv", FULL);
+    let dir = full_folder("p.xyz");
+    let out = mote()
+        .args(["-q", "pack", "--n", "100", "--phi", "0.3", "-o"])
+        .arg(dir.path().join("p.xyz"))
+        .output()
+        .unwrap();
+    assert_refused(&out, "p.xyz", FULL);
+}
+
+#[test]
+fn an_output_folder_that_cannot_be_made_is_named() {
+    if !Path::new("/sys/kernel").exists() {
+        eprintln!("skipped: no /sys on this machine");
+        return;
+    }
+    let out = mote()
+        .args(["-q", "run", "example:sun-earth", "-o", "/sys/mote-out"])
+        .output()
+        .unwrap();
+    assert_refused(&out, "/sys/mote-out", "");
+    let out = mote()
+        .args(["-q", "edmd", "example:cube", "--out-dir", "/sys/mote-out"])
+        .output()
+        .unwrap();
+    assert_refused(&out, "/sys/mote-out", "");
+    let out = mote()
+        .args([
+            "-q",
+            "pack",
+            "--n",
+            "100",
+            "--phi",
+            "0.3",
+            "-o",
+            "/sys/mote-out/p.xyz",
+        ])
+        .output()
+        .unwrap();
+    assert_refused(&out, "/sys/mote-out", "");
+}

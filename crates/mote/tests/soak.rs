@@ -1,0 +1,117 @@
+//! Soak runs (issue 23): a 10⁶-particle run for an hour (or
+//! `MOTE_SOAK_SECONDS`) with its resident memory sampled every 5 s from
+//! /proc; the run is then ended with SIGTERM, which must end it cleanly
+//! (exit 143). After the first minute the resident memory must not grow
+//! by more than 2 % + 16 MiB. The samples go to stdout (and to
+//! `MOTE_SOAK_LOG` when set), with the bytes per particle.
+//!
+//! `cargo test --release -p mote --test soak -- --ignored --nocapture`
+//! (two runs of an hour each; `MOTE_SOAK_THREADS` sets `--threads`, 1 by
+//! default).
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Resident memory (VmRSS) of a process in bytes, if it still runs.
+fn resident(pid: u32) -> Option<u64> {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+fn soak(scene: &str, particles: u64) {
+    let seconds: u64 = std::env::var("MOTE_SOAK_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3600);
+    let threads = std::env::var("MOTE_SOAK_THREADS").unwrap_or_else(|_| "1".into());
+    let out = tempfile::tempdir().unwrap();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../bench")
+        .join(scene);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(["-q", "--threads", &threads, "run"])
+        .arg(&scene)
+        .arg("-o")
+        .arg(out.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let start = Instant::now();
+    let mut samples: Vec<(f64, u64)> = Vec::new();
+    let mut log = std::env::var("MOTE_SOAK_LOG")
+        .ok()
+        .map(|p| std::fs::File::create(p).unwrap());
+    while start.elapsed() < Duration::from_secs(seconds) {
+        std::thread::sleep(Duration::from_secs(5));
+        if let Ok(Some(status)) = child.try_wait() {
+            panic!("{}: ended early with {status}", scene.display());
+        }
+        if let Some(rss) = resident(pid) {
+            let t = start.elapsed().as_secs_f64();
+            samples.push((t, rss));
+            if let Some(f) = log.as_mut() {
+                writeln!(f, "{t:.0} {rss}").unwrap();
+            }
+        }
+    }
+    Command::new("kill")
+        .args(["-TERM", &pid.to_string()])
+        .status()
+        .unwrap();
+    let status = child.wait_with_output().unwrap();
+    assert_eq!(
+        status.status.code(),
+        Some(143),
+        "SIGTERM must end the run cleanly: {}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let rows = std::fs::read_to_string(out.path().join("observables.csv"))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .count()
+        .saturating_sub(1);
+    let after_minute: Vec<u64> = samples
+        .iter()
+        .filter(|(t, _)| *t >= 60.0)
+        .map(|s| s.1)
+        .collect();
+    let at_minute = *after_minute
+        .first()
+        .expect("a sample after the first minute");
+    let peak = *after_minute.iter().max().unwrap();
+    let last = *after_minute.last().unwrap();
+    let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+    println!(
+        "{}: {seconds} s, {rows} observable rows, resident {:.1} MiB at 1 min, {:.1} MiB at the end, peak {:.1} MiB after 1 min: {:.0} bytes per particle",
+        scene.display(),
+        mib(at_minute),
+        mib(last),
+        mib(peak),
+        peak as f64 / particles as f64
+    );
+    let allowed = at_minute + at_minute / 50 + 16 * 1024 * 1024;
+    assert!(
+        peak <= allowed,
+        "resident memory grew from {:.1} to {:.1} MiB",
+        mib(at_minute),
+        mib(peak)
+    );
+}
+
+#[test]
+#[ignore = "an hour: the 10^6-atom LJ soak"]
+fn lennard_jones_million_soak() {
+    soak("soak-lj.toml", 1_000_188);
+}
+
+#[test]
+#[ignore = "an hour: the 10^6-sphere granular soak"]
+fn granular_million_soak() {
+    soak("soak-granular.toml", 1_000_000);
+}
