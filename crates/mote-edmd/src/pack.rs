@@ -294,6 +294,160 @@ pub struct Packer<const D: usize> {
     win_coll: u64,
     last_pressure: f64,
     history: Vec<Sample>,
+    /// Windows closed when the last checkpoint was taken.
+    checkpointed: u64,
+    /// Built from a checkpoint taken in the quasi-static finish: the run
+    /// goes on there.
+    resumed_in_finish: bool,
+}
+
+/// Where a packing stands at a checkpoint. The system has just been rebuilt
+/// (a new epoch), so a packer resumed from this state goes on from the
+/// same bits as the run that wrote it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PackState {
+    /// Box side lengths.
+    pub size: Vec<f64>,
+    pub positions: Vec<Vec<f64>>,
+    pub velocities: Vec<Vec<f64>>,
+    pub radii: Vec<f64>,
+    /// Growth rate δ and horizon of the epoch the system was built for.
+    pub delta: f64,
+    pub horizon: f64,
+    /// Taken at the top of a cycle of the quasi-static finish.
+    pub finishing: bool,
+    pub t_before: f64,
+    pub collisions: u64,
+    pub epochs: u64,
+    pub win_virial: f64,
+    pub win_time: f64,
+    pub win_coll: u64,
+    pub last_pressure: f64,
+    pub history: Vec<Sample>,
+}
+
+impl PackState {
+    /// Ids of the carried lists of a packing's checkpoint.
+    const SIZE: usize = 0;
+    const RADII: usize = 1;
+    const RUN: usize = 2;
+    const HISTORY: usize = 3;
+
+    /// The state in `template` (options, input and seed already there):
+    /// positions and velocities padded to 3 components, radii, box, the
+    /// run's numbers, and the history of windows (4 numbers each).
+    pub fn to_checkpoint(
+        &self,
+        template: &mote_io::checkpoint::Checkpoint,
+    ) -> mote_io::checkpoint::Checkpoint {
+        let pad = |v: &Vec<f64>| {
+            let mut x = [0.0; 3];
+            x[..v.len()].copy_from_slice(v);
+            x
+        };
+        let run = vec![
+            self.delta,
+            self.horizon,
+            f64::from(u8::from(self.finishing)),
+            self.t_before,
+            self.collisions as f64,
+            self.epochs as f64,
+            self.win_virial,
+            self.win_time,
+            self.win_coll as f64,
+            self.last_pressure,
+        ];
+        let history = self
+            .history
+            .iter()
+            .flat_map(|s| [s.collisions as f64, s.time, s.phi, s.pressure])
+            .collect();
+        mote_io::checkpoint::Checkpoint {
+            time: self.t_before,
+            step: self.history.len() as u64,
+            positions: self.positions.iter().map(pad).collect(),
+            velocities: self.velocities.iter().map(pad).collect(),
+            carried: vec![
+                (Self::SIZE, self.size.clone()),
+                (Self::RADII, self.radii.clone()),
+                (Self::RUN, run),
+                (Self::HISTORY, history),
+            ],
+            ..template.clone()
+        }
+    }
+
+    /// The state a checkpoint written by [`PackState::to_checkpoint`] holds,
+    /// for a packing of `dimension`.
+    pub fn from_checkpoint(
+        cp: &mote_io::checkpoint::Checkpoint,
+        dimension: usize,
+    ) -> Result<Self, EdmdError> {
+        let bad = |m: &str| EdmdError::Invalid(format!("checkpoint of a packing: {m}"));
+        let list = |id: usize| {
+            cp.carried
+                .iter()
+                .find(|(k, _)| *k == id)
+                .map(|(_, v)| v.as_slice())
+                .unwrap_or(&[])
+        };
+        let run = list(Self::RUN);
+        let history = list(Self::HISTORY);
+        let (size, radii) = (list(Self::SIZE), list(Self::RADII));
+        let n = cp.positions.len();
+        if run.len() != 10
+            || history.len() % 4 != 0
+            || size.len() != dimension
+            || radii.len() != n
+            || cp.velocities.len() != n
+        {
+            return Err(bad("its lists have the wrong lengths"));
+        }
+        let count = |x: f64| -> Result<u64, EdmdError> {
+            if x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53) {
+                Ok(x as u64)
+            } else {
+                Err(bad("a count is not a whole number"))
+            }
+        };
+        let cut = |v: &[f64; 3]| v[..dimension].to_vec();
+        Ok(PackState {
+            size: size.to_vec(),
+            positions: cp.positions.iter().map(cut).collect(),
+            velocities: cp.velocities.iter().map(cut).collect(),
+            radii: radii.to_vec(),
+            delta: run[0],
+            horizon: run[1],
+            finishing: run[2] != 0.0,
+            t_before: run[3],
+            collisions: count(run[4])?,
+            epochs: count(run[5])?,
+            win_virial: run[6],
+            win_time: run[7],
+            win_coll: count(run[8])?,
+            last_pressure: run[9],
+            history: history
+                .chunks(4)
+                .map(|c| {
+                    Ok(Sample {
+                        collisions: count(c[0])?,
+                        time: c[1],
+                        phi: c[2],
+                        pressure: c[3],
+                    })
+                })
+                .collect::<Result<_, EdmdError>>()?,
+        })
+    }
+}
+
+/// Checkpoints of a packing: `save` is called every `every` pressure
+/// windows (at the next point where the state can be rebuilt: a window's
+/// end while growing, a cycle's start in the finish) and when a signal
+/// stops the run.
+pub struct PackCheckpoints<'a> {
+    pub every: u64,
+    pub save: &'a mut dyn FnMut(&PackState) -> Result<(), EdmdError>,
 }
 
 /// Relative growth of the radii over one epoch: lists are built for radii
@@ -424,7 +578,117 @@ impl<const D: usize> Packer<D> {
             win_coll: 0,
             last_pressure: f64::NAN,
             history: Vec::new(),
+            checkpointed: 0,
+            resumed_in_finish: false,
         })
+    }
+
+    /// The packer a checkpoint's state continues (`settings` those of the
+    /// run that wrote it).
+    pub fn resume(settings: PackSettings, state: &PackState) -> Result<Self, EdmdError> {
+        let invalid = |m: &str| EdmdError::Invalid(format!("checkpoint of a packing: {m}"));
+        let n = state.radii.len();
+        if state.size.len() != D
+            || state.positions.len() != n
+            || state.velocities.len() != n
+            || state
+                .positions
+                .iter()
+                .chain(&state.velocities)
+                .any(|v| v.len() != D)
+        {
+            return Err(invalid("arrays of the wrong length for this dimension"));
+        }
+        let mut size = [0.0; D];
+        size.copy_from_slice(&state.size);
+        let mut walls = [false; D];
+        for (k, w) in settings.walls.iter().enumerate().take(D) {
+            walls[k] = *w;
+        }
+        let simbox = SimBox {
+            size,
+            boundary: walls.map(|w| {
+                if w {
+                    Boundary::Wall
+                } else {
+                    Boundary::Periodic
+                }
+            }),
+        };
+        let array = |v: &Vec<f64>| {
+            let mut x = [0.0; D];
+            x.copy_from_slice(v);
+            x
+        };
+        let sys = System::with_growth(
+            simbox,
+            state.positions.iter().map(array).collect(),
+            state.velocities.iter().map(array).collect(),
+            state.radii.clone(),
+            vec![1.0; n],
+            state.delta,
+            state.horizon,
+        )?;
+        Ok(Packer {
+            sys,
+            settings,
+            ke_target: 0.5 * D as f64 * n as f64,
+            t_before: state.t_before,
+            collisions: state.collisions,
+            epochs: state.epochs,
+            win_virial: state.win_virial,
+            win_time: state.win_time,
+            win_coll: state.win_coll,
+            last_pressure: state.last_pressure,
+            checkpointed: state.history.len() as u64,
+            history: state.history.clone(),
+            resumed_in_finish: state.finishing,
+        })
+    }
+
+    /// The state of a system just rebuilt (see [`PackState`]).
+    fn state(&self, delta: f64, horizon: f64, finishing: bool) -> PackState {
+        let sys = &self.sys;
+        PackState {
+            size: sys.simbox().size.to_vec(),
+            positions: sys.positions().iter().map(|x| x.to_vec()).collect(),
+            velocities: sys.velocities().iter().map(|x| x.to_vec()).collect(),
+            radii: sys.radii(),
+            delta,
+            horizon,
+            finishing,
+            t_before: self.t_before,
+            collisions: self.collisions,
+            epochs: self.epochs,
+            win_virial: self.win_virial,
+            win_time: self.win_time,
+            win_coll: self.win_coll,
+            last_pressure: self.last_pressure,
+            history: self.history.clone(),
+        }
+    }
+
+    /// Whether a checkpoint is due: a signal, or `every` windows closed
+    /// since the last one.
+    fn checkpoint_due(&self, cps: &Option<&mut PackCheckpoints>, signal: bool) -> bool {
+        cps.as_ref().is_some_and(|c| {
+            signal || self.history.len() as u64 >= self.checkpointed + c.every.max(1)
+        })
+    }
+
+    fn save(
+        &mut self,
+        cps: &mut Option<&mut PackCheckpoints>,
+        delta: f64,
+        horizon: f64,
+        finishing: bool,
+    ) -> Result<(), EdmdError> {
+        if let Some(c) = cps.as_mut() {
+            self.checkpointed = self.history.len() as u64;
+            let state = self.state(delta, horizon, finishing);
+            (c.save)(&state)?;
+        }
+        Ok(())
     }
 
     /// The box, positions and radii of a given start, checked: finite,
@@ -528,12 +792,13 @@ impl<const D: usize> Packer<D> {
 
     /// A fresh system from the synchronised state growing at Γ for one
     /// epoch.
-    fn new_epoch(&mut self) -> Result<(), EdmdError> {
+    fn new_epoch(&mut self) -> Result<(f64, f64), EdmdError> {
         let n = self.sys.len() as f64;
         let mean_d = 2.0 * self.sys.radii().iter().sum::<f64>() / n;
         let delta = self.settings.rate / mean_d;
         let horizon = epoch_growth(self.sys.packing_fraction(), D) / delta;
-        self.restart(delta, horizon)
+        self.restart(delta, horizon)?;
+        Ok((delta, horizon))
     }
 
     /// A fresh system from the synchronised state with growth rate δ
@@ -591,17 +856,31 @@ impl<const D: usize> Packer<D> {
         Ok((z, t))
     }
 
-    /// The quasi-static finish ([`Finish`]).
+    /// The quasi-static finish ([`Finish`]). Signals and checkpoints are
+    /// taken at the start of a cycle, where the system is rebuilt anyway.
     fn finish(
         &mut self,
         f: Finish,
         window: u64,
         start: Instant,
         progress: &mut impl FnMut(&Sample),
+        cps: &mut Option<&mut PackCheckpoints>,
     ) -> Result<Stop, EdmdError> {
+        // A packer resumed in the finish was built as the cycle's start.
+        let mut rebuilt = std::mem::take(&mut self.resumed_in_finish);
         loop {
             // relax at fixed radii
-            self.restart(0.0, f64::INFINITY)?;
+            if !rebuilt {
+                self.restart(0.0, f64::INFINITY)?;
+            }
+            rebuilt = false;
+            let signal = mote_io::system::stop_requested().is_some();
+            if self.checkpoint_due(cps, signal) {
+                self.save(cps, 0.0, f64::INFINITY, true)?;
+            }
+            if signal {
+                return Ok(Stop::Interrupted);
+            }
             let (mut z, mut t_w) = (f64::NAN, 0.0);
             for _ in 0..f.relax_windows {
                 let mut want = window;
@@ -621,9 +900,6 @@ impl<const D: usize> Packer<D> {
                     if start.elapsed() >= limit {
                         return Ok(Stop::WallClock);
                     }
-                }
-                if mote_io::system::stop_requested().is_some() {
-                    return Ok(Stop::Interrupted);
                 }
             }
             if z > self.settings.max_pressure {
@@ -648,11 +924,29 @@ impl<const D: usize> Packer<D> {
 
     /// Runs until a stop criterion fires; `progress` sees every pressure
     /// window.
-    pub fn run(&mut self, mut progress: impl FnMut(&Sample)) -> Result<PackOutcome, EdmdError> {
+    pub fn run(&mut self, progress: impl FnMut(&Sample)) -> Result<PackOutcome, EdmdError> {
+        self.run_with(progress, None)
+    }
+
+    /// [`Packer::run`] with checkpoints.
+    pub fn run_with(
+        &mut self,
+        mut progress: impl FnMut(&Sample),
+        mut cps: Option<&mut PackCheckpoints>,
+    ) -> Result<PackOutcome, EdmdError> {
         let start = Instant::now();
         let n = self.sys.len() as f64;
         let window = ((self.settings.rescale_every * n).round() as u64).max(1);
         let stop = loop {
+            if self.resumed_in_finish {
+                let f = self.settings.finish.ok_or_else(|| {
+                    EdmdError::Invalid(
+                        "a checkpoint taken in the quasi-static finish, for settings without one"
+                            .into(),
+                    )
+                })?;
+                break self.finish(f, window, start, &mut progress, &mut cps)?;
+            }
             let mut want = window - self.win_coll;
             if let Some(budget) = self.settings.max_collisions {
                 if self.collisions >= budget {
@@ -687,7 +981,7 @@ impl<const D: usize> Packer<D> {
                 }
                 if let Some(f) = self.settings.finish {
                     if z > f.start_pressure {
-                        break self.finish(f, window, start, &mut progress)?;
+                        break self.finish(f, window, start, &mut progress, &mut cps)?;
                     }
                 }
             }
@@ -696,7 +990,12 @@ impl<const D: usize> Packer<D> {
                     break Stop::WallClock;
                 }
             }
-            if mote_io::system::stop_requested().is_some() {
+            let signal = mote_io::system::stop_requested().is_some();
+            if self.checkpoint_due(&cps, signal) {
+                let (delta, horizon) = self.new_epoch()?;
+                self.save(&mut cps, delta, horizon, false)?;
+            }
+            if signal {
                 break Stop::Interrupted;
             }
         };

@@ -313,3 +313,58 @@ fn isostatic_at_ten_thousand() {
     assert!((c.backbone_z / 6.0 - 1.0).abs() < 0.03);
     assert!(q6 < 0.05);
 }
+
+/// A packer resumed from any of its checkpoints, in growth or in the
+/// quasi-static finish, ends with the bits of the run that wrote them.
+#[test]
+fn resumed_from_a_checkpoint_ends_bit_for_bit() {
+    use mote_edmd::pack::{PackCheckpoints, PackState};
+    let mut s = settings(200, 0.1, 5);
+    s.max_pressure = 1e7;
+    s.finish = Some(Finish::default());
+    let mut states: Vec<PackState> = Vec::new();
+    let mut p = Packer::<3>::new(s.clone()).unwrap();
+    let mut save = |st: &PackState| {
+        states.push(st.clone());
+        Ok(())
+    };
+    let mut cps = PackCheckpoints {
+        every: 4,
+        save: &mut save,
+    };
+    let whole = p.run_with(|_| {}, Some(&mut cps)).unwrap();
+    let (positions, radii) = (p.system().positions(), p.system().radii());
+    assert!(states.iter().any(|s| s.finishing) && states.iter().any(|s| !s.finishing));
+    let picks = [
+        states.iter().position(|s| !s.finishing).unwrap(),
+        states.iter().position(|s| s.finishing).unwrap(),
+        states.len() - 1,
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for k in picks {
+        // Through a checkpoint file, bit for bit.
+        let file = dir.path().join("p.mote");
+        let cp = states[k].to_checkpoint(&mote_io::checkpoint::Checkpoint::default());
+        mote_io::checkpoint::write(&file, &cp).unwrap();
+        let read = mote_io::checkpoint::read(&file).unwrap();
+        assert_eq!(PackState::from_checkpoint(&read, 3).unwrap(), states[k]);
+        let mut again = Packer::<3>::resume(s.clone(), &states[k]).unwrap();
+        let mut later = Vec::new();
+        let mut save = |st: &PackState| {
+            later.push(st.clone());
+            Ok(())
+        };
+        let mut cps = PackCheckpoints {
+            every: 4,
+            save: &mut save,
+        };
+        let out = again.run_with(|_| {}, Some(&mut cps)).unwrap();
+        assert_eq!(out.collisions, whole.collisions, "from checkpoint {k}");
+        assert_eq!(out.phi.to_bits(), whole.phi.to_bits());
+        assert_eq!(out.history, whole.history);
+        assert_eq!(again.system().positions(), positions);
+        assert_eq!(again.system().radii(), radii);
+        // And it writes the checkpoints the whole run wrote after k.
+        assert_eq!(later, states[k + 1..]);
+    }
+}
