@@ -27,8 +27,23 @@ fn number<T: std::str::FromStr>(key: &str, v: String) -> Result<T, FrontError> {
 /// `step`, or past `time` in tables without a step column, and frames past
 /// `time`), so the resumed run continues the files.
 pub(crate) fn trim_outputs(dir: &Path, step: u64, time: f64) -> Result<(), FrontError> {
-    let csv = dir.join("observables.csv");
-    if let Ok(text) = std::fs::read_to_string(&csv) {
+    trim_table(&dir.join("observables.csv"), step, time)?;
+    // Frames up to the checkpoint are kept verbatim (byte for byte).
+    use mote_io::trajectory::{keep_until, Format};
+    for format in [Format::Xyz, Format::Dump, Format::Gsd, Format::Vtk] {
+        let path = dir.join(format!("trajectory.{}", format.extension()));
+        if path.exists() {
+            keep_until(&path, format, step, time)?;
+        }
+    }
+    Ok(())
+}
+
+/// Drops the rows of a CSV table past `step` (its `step` column), or past
+/// `time` (its `time` column) in a table without one; a missing file is
+/// left alone.
+pub(crate) fn trim_table(csv: &Path, step: u64, time: f64) -> Result<(), FrontError> {
+    if let Ok(text) = std::fs::read_to_string(csv) {
         let mut column = None;
         let mut kept = String::new();
         for line in text.lines() {
@@ -55,15 +70,7 @@ pub(crate) fn trim_outputs(dir: &Path, step: u64, time: f64) -> Result<(), Front
                 kept.push('\n');
             }
         }
-        std::fs::write(&csv, kept).map_err(|e| IoError::os(&csv, e))?;
-    }
-    // Frames up to the checkpoint are kept verbatim (byte for byte).
-    use mote_io::trajectory::{keep_until, Format};
-    for format in [Format::Xyz, Format::Dump, Format::Gsd, Format::Vtk] {
-        let path = dir.join(format!("trajectory.{}", format.extension()));
-        if path.exists() {
-            keep_until(&path, format, step, time)?;
-        }
+        std::fs::write(csv, kept).map_err(|e| IoError::os(csv, e))?;
     }
     Ok(())
 }

@@ -168,6 +168,7 @@ pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, F
         let result = match cp.option("engine") {
             Some("rigid") => rigid::resume(&cp, options, monitor),
             Some("event-driven") => event_driven::resume(&cp, options, monitor),
+            Some("packing") => packing::resume(&cp, options, monitor),
             _ => particles::run(None, options, monitor),
         };
         monitor.finish();

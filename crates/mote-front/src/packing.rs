@@ -10,8 +10,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use mote_edmd::analyse::{bond_order, contacts, deepest_overlap};
-use mote_edmd::pack::{Finish, PackSettings, Packer, SizeSpec, Stop};
-use serde::Deserialize;
+use mote_edmd::pack::{Finish, PackCheckpoints, PackSettings, PackState, Packer, SizeSpec, Stop};
+use mote_io::checkpoint::Checkpoint;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{refuse, FrontError};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
@@ -19,7 +20,7 @@ use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 /// What a packing is asked for, by either way in. The keys of a scene's
 /// `[packing]` table; `mote pack` spells them as options (`--dim` for
 /// `dimension`, `--no-jam` for `jam = false`, `-` for `_`).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PackingSpec {
     /// Number of particles (ignored with `dist = "file:PATH"`).
@@ -263,11 +264,67 @@ fn read_radii(path: &Path) -> Result<Vec<f64>, FrontError> {
 }
 
 /// Where a packing goes: the XYZ file (the CSV and POV-Ray scene go beside
-/// it, same stem) and a picture.
+/// it, same stem), a picture, checkpoints; and the checkpoint it resumes.
 #[derive(Debug, Clone, Default)]
 pub struct PackFiles {
     pub xyz: Option<PathBuf>,
     pub picture: Option<PathBuf>,
+    pub checkpoints: Option<PackCheckpointFile>,
+    /// Continue this checkpoint's packing (the CSV is trimmed back to it
+    /// and appended to).
+    pub resume: Option<Checkpoint>,
+}
+
+/// Checkpoints of a packing: every `every` pressure windows to `path`, with
+/// the options and input of `template` (see [`checkpoint_template`]).
+#[derive(Debug, Clone)]
+pub struct PackCheckpointFile {
+    pub every: u64,
+    pub path: PathBuf,
+    pub template: Checkpoint,
+}
+
+/// What a packing's checkpoint records besides its state: the input as a
+/// `[packing]` scene (`label`, `text`), the seed, the schedule, where the
+/// packing goes and the folder its relative paths start from.
+pub fn checkpoint_template(
+    label: &str,
+    text: &str,
+    seed: u64,
+    every: u64,
+    xyz: &Path,
+    base: &Path,
+) -> Checkpoint {
+    // Relative paths are kept from the folder the run started in.
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    Checkpoint {
+        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
+        seed,
+        options: vec![
+            ("engine".into(), "packing".into()),
+            ("checkpoint-every".into(), every.to_string()),
+            ("output".into(), absolute(xyz).display().to_string()),
+            ("base".into(), absolute(base).display().to_string()),
+        ],
+        input_label: label.to_string(),
+        input_text: text.to_string(),
+        ..Checkpoint::default()
+    }
+}
+
+/// The options of `mote pack` as the text of a `[packing]` scene (what its
+/// checkpoints record as their input).
+pub fn spec_scene_text(spec: &PackingSpec, seed: u64) -> Result<String, FrontError> {
+    #[derive(Serialize)]
+    struct Scene<'a> {
+        seed: u64,
+        packing: &'a PackingSpec,
+    }
+    toml::to_string(&Scene {
+        seed,
+        packing: spec,
+    })
+    .map_err(|e| FrontError::request(format!("the packing options as a scene: {e}")))
 }
 
 /// What a packing run did: the summary lines and how it ended.
@@ -303,41 +360,63 @@ fn pack_dim<const D: usize>(
     monitor: &mut dyn Monitor,
 ) -> Result<Packed, FrontError> {
     let max_pressure = settings.max_pressure;
-    let mut packer = Packer::<D>::new(settings)?;
+    let mut packer = match &files.resume {
+        Some(cp) => Packer::<D>::resume(settings, &PackState::from_checkpoint(cp, D)?)?,
+        None => Packer::<D>::new(settings)?,
+    };
     let stem = files.xyz.as_ref().map(|p| p.with_extension(""));
     if let Some(dir) = files.xyz.as_ref().and_then(|p| p.parent()) {
         if !dir.as_os_str().is_empty() {
             std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
         }
     }
-    let mut csv = match &stem {
-        Some(s) => Some(mote_io::csv::CsvWriter::create(
+    let mut csv = match (&stem, &files.resume) {
+        (Some(s), Some(cp)) => {
+            let path = s.with_extension("csv");
+            crate::checkpoints::trim_table(&path, u64::MAX, cp.time)?;
+            Some(mote_io::csv::CsvWriter::append(&path, 4)?)
+        }
+        (Some(s), None) => Some(mote_io::csv::CsvWriter::create(
             &s.with_extension("csv"),
             provenance,
             &["collisions", "time", "phi", "pressure"].map(String::from),
             &["", "", "", ""].map(String::from),
         )?),
-        None => None,
+        (None, _) => None,
     };
-    let cpu0 = crate::cpu::cpu_seconds();
-    let mut csv_err = None;
-    let outcome = packer.run(|s| {
-        if let Some(w) = csv.as_mut() {
-            if let Err(e) = w.row(&[s.collisions as f64, s.time, s.phi, s.pressure]) {
-                csv_err.get_or_insert(e);
-            }
+    let mut save = |state: &PackState| -> Result<(), mote_edmd::EdmdError> {
+        if let Some(c) = &files.checkpoints {
+            mote_io::checkpoint::write(&c.path, &state.to_checkpoint(&c.template))?;
         }
-        // Progress: log10 of the pressure towards the threshold.
-        let f = (s.pressure.max(1.0).log10() / max_pressure.log10()).clamp(0.0, 1.0);
-        monitor.progress(
-            (f * 1000.0) as u64,
-            1000,
-            &format!(
-                "phi {:.5}  Z {:.3e}  {} collisions",
-                s.phi, s.pressure, s.collisions
-            ),
-        );
-    })?;
+        Ok(())
+    };
+    let mut checkpoints = files.checkpoints.as_ref().map(|c| PackCheckpoints {
+        every: c.every,
+        save: &mut save,
+    });
+    let cpu0 = crate::cpu::cpu_seconds();
+    let collisions0 = packer.collisions();
+    let mut csv_err = None;
+    let outcome = packer.run_with(
+        |s| {
+            if let Some(w) = csv.as_mut() {
+                if let Err(e) = w.row(&[s.collisions as f64, s.time, s.phi, s.pressure]) {
+                    csv_err.get_or_insert(e);
+                }
+            }
+            // Progress: log10 of the pressure towards the threshold.
+            let f = (s.pressure.max(1.0).log10() / max_pressure.log10()).clamp(0.0, 1.0);
+            monitor.progress(
+                (f * 1000.0) as u64,
+                1000,
+                &format!(
+                    "phi {:.5}  Z {:.3e}  {} collisions",
+                    s.phi, s.pressure, s.collisions
+                ),
+            );
+        },
+        checkpoints.as_mut(),
+    )?;
     monitor.finish();
     if let Some(e) = csv_err {
         return Err(e.into());
@@ -378,10 +457,15 @@ fn pack_dim<const D: usize>(
             outcome.pressure
         ),
         format!(
-            "{} collisions in {:.2} s CPU ({:.3e} per CPU-second), {} growth epochs.",
+            "{} collisions{} in {:.2} s CPU ({:.3e} per CPU-second), {} growth epochs.",
             outcome.collisions,
+            if collisions0 > 0 {
+                format!(" ({} since the checkpoint)", outcome.collisions - collisions0)
+            } else {
+                String::new()
+            },
             cpu,
-            outcome.collisions as f64 / cpu.max(1e-9),
+            (outcome.collisions - collisions0) as f64 / cpu.max(1e-9),
             outcome.epochs
         ),
         format!(
@@ -481,11 +565,6 @@ pub(crate) fn run(
             (options.until.is_some(), "--until", WHY_NO_TIME),
             (options.solver.is_some(), "--solver", crate::WHY_NO_SOLVER),
             (options.system.is_some(), "--system", crate::WHY_NO_SYSTEM),
-            (
-                options.checkpoint_every.is_some(),
-                "--checkpoint-every",
-                "packings write no checkpoints yet; a signal still writes the packing so far",
-            ),
         ],
     )?;
     let source = mote_io::Source::new(&input.label, &input.text);
@@ -519,11 +598,98 @@ pub(crate) fn run(
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase()
     ));
+    let xyz = dir.join("packing.xyz");
     let files = PackFiles {
-        xyz: Some(dir.join("packing.xyz")),
+        checkpoints: options.checkpoint_every.map(|every| PackCheckpointFile {
+            every,
+            path: dir.join("checkpoint.mote"),
+            template: checkpoint_template(&input.label, &input.text, seed, every, &xyz, &base),
+        }),
+        xyz: Some(xyz),
         picture: options.picture.clone(),
+        resume: None,
     };
     let provenance = crate::provenance(&input.label, seed);
+    let packed = pack(
+        spec.dimension,
+        settings,
+        spec.tol,
+        &files,
+        &provenance,
+        monitor,
+    )?;
+    Ok(Outcome {
+        engine: Engine::Packing,
+        seed,
+        dir,
+        summary: packed.summary,
+        ending: packed.ending,
+    })
+}
+
+/// Continues the packing a checkpoint came from (by `mote pack` or a
+/// `[packing]` scene): the same settings, seed, files and checkpoint
+/// schedule; the CSV is trimmed back to the checkpoint and the packing is
+/// written at the end as an uninterrupted run would have.
+pub(crate) fn resume(
+    cp: &Checkpoint,
+    given: &RunOptions,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    let option = |k: &str| {
+        cp.option(k).ok_or_else(|| {
+            FrontError::request(format!("the packing checkpoint has no option '{k}'"))
+        })
+    };
+    let source = mote_io::Source::new(&cp.input_label, &cp.input_text);
+    let scene: PackingScene = toml::from_str(&cp.input_text)
+        .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))?;
+    let every: u64 = option("checkpoint-every")?
+        .parse()
+        .map_err(|_| FrontError::request("checkpoint-every is not a whole number"))?;
+    let xyz = PathBuf::from(option("output")?);
+    let base = PathBuf::from(option("base")?);
+    let seed = cp.seed;
+    let spec = &scene.packing;
+    let settings = spec.settings(seed, Naming::Scene(source), &base)?;
+    let dir = xyz
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."));
+    let _lock = crate::lock::FolderLock::take(&dir)?;
+    monitor.start(&format!(
+        "mote run --resume: packing {} from window {} ({} collisions), seed {seed}",
+        cp.input_label,
+        cp.step,
+        cp.carried
+            .iter()
+            .find(|(k, _)| *k == 2)
+            .and_then(|(_, run)| run.get(4))
+            .copied()
+            .unwrap_or(0.0)
+    ));
+    let path = given
+        .resume
+        .clone()
+        .unwrap_or_else(|| dir.join("checkpoint.mote"));
+    let files = PackFiles {
+        xyz: Some(xyz),
+        picture: given.picture.clone(),
+        checkpoints: Some(PackCheckpointFile {
+            every,
+            path,
+            template: checkpoint_template(
+                &cp.input_label,
+                &cp.input_text,
+                seed,
+                every,
+                &PathBuf::from(option("output")?),
+                &base,
+            ),
+        }),
+        resume: Some(cp.clone()),
+    };
+    let provenance = crate::provenance(&cp.input_label, seed);
     let packed = pack(
         spec.dimension,
         settings,

@@ -617,3 +617,79 @@ fn a_second_run_into_a_busy_folder_is_refused() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!lock.exists());
 }
+
+const PACKING: &str = "[packing]\nn = 400\nmax_pressure = 1e8\n";
+
+/// A packing killed with SIGKILL resumes from its last checkpoint to the
+/// bits of an uninterrupted run: the packing, its CSV of windows and the
+/// last checkpoint, byte for byte. Ctrl-C ends one with 130 and a last
+/// checkpoint, from which it goes on to a jammed packing (not bit for bit:
+/// the checkpoint at the signal rebuilds the system where the uninterrupted
+/// run did not).
+#[test]
+fn killed_packing_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("p.toml"), PACKING).unwrap();
+    let args = ["--seed", "3", "run", "p.toml", "--checkpoint-every", "10"];
+    let (whole, at_kill, resumed) = whole_killed_resumed(dir.path(), &args, 20);
+    assert!(at_kill.step >= 20 && at_kill.step < whole.step);
+    // The state, bit for bit (the options name each run's own folder).
+    let bits = |c: &Checkpoint| {
+        (
+            c.step,
+            c.time.to_bits(),
+            c.positions.clone(),
+            c.velocities.clone(),
+            carried_bits(&c.carried),
+        )
+    };
+    assert!(
+        bits(&resumed) == bits(&whole),
+        "killed at window {}",
+        at_kill.step
+    );
+    for file in ["packing.xyz", "packing.csv"] {
+        assert!(same_file(dir.path(), file), "{file} differs");
+    }
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args([
+            "-q",
+            "--seed",
+            "3",
+            "run",
+            "p.toml",
+            "--checkpoint-every",
+            "10",
+            "-o",
+            "int",
+        ])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let cp_path = dir.path().join("int/checkpoint.mote");
+    let code = signal_when_checkpointed(&mut child, &cp_path, 20, "INT");
+    assert_eq!(code, Some(130), "exit status after SIGINT");
+    let at_stop = mote_io::checkpoint::read(&cp_path).unwrap();
+    assert!(at_stop.step < whole.step, "finished before the signal");
+    let o = mote(
+        &["run", "--resume", "int/checkpoint.mote", "-q"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = mote(&["pack", "analyse", "int/packing.xyz"], dir.path());
+    let summary = String::from_utf8_lossy(&o.stdout);
+    // Jammed, and no overlap beyond round-off.
+    let value = |key: &str| -> Option<f64> {
+        let line = summary.lines().find(|l| l.starts_with(key))?;
+        line.split_whitespace().last()?.parse().ok()
+    };
+    assert!(value("packing fraction").unwrap() > 0.63, "{summary}");
+    let overlap = value("deepest overlap");
+    assert!(
+        overlap.map_or(summary.contains("overlaps              none"), |g| g
+            > -1e-12),
+        "{summary}"
+    );
+}

@@ -86,6 +86,11 @@ pub struct PackArgs {
     /// Render the packing to this PNG.
     #[arg(long, value_name = "FILE.png")]
     picture: Option<PathBuf>,
+    /// Write STEM.checkpoint.mote every N pressure windows and when a
+    /// signal stops the run (needs -o); continue with
+    /// `mote run --resume STEM.checkpoint.mote`.
+    #[arg(long, value_name = "N")]
+    checkpoint_every: Option<u64>,
 }
 
 #[derive(clap::Subcommand, Debug)]
@@ -176,12 +181,36 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     ));
     let provenance = mote_io::Provenance {
         program: format!("mote {}", env!("CARGO_PKG_VERSION")),
-        scene: label,
+        scene: label.clone(),
         seed,
+    };
+    let checkpoints = match (a.checkpoint_every, &a.output) {
+        (None, _) => None,
+        (Some(0), _) => anyhow::bail!("--checkpoint-every 0: give a number of windows ≥ 1"),
+        (Some(_), None) => {
+            anyhow::bail!("--checkpoint-every needs -o FILE: the packing is resumed into it")
+        }
+        (Some(every), Some(xyz)) => {
+            let text = mote_front::packing::spec_scene_text(&spec, seed)?;
+            Some(mote_front::packing::PackCheckpointFile {
+                every,
+                path: xyz.with_extension("checkpoint.mote"),
+                template: mote_front::packing::checkpoint_template(
+                    &label,
+                    &text,
+                    seed,
+                    every,
+                    xyz,
+                    Path::new("."),
+                ),
+            })
+        }
     };
     let files = PackFiles {
         xyz: a.output.clone(),
         picture: a.picture.clone(),
+        checkpoints,
+        resume: None,
     };
     let packed = mote_front::packing::pack(
         spec.dimension,
