@@ -25,6 +25,7 @@ use std::path::PathBuf;
 pub use engine::Engine;
 pub use error::FrontError;
 pub use input::Input;
+pub use particles::resume_state;
 
 /// The options of `mote run`, common to every engine.
 #[derive(Debug, Clone, Default)]

@@ -327,11 +327,17 @@ pub fn spec_scene_text(spec: &PackingSpec, seed: u64) -> Result<String, FrontErr
     .map_err(|e| FrontError::request(format!("the packing options as a scene: {e}")))
 }
 
-/// What a packing run did: the summary lines and how it ended.
+/// What a packing run did: the summary lines, how it ended, and the
+/// packing itself.
 #[derive(Debug, Clone)]
 pub struct Packed {
     pub summary: Vec<String>,
     pub ending: Ending,
+    /// The final spheres and box.
+    pub frame: mote_io::xyz::Frame,
+    pub phi: f64,
+    /// The reduced pressure of the last window.
+    pub pressure: f64,
 }
 
 /// Grows the packing `settings` describe, writes `files` and says what it
@@ -504,7 +510,13 @@ fn pack_dim<const D: usize>(
         },
         _ => Ending::Finished,
     };
-    Ok(Packed { summary, ending })
+    Ok(Packed {
+        summary,
+        ending,
+        frame,
+        phi: outcome.phi,
+        pressure: outcome.pressure,
+    })
 }
 
 /// The POV-Ray scene of a packing, framed and lit as the pictures are.

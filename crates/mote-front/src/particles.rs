@@ -15,7 +15,7 @@ use crate::error::{refuse, FrontError};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
 /// Puts the checkpoint's state into the freshly built simulation.
-fn resume_state(
+pub fn resume_state(
     cp: &Checkpoint,
     sim: &mut mote_md::Simulation,
     label: &str,

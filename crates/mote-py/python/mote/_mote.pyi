@@ -1,0 +1,129 @@
+"""Type stubs of mote's native module (see docs/python.md)."""
+
+from os import PathLike
+from typing import Any, Callable, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+Path = Union[str, PathLike]
+
+class MoteError(RuntimeError):
+    """A run that could not go on (an I/O error, a refused request)."""
+
+class UnstableError(MoteError):
+    """A run that went unstable: the message names the step and the particle;
+    the simulation keeps the state it reached."""
+
+class Simulation:
+    """A time-stepped simulation (gravity, springs, Lennard-Jones, granular,
+    dipoles, Brownian dynamics) built from a scene: a file, a TOML string or a
+    dict with the keys of docs/scene-format.md."""
+
+    @staticmethod
+    def from_file(path: Path, seed: Optional[int] = None) -> "Simulation":
+        """A scene file or ``example:NAME``; ``seed`` replaces the scene's."""
+    @staticmethod
+    def from_toml(text: str, seed: Optional[int] = None, name: str = "<string>") -> "Simulation":
+        """A scene given as TOML text; ``name`` labels its messages."""
+    @staticmethod
+    def from_dict(scene: dict[str, Any], seed: Optional[int] = None) -> "Simulation":
+        """A scene given as a dict of the scene file's tables and keys."""
+    @staticmethod
+    def resume(path: Path) -> "Simulation":
+        """The simulation a checkpoint holds, ready to go on bit for bit."""
+    def save_checkpoint(self, path: Path) -> None:
+        """Writes a checkpoint that ``Simulation.resume`` continues bit for bit."""
+    def step(self, n: int = 1) -> None:
+        """Advances ``n`` steps (the GIL is released meanwhile)."""
+    def run(
+        self,
+        steps: Optional[int] = None,
+        until: Optional[float] = None,
+        callback: Optional[Callable[["Simulation"], Any]] = None,
+        every: int = 100,
+    ) -> None:
+        """Runs ``steps`` steps or until time ``until`` (the scene's length when
+        neither is given), calling ``callback(sim)`` every ``every`` steps."""
+    time: float
+    """Simulated time (settable between runs)."""
+    dt: float
+    """Time step (settable between runs)."""
+    @property
+    def steps(self) -> int:
+        """Steps taken."""
+    @property
+    def seed(self) -> int:
+        """The seed of the run's random numbers."""
+    def __len__(self) -> int: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]:
+        """(N, 3) view of mote's memory; writes reach the next step."""
+    @property
+    def velocities(self) -> npt.NDArray[np.float64]:
+        """(N, 3) writable view."""
+    @property
+    def omegas(self) -> npt.NDArray[np.float64]:
+        """(N, 3) angular velocities, writable view."""
+    @property
+    def dipoles(self) -> npt.NDArray[np.float64]:
+        """(N, 3) magnetic dipole moments, writable view."""
+    @property
+    def masses(self) -> npt.NDArray[np.float64]:
+        """(N,) writable view."""
+    @property
+    def radii(self) -> npt.NDArray[np.float64]:
+        """(N,) writable view."""
+    @property
+    def charges(self) -> npt.NDArray[np.float64]:
+        """(N,) writable view."""
+    @property
+    def species(self) -> list[str]:
+        """Species names of the particles."""
+    @property
+    def observables(self) -> dict[str, npt.NDArray[np.float64]]:
+        """The observables measured so far: time, kinetic, potential, total,
+        rotational, kT, pressure, momentum, angular_momentum, magnetisation."""
+
+def run(
+    scene: Union[Path, str, dict[str, Any], None] = None,
+    *,
+    output: Optional[Path] = None,
+    seed: Optional[int] = None,
+    steps: Optional[int] = None,
+    until: Optional[float] = None,
+    dt: Optional[float] = None,
+    checkpoint_every: Optional[int] = None,
+    trajectory_format: Optional[str] = None,
+    resume: Optional[Path] = None,
+) -> dict[str, Any]:
+    """Runs a scene of any engine to its end as ``mote run`` does; returns
+    engine, seed, dir, summary and ending."""
+
+def pack(
+    n: int = 1000,
+    *,
+    dimension: int = 3,
+    dist: str = "mono",
+    rate: float = 0.01,
+    max_pressure: float = 1e12,
+    phi: Optional[float] = None,
+    walls: str = "",
+    jam: bool = True,
+    seed: Optional[int] = None,
+    start: Optional[str] = None,
+    output: Optional[Path] = None,
+) -> dict[str, Any]:
+    """A packing by growing hard spheres; returns positions, radii, box, phi,
+    pressure, seed and summary."""
+
+def rcp(
+    *,
+    sigma: Optional[float] = None,
+    diameters: Optional[list[float]] = None,
+    volumes: Optional[list[float]] = None,
+    rods: int = 16000,
+) -> float:
+    """The rod-packing estimate of the random close packing fraction."""

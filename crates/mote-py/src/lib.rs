@@ -1,0 +1,42 @@
+//! `import mote`: the Python API (pyo3 + numpy, built by maturin).
+//!
+//! Scenes go through the same front as `mote run` (`mote_front`), so a
+//! scene file, a TOML string and a Python dict are one format with one
+//! parser. A time-stepped scene becomes a [`Simulation`] that Python steps,
+//! reads and writes (particle arrays are numpy views of mote's own
+//! memory); every engine runs whole through [`run`]; packings and the
+//! rod-packing estimator are functions.
+
+use pyo3::prelude::*;
+
+mod convert;
+mod simulation;
+mod tools;
+
+pyo3::create_exception!(
+    mote,
+    MoteError,
+    pyo3::exceptions::PyRuntimeError,
+    "A run that could not go on (an I/O error, a refused request)."
+);
+pyo3::create_exception!(
+    mote,
+    UnstableError,
+    MoteError,
+    "A run that went unstable: the message names the step and the particle; the simulation keeps the state it reached."
+);
+
+/// mote: many-particle simulation (time-stepped, rigid, event-driven,
+/// packings, the rod-packing estimator) from Python.
+#[pymodule]
+fn _mote(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("MoteError", py.get_type::<MoteError>())?;
+    m.add("UnstableError", py.get_type::<UnstableError>())?;
+    m.add_class::<simulation::Simulation>()?;
+    m.add_function(wrap_pyfunction!(tools::run, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::pack, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::rcp, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

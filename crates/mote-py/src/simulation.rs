@@ -1,0 +1,494 @@
+//! `mote.Simulation`: a time-stepped scene that Python steps, reads and
+//! writes.
+//!
+//! Stepping follows `mote run` exactly: the first call primes the
+//! integrator and measures the start; observables are measured at the
+//! scene's `observables_every` (absolute step multiples) and at the end of
+//! each `run` (as `mote run` does at its last step), never at other chunk
+//! ends, so `run(steps=N)` gives the bits of `mote run --steps N` and a
+//! callback every k steps changes nothing.
+
+use std::path::PathBuf;
+
+use mote_io::checkpoint::Checkpoint;
+use mote_md::observe::Observables;
+use mote_md::scene::Scene;
+use mote_md::{DVec3, RunLength};
+use mote_run::Propagator;
+use numpy::ndarray::{ArrayView1, ArrayView2};
+use numpy::prelude::*;
+use numpy::{PyArray1, PyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::{Mutex, MutexGuard};
+
+use crate::convert::{dict_to_toml, md_error, parse_error};
+
+/// The stepping state behind a Python `Simulation` (no Python types: it
+/// runs with the GIL released).
+struct Engine {
+    sim: mote_md::Simulation,
+    /// Scene label and text, kept for checkpoints.
+    label: String,
+    text: String,
+    observables_every: u64,
+    primed: bool,
+    samples: Vec<Observables>,
+    /// Positions after the last step, to see writes from Python (which
+    /// make the carried accelerations stale).
+    seen: Vec<DVec3>,
+}
+
+impl Engine {
+    fn from_text(text: &str, label: &str, seed: Option<u64>) -> PyResult<Engine> {
+        let scene = Scene::parse(text, label).map_err(parse_error)?;
+        let (seed, _) = mote_front::seed::resolve(seed, scene.seed);
+        let built = scene.build(text, label, seed).map_err(parse_error)?;
+        if built.simulation.dt <= 0.0 {
+            return Err(PyValueError::new_err(format!(
+                "{label}: no time step ([run] dt)"
+            )));
+        }
+        Ok(Engine {
+            sim: built.simulation,
+            label: label.to_string(),
+            text: text.to_string(),
+            observables_every: scene.output.observables_every,
+            primed: false,
+            samples: Vec::new(),
+            seen: Vec::new(),
+        })
+    }
+
+    /// Primes on the first call, and again after Python moved particles.
+    fn prepare(&mut self) -> Result<(), mote_md::MdError> {
+        let p = &self.sim.system.particles.position;
+        if self.primed && self.seen != *p {
+            self.sim.system.carried_acceleration.clear();
+            self.sim.system.carried_angular_acceleration.clear();
+        }
+        self.sim.prime(&mut |_| {})?;
+        if !self.primed {
+            let s = self.sim.measure();
+            self.samples.push(s);
+            self.primed = true;
+        }
+        Ok(())
+    }
+
+    /// Advances `n` steps; measures on the schedule and, with `end_sample`,
+    /// after the last step.
+    fn advance(&mut self, n: u64, end_sample: bool) -> Result<(), mote_md::MdError> {
+        self.prepare()?;
+        let last = self.sim.system.step + n;
+        let every = self.observables_every;
+        while self.sim.system.step < last {
+            self.sim.advance()?;
+            let step = self.sim.system.step;
+            if let Some((particle, what)) = self.sim.unstable() {
+                self.seen.clone_from(&self.sim.system.particles.position);
+                return Err(mote_md::MdError::Unstable {
+                    step,
+                    time: self.sim.system.time,
+                    particle,
+                    what,
+                });
+            }
+            let end = end_sample && step == last;
+            if end || (every > 0 && step.is_multiple_of(every)) {
+                let s = self.sim.measure();
+                self.samples.push(s);
+            }
+        }
+        self.seen.clone_from(&self.sim.system.particles.position);
+        Ok(())
+    }
+}
+
+/// A time-stepped simulation (gravity, springs, Lennard-Jones, granular,
+/// dipoles, Brownian dynamics) built from a scene: a file, a TOML string
+/// or a dict with the keys of docs/scene-format.md.
+///
+/// >>> sim = mote.Simulation.from_file("examples/sun-earth.toml")
+/// >>> sim.run(until=365.25)
+/// >>> sim.positions[1]
+#[pyclass(module = "mote")]
+pub struct Simulation {
+    /// Behind a lock: Python may call from several threads.
+    engine: Mutex<Engine>,
+}
+
+impl Simulation {
+    fn new(engine: Engine) -> Self {
+        Simulation {
+            engine: Mutex::new(engine),
+        }
+    }
+
+    /// The engine, unless another thread is running it (waiting for it
+    /// while holding the GIL could deadlock with that thread's return).
+    fn engine(&self) -> PyResult<MutexGuard<'_, Engine>> {
+        match self.engine.try_lock() {
+            Ok(g) => Ok(g),
+            // A panic while holding the lock leaves the state as it was at
+            // that point: still readable.
+            Err(std::sync::TryLockError::Poisoned(p)) => Ok(p.into_inner()),
+            Err(std::sync::TryLockError::WouldBlock) => Err(crate::MoteError::new_err(
+                "the simulation is running in another thread",
+            )),
+        }
+    }
+}
+
+fn view<'py>(
+    this: &Bound<'py, Simulation>,
+    which: fn(&mote_md::particles::Particles) -> &[DVec3],
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let s = this.borrow();
+    let e = s.engine()?;
+    let v = which(&e.sim.system.particles);
+    // DVec3 is three f64 in a row (repr(C)): an (N, 3) array.
+    let arr = unsafe { ArrayView2::from_shape_ptr((v.len(), 3), v.as_ptr() as *const f64) };
+    // SAFETY: the particle arrays are never reallocated (a time-stepped
+    // system keeps its particles), and the array keeps `this` alive.
+    Ok(unsafe { PyArray2::borrow_from_array(&arr, this.clone().into_any()) })
+}
+
+fn view1<'py>(
+    this: &Bound<'py, Simulation>,
+    which: fn(&mote_md::particles::Particles) -> &[f64],
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let s = this.borrow();
+    let e = s.engine()?;
+    let v = which(&e.sim.system.particles);
+    let arr = ArrayView1::from(v);
+    // SAFETY: as in `view`.
+    Ok(unsafe { PyArray1::borrow_from_array(&arr, this.clone().into_any()) })
+}
+
+#[pymethods]
+impl Simulation {
+    /// A scene file or `example:NAME`; `seed` replaces the scene's.
+    #[staticmethod]
+    #[pyo3(signature = (path, seed=None))]
+    fn from_file(path: PathBuf, seed: Option<u64>) -> PyResult<Self> {
+        let input = mote_front::Input::read(&path.to_string_lossy())
+            .map_err(crate::convert::front_error)?;
+        Self::checked(&input)?;
+        Ok(Simulation::new(Engine::from_text(
+            &input.text,
+            &input.label,
+            seed,
+        )?))
+    }
+
+    /// A scene given as TOML text; `name` labels its messages.
+    #[staticmethod]
+    #[pyo3(signature = (text, seed=None, name="<string>"))]
+    fn from_toml(text: &str, seed: Option<u64>, name: &str) -> PyResult<Self> {
+        let input = mote_front::Input {
+            name: "python".into(),
+            label: name.into(),
+            text: text.into(),
+            plist: false,
+        };
+        Self::checked(&input)?;
+        Ok(Simulation::new(Engine::from_text(text, name, seed)?))
+    }
+
+    /// A scene given as a dict of the scene file's tables and keys.
+    #[staticmethod]
+    #[pyo3(signature = (scene, seed=None))]
+    fn from_dict(scene: &Bound<'_, PyDict>, seed: Option<u64>) -> PyResult<Self> {
+        let text = dict_to_toml(scene)?;
+        Self::from_toml(&text, seed, "<dict>")
+    }
+
+    /// The simulation a checkpoint (`save_checkpoint`, `mote run
+    /// --checkpoint-every`) holds, ready to go on bit for bit.
+    #[staticmethod]
+    fn resume(path: PathBuf) -> PyResult<Self> {
+        let cp =
+            mote_io::checkpoint::read(&path).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        if cp.option("engine").is_some_and(|e| e != "particles") {
+            return Err(PyValueError::new_err(format!(
+                "{}: a checkpoint of a {} run: resume it with mote.run(resume=...)",
+                path.display(),
+                cp.option("engine").unwrap_or_default()
+            )));
+        }
+        let mut engine = Engine::from_text(&cp.input_text, &cp.input_label, Some(cp.seed))?;
+        if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
+            engine.sim.dt = dt;
+        }
+        mote_front::resume_state(&cp, &mut engine.sim, &cp.input_label)
+            .map_err(crate::convert::front_error)?;
+        // The checkpoint's run already measured its start.
+        engine.primed = true;
+        engine
+            .seen
+            .clone_from(&engine.sim.system.particles.position);
+        Ok(Simulation::new(engine))
+    }
+
+    /// Writes a checkpoint: `Simulation.resume(path)` and `mote run
+    /// --resume path` go on from it bit for bit.
+    fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
+        let mut guard = self.engine()?;
+        let e = &mut *guard;
+        e.prepare().map_err(md_error)?;
+        let mut cp = Checkpoint {
+            program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
+            seed: e.sim.seed,
+            options: vec![
+                ("name".into(), "python".into()),
+                ("plist".into(), "false".into()),
+                ("total-steps".into(), e.sim.system.step.to_string()),
+                ("dt".into(), mote_io::checkpoint::hex(e.sim.dt)),
+                ("output".into(), ".".into()),
+            ],
+            input_label: e.label.clone(),
+            input_text: e.text.clone(),
+            ..Checkpoint::default()
+        };
+        e.sim.save(&mut cp).map_err(md_error)?;
+        mote_io::checkpoint::write(&path, &cp).map_err(|e| crate::MoteError::new_err(e.to_string()))
+    }
+
+    /// Advances `n` steps (the GIL is released meanwhile).
+    #[pyo3(signature = (n=1))]
+    fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
+        let mut guard = self.engine()?;
+        let engine = &mut *guard;
+        py.detach(|| engine.advance(n, false)).map_err(md_error)
+    }
+
+    /// Runs `steps` steps or until time `until` (the scene's run length
+    /// when neither is given), calling `callback(sim)` every `every` steps
+    /// when given. The GIL is released while mote computes.
+    #[pyo3(signature = (steps=None, until=None, callback=None, every=100))]
+    fn run(
+        slf: Bound<'_, Self>,
+        steps: Option<u64>,
+        until: Option<f64>,
+        callback: Option<Bound<'_, PyAny>>,
+        every: u64,
+    ) -> PyResult<()> {
+        let py = slf.py();
+        let total = {
+            let s = slf.borrow();
+            let e = s.engine()?;
+            let length = match (steps, until) {
+                (Some(_), Some(_)) => {
+                    return Err(PyValueError::new_err("give steps or until, not both"))
+                }
+                (Some(n), None) => RunLength::Steps(n),
+                (None, Some(t)) => {
+                    if !t.is_finite() {
+                        return Err(PyValueError::new_err(format!(
+                            "until = {t}: must be a finite time"
+                        )));
+                    }
+                    RunLength::Until(t)
+                }
+                (None, None) => {
+                    let scene = Scene::parse(&e.text, &e.label).map_err(parse_error)?;
+                    match scene
+                        .run
+                        .schedule(mote_io::Source::new(&e.label, &e.text))
+                        .map_err(parse_error)?
+                        .2
+                    {
+                        Some(l) => l,
+                        None => {
+                            return Err(PyValueError::new_err(
+                                "the scene gives no run length: give steps= or until=",
+                            ))
+                        }
+                    }
+                }
+            };
+            length.steps_from(e.sim.system.time, e.sim.dt)
+        };
+        if every == 0 {
+            return Err(PyValueError::new_err("every must be at least 1"));
+        }
+        let chunk = if callback.is_some() {
+            every
+        } else {
+            total.max(1)
+        };
+        let mut done = 0;
+        while done < total {
+            let n = chunk.min(total - done);
+            {
+                let s = slf.borrow();
+                let mut guard = s.engine()?;
+                let engine = &mut *guard;
+                let last = done + n == total;
+                py.detach(|| engine.advance(n, last)).map_err(md_error)?;
+            }
+            done += n;
+            if let Some(f) = &callback {
+                f.call1((slf.clone(),))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Simulated time (settable between runs).
+    #[getter]
+    fn time(&self) -> PyResult<f64> {
+        Ok(self.engine()?.sim.system.time)
+    }
+
+    #[setter]
+    fn set_time(&self, t: f64) -> PyResult<()> {
+        if !t.is_finite() {
+            return Err(PyValueError::new_err("time must be finite"));
+        }
+        self.engine()?.sim.system.time = t;
+        Ok(())
+    }
+
+    /// Time step (settable between runs).
+    #[getter]
+    fn dt(&self) -> PyResult<f64> {
+        Ok(self.engine()?.sim.dt)
+    }
+
+    #[setter]
+    fn set_dt(&self, dt: f64) -> PyResult<()> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "dt = {dt}: must be positive and finite"
+            )));
+        }
+        self.engine()?.sim.dt = dt;
+        Ok(())
+    }
+
+    /// Steps taken.
+    #[getter]
+    fn steps(&self) -> PyResult<u64> {
+        Ok(self.engine()?.sim.system.step)
+    }
+
+    /// The seed of the run's random numbers.
+    #[getter]
+    fn seed(&self) -> PyResult<u64> {
+        Ok(self.engine()?.sim.seed)
+    }
+
+    fn __len__(&self) -> PyResult<usize> {
+        Ok(self.engine()?.sim.system.particles.len())
+    }
+
+    /// Positions, (N, 3): a view of mote's memory; writes reach the next step.
+    #[getter]
+    fn positions<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        view(this, |p| &p.position)
+    }
+
+    /// Velocities, (N, 3), a writable view.
+    #[getter]
+    fn velocities<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        view(this, |p| &p.velocity)
+    }
+
+    /// Angular velocities, (N, 3), a writable view.
+    #[getter]
+    fn omegas<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        view(this, |p| &p.angular_velocity)
+    }
+
+    /// Magnetic dipole moments, (N, 3), a writable view.
+    #[getter]
+    fn dipoles<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        view(this, |p| &p.dipole)
+    }
+
+    /// Masses, (N,), a writable view.
+    #[getter]
+    fn masses<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        view1(this, |p| &p.mass)
+    }
+
+    /// Radii, (N,), a writable view.
+    #[getter]
+    fn radii<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        view1(this, |p| &p.radius)
+    }
+
+    /// Charges, (N,), a writable view.
+    #[getter]
+    fn charges<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        view1(this, |p| &p.charge)
+    }
+
+    /// The species names of the particles.
+    #[getter]
+    fn species(&self) -> PyResult<Vec<String>> {
+        Ok(self.engine()?.sim.system.species.clone())
+    }
+
+    /// The observables measured so far (the columns of `mote run`'s
+    /// observables.csv) as numpy arrays: time, kinetic, potential, total,
+    /// rotational, kT, pressure, momentum (n, 3), angular_momentum (n, 3),
+    /// magnetisation (n, 3).
+    #[getter]
+    fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let guard = self.engine()?;
+        let s = &guard.samples;
+        let d = PyDict::new(py);
+        let col = |f: fn(&Observables) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
+        let vec3 = |f: fn(&Observables) -> DVec3| {
+            let flat: Vec<f64> = s.iter().flat_map(|o| f(o).to_array()).collect();
+            PyArray1::from_vec(py, flat).reshape([s.len(), 3])
+        };
+        d.set_item("time", col(|o| o.time))?;
+        d.set_item("kinetic", col(|o| o.kinetic))?;
+        d.set_item("potential", col(|o| o.potential))?;
+        d.set_item("total", col(|o| o.total_energy()))?;
+        d.set_item("rotational", col(|o| o.rotational))?;
+        d.set_item("kT", col(|o| o.kt))?;
+        d.set_item("pressure", col(|o| o.pressure))?;
+        d.set_item("momentum", vec3(|o| o.momentum)?)?;
+        d.set_item("angular_momentum", vec3(|o| o.angular_momentum)?)?;
+        d.set_item("magnetisation", vec3(|o| o.magnetisation)?)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let e = self.engine()?;
+        Ok(format!(
+            "<mote.Simulation {}: {} particles, t = {}, step {}, dt = {}>",
+            e.label,
+            e.sim.system.particles.len(),
+            e.sim.system.time,
+            e.sim.system.step,
+            e.sim.dt
+        ))
+    }
+}
+
+impl Simulation {
+    /// Refuses inputs of the other engines with the way to run them.
+    fn checked(input: &mote_front::Input) -> PyResult<()> {
+        if input.plist {
+            return Err(PyValueError::new_err(format!(
+                "{}: an MPPphys particle file: run it with mote.run()",
+                input.label
+            )));
+        }
+        match input.engine() {
+            mote_front::Engine::Particles => Ok(()),
+            other => Err(PyValueError::new_err(format!(
+                "{}: a {} scene: mote.Simulation steps time-stepped scenes; run this one with mote.run()",
+                input.label,
+                other.title()
+            ))),
+        }
+    }
+}

@@ -1,0 +1,217 @@
+//! Whole runs of any engine, packings and the rod-packing estimator.
+
+use std::path::PathBuf;
+
+use numpy::prelude::*;
+use numpy::PyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{dict_to_toml, front_error};
+
+/// Runs a scene of any engine to its end, as `mote run` does, writing its
+/// files to `output` (default `out/<name>`); `scene` is a path,
+/// `example:NAME`, TOML text (when it holds a newline) or a dict. Returns a
+/// dict: engine, seed, dir, summary (lines), ending ("finished",
+/// "unstable: ...", "interrupted: ..."). `resume` continues a checkpoint
+/// of any engine instead. The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (scene=None, *, output=None, seed=None, steps=None, until=None, dt=None, checkpoint_every=None, trajectory_format=None, resume=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn run<'py>(
+    py: Python<'py>,
+    scene: Option<Bound<'py, PyAny>>,
+    output: Option<PathBuf>,
+    seed: Option<u64>,
+    steps: Option<u64>,
+    until: Option<f64>,
+    dt: Option<f64>,
+    checkpoint_every: Option<u64>,
+    trajectory_format: Option<String>,
+    resume: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let options = mote_front::RunOptions {
+        output,
+        seed,
+        steps,
+        until,
+        dt,
+        checkpoint_every,
+        trajectory_format,
+        resume: resume.clone(),
+        ..mote_front::RunOptions::default()
+    };
+    let input = match (&scene, &resume) {
+        (None, None) => return Err(PyValueError::new_err("give a scene or resume=")),
+        (Some(_), Some(_)) => {
+            return Err(PyValueError::new_err("give a scene or resume=, not both"))
+        }
+        (None, Some(_)) => None,
+        (Some(s), None) => Some(if let Ok(d) = s.cast::<PyDict>() {
+            mote_front::Input {
+                name: "python".into(),
+                label: "<dict>".into(),
+                text: dict_to_toml(d)?,
+                plist: false,
+            }
+        } else {
+            let s: String = s.extract()?;
+            if s.contains('\n') {
+                mote_front::Input {
+                    name: "python".into(),
+                    label: "<string>".into(),
+                    text: s,
+                    plist: false,
+                }
+            } else {
+                mote_front::Input::read(&s).map_err(front_error)?
+            }
+        }),
+    };
+    let outcome = py
+        .detach(|| {
+            let mut monitor = mote_front::Silent;
+            match &input {
+                Some(i) => mote_front::run_input(i, &options, &mut monitor),
+                None => mote_front::run(&options, &mut monitor),
+            }
+        })
+        .map_err(front_error)?;
+    let d = PyDict::new(py);
+    d.set_item("engine", format!("{:?}", outcome.engine))?;
+    d.set_item("seed", outcome.seed)?;
+    d.set_item("dir", outcome.dir.display().to_string())?;
+    d.set_item("summary", outcome.summary)?;
+    let ending = match outcome.ending {
+        mote_front::Ending::Finished => "finished".to_string(),
+        mote_front::Ending::Unstable(m) => format!("unstable: {m}"),
+        mote_front::Ending::Interrupted { message, .. } => format!("interrupted: {message}"),
+    };
+    d.set_item("ending", ending)?;
+    Ok(d)
+}
+
+/// A packing by growing hard spheres (Lubachevsky–Stillinger), the keys
+/// of `mote pack` (`mote pack --help`). Returns a dict: positions (N, D),
+/// radii (N,), box (D,), phi, pressure, summary (lines). `output` also
+/// writes it (format by extension) with its CSV of windows.
+#[pyfunction]
+#[pyo3(signature = (n=1000, *, dimension=3, dist="mono", rate=0.01, max_pressure=1e12, phi=None, walls="", jam=true, seed=None, start=None, output=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn pack<'py>(
+    py: Python<'py>,
+    n: usize,
+    dimension: usize,
+    dist: &str,
+    rate: f64,
+    max_pressure: f64,
+    phi: Option<f64>,
+    walls: &str,
+    jam: bool,
+    seed: Option<u64>,
+    start: Option<String>,
+    output: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mote_front::packing::{pack, Naming, PackFiles, PackingSpec};
+    let spec = PackingSpec {
+        n,
+        dimension,
+        dist: dist.into(),
+        rate,
+        max_pressure,
+        phi,
+        walls: walls.into(),
+        jam,
+        start,
+        ..PackingSpec::default()
+    };
+    let (seed, _) = mote_front::seed::resolve(seed, None);
+    let settings = spec
+        .settings(seed, Naming::Options, std::path::Path::new("."))
+        .map_err(front_error)?;
+    let provenance = mote_io::Provenance {
+        program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
+        scene: format!("mote.pack(n={n}, dist={dist:?}, rate={rate})"),
+        seed,
+    };
+    let files = PackFiles {
+        xyz: output,
+        ..PackFiles::default()
+    };
+    let packed = py
+        .detach(|| {
+            pack(
+                dimension,
+                settings,
+                None,
+                &files,
+                &provenance,
+                &mut mote_front::Silent,
+            )
+        })
+        .map_err(front_error)?;
+    let f = &packed.frame;
+    let d = PyDict::new(py);
+    let flat: Vec<f64> = f
+        .positions
+        .iter()
+        .flat_map(|p| p[..dimension].to_vec())
+        .collect();
+    d.set_item(
+        "positions",
+        PyArray1::from_vec(py, flat).reshape([f.positions.len(), dimension])?,
+    )?;
+    d.set_item("radii", PyArray1::from_vec(py, f.radii.clone()))?;
+    let sides: Vec<f64> = (0..dimension).map(|k| f.cell[k][k]).collect();
+    d.set_item("box", PyArray1::from_vec(py, sides))?;
+    d.set_item("phi", packed.phi)?;
+    d.set_item("pressure", packed.pressure)?;
+    d.set_item("seed", seed)?;
+    d.set_item("summary", packed.summary)?;
+    Ok(d)
+}
+
+/// The rod-packing estimate of the random close packing fraction (Farr &
+/// Groot 2009), as `mote rcp`: `sigma` for a lognormal of log-width σ
+/// (number-weighted), or `diameters` with `volumes` for a sum of
+/// monodisperse populations; `rods` rods (default 16000).
+#[pyfunction]
+#[pyo3(signature = (*, sigma=None, diameters=None, volumes=None, rods=16000))]
+pub fn rcp(
+    py: Python<'_>,
+    sigma: Option<f64>,
+    diameters: Option<Vec<f64>>,
+    volumes: Option<Vec<f64>>,
+    rods: usize,
+) -> PyResult<f64> {
+    use mote_rcp::{Population, RodPacking, SizeDistribution};
+    let bad = |e: mote_rcp::RcpError| PyValueError::new_err(e.to_string());
+    let dist = match (sigma, diameters) {
+        (Some(s), None) => SizeDistribution::lognormal(s).map_err(bad)?,
+        (None, Some(d)) => {
+            let v = volumes.unwrap_or_else(|| vec![1.0; d.len()]);
+            if v.len() != d.len() {
+                return Err(PyValueError::new_err(format!(
+                    "{} diameters but {} volumes",
+                    d.len(),
+                    v.len()
+                )));
+            }
+            SizeDistribution::new(
+                d.iter()
+                    .zip(&v)
+                    .map(|(&d, &v)| Population::monodisperse(d, v)),
+            )
+            .map_err(bad)?
+        }
+        _ => {
+            return Err(PyValueError::new_err(
+                "give sigma= or diameters= (with volumes=)",
+            ))
+        }
+    };
+    let packing = RodPacking::default().rods(rods);
+    let out = py.detach(|| packing.estimate(&dist)).map_err(bad)?;
+    Ok(out.phi)
+}

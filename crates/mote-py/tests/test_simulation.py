@@ -1,0 +1,184 @@
+"""mote's Python API: the same numbers as `mote run`, numpy views that
+reflect writes, the GIL released while mote computes, and bad input raised
+as Python exceptions (never a crash)."""
+
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import mote
+
+LJ = """
+title = "LJ liquid, 256 atoms"
+units = "lj"
+seed = 5
+
+[run]
+integrator = "leapfrog"
+dt = 0.005
+steps = 200
+
+[lennard_jones]
+cutoff = 2.5
+skin = 0.3
+
+[[fcc]]
+cells = [4, 4, 4]
+density = 0.8442
+kt = 1.44
+
+[output]
+observables_every = 10
+trajectory_every = 0
+"""
+
+
+def csv_columns(path):
+    """The columns of an observables.csv (comments skipped) by name."""
+    with open(path) as f:
+        lines = [l for l in f if not l.startswith("#")]
+    names = [n.strip() for n in lines[0].split(",")]
+    rows = np.array([[float(x) for x in l.split(",")] for l in lines[1:]])
+    return {n: rows[:, k] for k, n in enumerate(names)}
+
+
+def test_run_gives_the_bits_of_mote_run(tmp_path):
+    sim = mote.Simulation.from_toml(LJ)
+    sim.run()
+    assert sim.steps == 200
+    out = mote.run(LJ, output=tmp_path, checkpoint_every=1000)
+    assert out["ending"] == "finished"
+    ref = mote.Simulation.resume(tmp_path / "checkpoint.mote")
+    assert ref.steps == 200
+    # Bit for bit: the state, and every measured observable.
+    assert np.array_equal(sim.positions, ref.positions)
+    assert np.array_equal(sim.velocities, ref.velocities)
+    table = csv_columns(tmp_path / "observables.csv")
+    obs = sim.observables
+    assert np.array_equal(table["time"], obs["time"])
+    assert np.array_equal(table["kinetic_energy"], obs["kinetic"])
+    assert np.array_equal(table["potential_energy"], obs["potential"])
+
+
+def test_chunks_and_callbacks_change_nothing():
+    whole = mote.Simulation.from_toml(LJ)
+    whole.run(steps=200)
+    chunked = mote.Simulation.from_toml(LJ)
+    for _ in range(4):
+        chunked.step(50)
+    assert np.array_equal(whole.positions, chunked.positions)
+    seen = []
+    called = mote.Simulation.from_toml(LJ)
+    called.run(steps=200, callback=lambda s: seen.append(s.steps), every=7)
+    assert seen == list(range(7, 200, 7)) + [200]
+    assert np.array_equal(whole.positions, called.positions)
+
+
+def test_views_are_mote_memory_and_writes_reach_the_next_step():
+    sim = mote.Simulation.from_dict(
+        {
+            "run": {"integrator": "leapfrog", "dt": 0.5, "steps": 10},
+            "particle": [{"position": [0.0, 0.0, 0.0], "mass": 1.0}],
+        }
+    )
+    x = sim.positions
+    assert x.shape == (1, 3) and x.base is sim
+    # Without a copy: the same memory on every access.
+    assert sim.positions.__array_interface__["data"][0] == x.__array_interface__["data"][0]
+    sim.velocities[0] = [2.0, 0.0, -1.0]
+    sim.step(1)
+    assert np.array_equal(x[0], [1.0, 0.0, -0.5])
+    x[0] = [10.0, 10.0, 10.0]
+    sim.step(2)
+    assert np.array_equal(sim.positions[0], [12.0, 10.0, 9.0])
+    sim.dt = 0.25
+    sim.step(4)
+    assert np.array_equal(sim.positions[0], [14.0, 10.0, 8.0])
+    assert sim.time == pytest.approx(2.5)
+
+
+def test_the_gil_is_released_while_mote_computes():
+    sim = mote.Simulation.from_toml(LJ.replace("[4, 4, 4]", "[7, 7, 7]"))
+    worker = threading.Thread(target=sim.run, kwargs={"steps": 300})
+    count = 0
+    worker.start()
+    start = time.perf_counter()
+    while worker.is_alive():
+        count += 1
+    elapsed = time.perf_counter() - start
+    worker.join()
+    assert sim.steps == 300
+    # Python counted all along; with the GIL held it could not have.
+    assert elapsed > 0.05 and count > 10_000, (elapsed, count)
+
+
+def test_bad_input_raises_with_the_line():
+    with pytest.raises(ValueError, match=r"<string>:3: unknown field `foo`"):
+        mote.Simulation.from_toml("[run]\ndt = 0.1\nfoo = 3\n")
+    with pytest.raises(ValueError, match=r"<dict>:.*unknown field `dtt`"):
+        mote.Simulation.from_dict({"run": {"dtt": 0.1}})
+    with pytest.raises(TypeError, match="run.dt"):
+        mote.Simulation.from_dict({"run": {"dt": object()}})
+    with pytest.raises(ValueError, match="mote.run"):
+        mote.Simulation.from_file("example:cube")
+    with pytest.raises(ValueError, match="dt = -1"):
+        mote.Simulation.from_toml(LJ).dt = -1.0
+    with pytest.raises(ValueError, match="steps or until"):
+        mote.Simulation.from_toml(LJ).run(steps=1, until=1.0)
+    with pytest.raises(OSError, match="no/such/scene.toml"):
+        mote.Simulation.from_file("no/such/scene.toml")
+
+
+def test_an_unstable_run_raises_naming_step_and_particle_and_keeps_the_state():
+    sim = mote.Simulation.from_dict(
+        {
+            "run": {"integrator": "leapfrog", "dt": 0.1, "steps": 10},
+            "particle": [
+                {"position": [0.0, 0.0, 0.0], "mass": 1.0},
+                {"position": [1.0, 0.0, 0.0], "mass": 1.0},
+            ],
+        }
+    )
+    sim.step(3)
+    sim.velocities[1] = [np.inf, 0.0, 0.0]
+    with pytest.raises(mote.UnstableError, match=r"step 4 .*particle 1"):
+        sim.step(5)
+    assert sim.steps == 4
+    assert np.isfinite(sim.positions[0]).all()
+
+
+def test_checkpoints_resume_bit_for_bit(tmp_path):
+    a = mote.Simulation.from_toml(LJ)
+    a.step(60)
+    a.save_checkpoint(tmp_path / "a.mote")
+    a.step(70)
+    b = mote.Simulation.resume(tmp_path / "a.mote")
+    assert b.steps == 60 and b.time == pytest.approx(0.3)
+    b.step(70)
+    assert np.array_equal(a.positions, b.positions)
+
+
+def test_every_engine_runs_whole(tmp_path):
+    for scene, kw in [
+        ("example:cube", {"until": 0.5}),
+        ("example:magnet-in-field", {"steps": 20}),
+        ("[packing]\nn = 100\nmax_pressure = 1e5\n", {}),
+        (LJ, {"steps": 10}),
+    ]:
+        out = mote.run(scene, output=tmp_path / str(len(kw)) / scene[:8].strip("[:\n"), seed=2, **kw)
+        assert out["ending"] == "finished", out
+        assert out["summary"]
+
+
+def test_pack_and_rcp():
+    r = mote.pack(200, phi=0.5, seed=1)
+    assert r["positions"].shape == (200, 3) and r["radii"].shape == (200,)
+    volume = (4.0 / 3.0 * np.pi * r["radii"] ** 3).sum()
+    assert volume / np.prod(r["box"]) == pytest.approx(0.5, abs=1e-12)
+    # spherepack1d's monodisperse value and the published lognormal one.
+    assert round(mote.rcp(diameters=[1.0]), 6) == 0.643485
+    assert 0.66 < mote.rcp(sigma=0.3) < 0.68
+    with pytest.raises(ValueError):
+        mote.rcp(sigma=-1.0)
