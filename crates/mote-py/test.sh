@@ -10,6 +10,8 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip >/dev/null
 "$venv/bin/python" -m pip install --quiet "maturin>=1.5,<2" pytest numpy matplotlib
+# ASE for the interop test (skipped with a message where it cannot install).
+"$venv/bin/python" -m pip install --quiet ase >/dev/null 2>&1 || echo "note: could not install ase; its Python test will skip"
 (cd "$here" && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --quiet)
 cd "$here"
 "$venv/bin/python" -m pytest -q tests

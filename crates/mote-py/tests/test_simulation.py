@@ -182,3 +182,21 @@ def test_pack_and_rcp():
     assert 0.66 < mote.rcp(sigma=0.3) < 0.68
     with pytest.raises(ValueError):
         mote.rcp(sigma=-1.0)
+
+
+def test_ase_atoms_in_and_out():
+    ase = pytest.importorskip("ase")
+    atoms = ase.Atoms("Ar4", positions=[[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 2.5]], cell=[8, 8, 8], pbc=True)
+    atoms.set_velocities([[0.01, 0, 0], [0, 0.02, 0], [0, 0, -0.01], [0.005, 0.005, 0]])
+    sim = mote.from_ase(atoms, {"run": {"integrator": "leapfrog", "dt": 0.1}})
+    assert len(sim) == 4 and sim.species == ["Ar"] * 4
+    assert np.array_equal(sim.positions, atoms.positions)
+    assert np.array_equal(sim.velocities, atoms.get_velocities())
+    assert np.array_equal(sim.masses, atoms.get_masses())
+    sim.step(10)  # no forces: straight lines
+    back = mote.to_ase(sim, box=([0, 0, 0], [8, 8, 8], [True] * 3))
+    assert np.allclose(back.positions, (atoms.positions + 1.0 * atoms.get_velocities()) % 8.0, atol=1e-12)
+    assert np.allclose(back.get_velocities(), atoms.get_velocities(), atol=1e-15)
+    assert back.get_chemical_symbols() == ["Ar"] * 4
+    with pytest.raises(ValueError, match="skewed"):
+        mote.from_ase(ase.Atoms("Ar", positions=[[0, 0, 0]], cell=[[4, 0, 0], [1, 4, 0], [0, 0, 4]], pbc=True), {"run": {"dt": 0.1}})
