@@ -460,6 +460,23 @@ impl Simulation {
         Ok(d)
     }
 
+    /// Ray-traces the current state as `mote run --picture` does: a
+    /// (height, width, 3) uint8 array, or a PNG written to `output`.
+    #[pyo3(signature = (output=None, width=800, height=600))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        output: Option<PathBuf>,
+        width: u32,
+        height: u32,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let frame = mote_md::output::frame_of(&self.engine()?.sim.system);
+        let image = py
+            .detach(|| mote_render::frame::picture_image(&frame, width, height))
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        crate::tools::image_out(py, image, output)
+    }
+
     fn __repr__(&self) -> PyResult<String> {
         let e = self.engine()?;
         Ok(format!(

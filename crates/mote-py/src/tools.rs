@@ -215,3 +215,50 @@ pub fn rcp(
     let out = py.detach(|| packing.estimate(&dist)).map_err(bad)?;
     Ok(out.phi)
 }
+
+/// An image as numpy (height, width, 3) uint8, or written to `path` (PNG)
+/// when given (then None).
+pub fn image_out<'py>(
+    py: Python<'py>,
+    image: mote_render::Image,
+    path: Option<PathBuf>,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    match path {
+        Some(p) => {
+            image
+                .write_png(&p)
+                .map_err(|e| crate::MoteError::new_err(e.to_string()))?;
+            Ok(None)
+        }
+        None => {
+            let (h, w) = (image.height as usize, image.width as usize);
+            let array = PyArray1::from_vec(py, image.rgb).reshape([h, w, 3])?;
+            Ok(Some(array.into_any()))
+        }
+    }
+}
+
+/// Ray-traces a frame of a trajectory file (`.xyz`, `.dump`, `.gsd`,
+/// `.vtp`/`.pvd`; `frame` counts from 0, negative from the end, default
+/// the last) as `mote run --picture` does: coloured by species, shadows,
+/// box drawn. Returns a (height, width, 3) uint8 array, or writes `output`
+/// (PNG) and returns None.
+#[pyfunction]
+#[pyo3(signature = (trajectory, *, frame=None, output=None, width=800, height=600))]
+pub fn render<'py>(
+    py: Python<'py>,
+    trajectory: PathBuf,
+    frame: Option<i64>,
+    output: Option<PathBuf>,
+    width: u32,
+    height: u32,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let frames = mote_io::trajectory::read_frames(&trajectory)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let f =
+        mote_io::trajectory::pick(&frames, frame, &trajectory).map_err(PyValueError::new_err)?;
+    let image = py
+        .detach(|| mote_render::frame::picture_image(f, width, height))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    image_out(py, image, output)
+}

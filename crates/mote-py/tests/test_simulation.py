@@ -200,3 +200,17 @@ def test_ase_atoms_in_and_out():
     assert back.get_chemical_symbols() == ["Ar"] * 4
     with pytest.raises(ValueError, match="skewed"):
         mote.from_ase(ase.Atoms("Ar", positions=[[0, 0, 0]], cell=[[4, 0, 0], [1, 4, 0], [0, 0, 4]], pbc=True), {"run": {"dt": 0.1}})
+
+
+def test_pictures_as_arrays_and_files(tmp_path):
+    sim = mote.Simulation.from_toml(LJ)
+    image = sim.render(width=64, height=48)
+    assert image.shape == (48, 64, 3) and image.dtype == np.uint8
+    assert image.std() > 0  # not blank
+    sim.render(tmp_path / "lj.png", width=64, height=48)
+    assert (tmp_path / "lj.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    mote.run(LJ.replace("trajectory_every = 0", "trajectory_every = 50"), output=tmp_path / "run", steps=100)
+    again = mote.render(tmp_path / "run" / "trajectory.xyz", frame=-1, width=64, height=48)
+    assert again.shape == (48, 64, 3)
+    with pytest.raises(ValueError, match="no frame 9"):
+        mote.render(tmp_path / "run" / "trajectory.xyz", frame=9)

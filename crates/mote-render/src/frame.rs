@@ -150,6 +150,11 @@ pub fn picture(
     width: u32,
     height: u32,
 ) -> Result<(), RenderError> {
+    picture_image(frame, width, height)?.write_png(path)
+}
+
+/// The image [`picture`] writes.
+pub fn picture_image(frame: &Frame, width: u32, height: u32) -> Result<crate::Image, RenderError> {
     let (scene, _) = scene_from_frame(
         frame,
         &ColorBy::Species,
@@ -164,7 +169,5 @@ pub fn picture(
         shadows: true,
         ..crate::RenderOptions::default()
     };
-    crate::Renderer::new(&scene)
-        .render(&cam, &opts)
-        .write_png(path)
+    Ok(crate::Renderer::new(&scene).render(&cam, &opts))
 }

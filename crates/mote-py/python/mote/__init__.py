@@ -13,10 +13,11 @@ from ._mote import (  # noqa: F401
     __version__,
     pack,
     rcp,
+    render,
     run,
 )
 
-__all__ = ["MoteError", "Simulation", "UnstableError", "pack", "rcp", "run"]
+__all__ = ["MoteError", "Simulation", "UnstableError", "pack", "rcp", "render", "run"]
 
 
 def from_ase(atoms, scene=None, seed=None):

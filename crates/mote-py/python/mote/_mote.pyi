@@ -82,6 +82,9 @@ class Simulation:
     @property
     def species(self) -> list[str]:
         """Species names of the particles."""
+    def render(self, output: Optional[Path] = None, width: int = 800, height: int = 600) -> Optional[npt.NDArray[np.uint8]]:
+        """Ray-traces the current state: a (height, width, 3) image, or a PNG
+        written to ``output``."""
     @property
     def observables(self) -> dict[str, npt.NDArray[np.float64]]:
         """The observables measured so far: time, kinetic, potential, total,
@@ -127,3 +130,14 @@ def rcp(
     rods: int = 16000,
 ) -> float:
     """The rod-packing estimate of the random close packing fraction."""
+
+def render(
+    trajectory: Path,
+    *,
+    frame: Optional[int] = None,
+    output: Optional[Path] = None,
+    width: int = 800,
+    height: int = 600,
+) -> Optional[npt.NDArray[np.uint8]]:
+    """Ray-traces a frame of a trajectory file: a (height, width, 3) image, or
+    a PNG written to ``output``."""
