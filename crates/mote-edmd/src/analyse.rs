@@ -156,55 +156,91 @@ impl Contacts {
     }
 }
 
-/// Finds contacts at relative gap `tol` and rattlers (< D + 1 contacts; a
-/// particle touching a wall counts the wall as a contact).
+/// Finds contacts at relative gap `tol` and rattlers (fewer than D + 1
+/// contacts with non-rattlers, removed recursively; a particle touching a
+/// wall counts the wall as a contact).
 pub fn contacts<const D: usize>(
     simbox: &SimBox<D>,
     pos: &[[f64; D]],
     radii: &[f64],
     tol: f64,
 ) -> Contacts {
+    contacts_with(simbox, pos, radii, tol, false)
+}
+
+/// As [`contacts`], with the strict test of mechanical stability: a
+/// particle is also a rattler when its contacts with non-rattlers all lie
+/// in one open hemisphere, so that no repulsive contact forces can balance
+/// it (the origin outside the convex hull of the contact directions:
+/// [`balanced`]). Removing a particle can unbalance its neighbours, so the
+/// test cascades: what is left is a backbone in which every particle can
+/// be in force balance.
+pub fn stable_contacts<const D: usize>(
+    simbox: &SimBox<D>,
+    pos: &[[f64; D]],
+    radii: &[f64],
+    tol: f64,
+) -> Contacts {
+    contacts_with(simbox, pos, radii, tol, true)
+}
+
+fn contacts_with<const D: usize>(
+    simbox: &SimBox<D>,
+    pos: &[[f64; D]],
+    radii: &[f64],
+    tol: f64,
+    strict: bool,
+) -> Contacts {
     let n = pos.len();
     let rmax = radii.iter().cloned().fold(0.0, f64::max);
     let mut pairs = Vec::new();
-    for_pairs(simbox, pos, 2.0 * rmax * (1.0 + tol), |i, j, _, dist| {
-        if dist < (1.0 + tol) * (radii[i] + radii[j]) {
+    // Unit directions from each particle to each of its contacts.
+    let mut adj: Vec<Vec<(usize, [f64; D])>> = vec![Vec::new(); n];
+    for_pairs(simbox, pos, 2.0 * rmax * (1.0 + tol), |i, j, r, dist| {
+        if dist < (1.0 + tol) * (radii[i] + radii[j]) && dist > 0.0 {
             pairs.push((i, j));
+            // r = x_i − x_j: j lies along −r from i.
+            let u = r.map(|x| x / dist);
+            adj[i].push((j, u.map(|x| -x)));
+            adj[j].push((i, u));
         }
     });
-    let mut wall = vec![0usize; n];
+    let mut walls: Vec<Vec<[f64; D]>> = vec![Vec::new(); n];
     for i in 0..n {
         for d in 0..D {
             if simbox.boundary[d] == Boundary::Wall {
                 let r = radii[i] * (1.0 + tol);
-                if pos[i][d] < r || pos[i][d] > simbox.size[d] - r {
-                    wall[i] += 1;
+                let mut u = [0.0; D];
+                if pos[i][d] < r {
+                    u[d] = -1.0;
+                    walls[i].push(u);
+                } else if pos[i][d] > simbox.size[d] - r {
+                    u[d] = 1.0;
+                    walls[i].push(u);
                 }
             }
         }
     }
-    let mut z = wall.clone();
-    let mut adj = vec![Vec::new(); n];
-    for &(i, j) in &pairs {
-        z[i] += 1;
-        z[j] += 1;
-        adj[i].push(j);
-        adj[j].push(i);
-    }
-    let mut live = z.clone();
+    let z: Vec<usize> = (0..n).map(|i| adj[i].len() + walls[i].len()).collect();
     let mut rattler = vec![false; n];
-    let mut stack: Vec<usize> = (0..n).filter(|&i| live[i] < D + 1).collect();
+    let loose = |i: usize, rattler: &[bool]| -> bool {
+        let dirs: Vec<[f64; D]> = adj[i]
+            .iter()
+            .filter(|(j, _)| !rattler[*j])
+            .map(|(_, u)| *u)
+            .chain(walls[i].iter().copied())
+            .collect();
+        dirs.len() < D + 1 || (strict && !balanced(&dirs))
+    };
+    let mut stack: Vec<usize> = (0..n).filter(|&i| loose(i, &rattler)).collect();
     while let Some(i) = stack.pop() {
         if rattler[i] {
             continue;
         }
         rattler[i] = true;
-        for &j in &adj[i] {
-            if !rattler[j] {
-                live[j] -= 1;
-                if live[j] < D + 1 {
-                    stack.push(j);
-                }
+        for &(j, _) in &adj[i] {
+            if !rattler[j] && loose(j, &rattler) {
+                stack.push(j);
             }
         }
     }
@@ -212,7 +248,10 @@ pub fn contacts<const D: usize>(
     let backbone_z = if back.is_empty() {
         0.0
     } else {
-        back.iter().map(|&i| live[i] - wall[i]).sum::<usize>() as f64 / back.len() as f64
+        back.iter()
+            .map(|&i| adj[i].iter().filter(|(j, _)| !rattler[*j]).count())
+            .sum::<usize>() as f64
+            / back.len() as f64
     };
     Contacts {
         tol,
@@ -221,6 +260,75 @@ pub fn contacts<const D: usize>(
         backbone_z,
         pairs,
     }
+}
+
+/// Whether repulsive forces along unit directions `dirs` can balance:
+/// whether the origin lies in their convex hull. By Carathéodory it then
+/// lies in the hull of some D + 1 of them, so every such subset is tried:
+/// Σ λₖ uₖ = 0, Σ λₖ = 1 solved for λ, accepted when λ ≥ 0 (to 1e-12).
+/// Directions all in one open hemisphere never balance.
+pub fn balanced<const D: usize>(dirs: &[[f64; D]]) -> bool {
+    let m = dirs.len();
+    if m < D + 1 {
+        // Fewer: the hull is too small unless two are opposite (a particle
+        // squeezed along a line, which is still no mechanical backbone).
+        return false;
+    }
+    let mut pick: Vec<usize> = (0..=D).collect();
+    loop {
+        if simplex_holds_origin::<D>(&pick.iter().map(|&k| dirs[k]).collect::<Vec<_>>()) {
+            return true;
+        }
+        // The next (D + 1)-subset in lexicographic order.
+        let mut k = D;
+        loop {
+            if pick[k] < m - (D + 1 - k) {
+                pick[k] += 1;
+                for l in k + 1..=D {
+                    pick[l] = pick[l - 1] + 1;
+                }
+                break;
+            }
+            if k == 0 {
+                return false;
+            }
+            k -= 1;
+        }
+    }
+}
+
+/// Whether the origin lies in the simplex of D + 1 points (barycentric
+/// weights by Gaussian elimination with partial pivoting).
+fn simplex_holds_origin<const D: usize>(v: &[[f64; D]]) -> bool {
+    let size = D + 1;
+    // Rows: D coordinates and the sum of weights; columns: the points.
+    let mut a = vec![vec![0.0; size + 1]; size];
+    for (k, p) in v.iter().enumerate() {
+        for d in 0..D {
+            a[d][k] = p[d];
+        }
+        a[D][k] = 1.0;
+    }
+    a[D][size] = 1.0;
+    for col in 0..size {
+        let pivot = (col..size)
+            .max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))
+            .unwrap();
+        if a[pivot][col].abs() < 1e-12 {
+            // Degenerate (coplanar points): some other subset decides.
+            return false;
+        }
+        a.swap(col, pivot);
+        for row in 0..size {
+            if row != col {
+                let f = a[row][col] / a[col][col];
+                for c in col..=size {
+                    a[row][c] -= f * a[col][c];
+                }
+            }
+        }
+    }
+    (0..size).all(|k| a[k][size] / a[k][k] >= -1e-12)
 }
 
 /// The pair correlation g(r) with r in units of the mean diameter, over
@@ -339,6 +447,92 @@ pub fn bond_order<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn unit<const D: usize>(v: [f64; D]) -> [f64; D] {
+        let l = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        v.map(|x| x / l)
+    }
+
+    /// Contacts balance when they surround the particle, not when they
+    /// all lie in one hemisphere (or one plane in 3-D).
+    #[test]
+    fn contact_directions_balance_only_around_the_particle() {
+        let tetra = [
+            [1.0, 1.0, 1.0],
+            [1.0, -1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+        ]
+        .map(unit);
+        assert!(balanced(&tetra));
+        let mut octa = Vec::new();
+        for d in 0..3 {
+            for s in [1.0, -1.0] {
+                let mut u = [0.0; 3];
+                u[d] = s;
+                octa.push(u);
+            }
+        }
+        assert!(balanced(&octa));
+        // Six contacts, all above the equator: no force can push down.
+        let cap: Vec<[f64; 3]> = (0..6)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::PI / 3.0;
+                unit([a.cos(), a.sin(), 0.2])
+            })
+            .collect();
+        assert!(!balanced(&cap));
+        // The same with one contact below: balanced.
+        let mut held = cap.clone();
+        held.push([0.0, 0.0, -1.0]);
+        assert!(balanced(&held));
+        // Four in a plane: nothing out of it.
+        assert!(!balanced(&[
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0]
+        ]));
+        // 2-D: a triangle around the disk balances; three in a half-plane do not.
+        let tri = [0.0f64, 2.0, 4.0].map(|a| [a.cos(), a.sin()]);
+        assert!(balanced(&tri));
+        assert!(!balanced(&[[1.0, 0.1], [0.0, 1.0], [-1.0, 0.1]].map(unit)));
+        assert!(balanced(&[[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]]));
+    }
+
+    /// A crystal has no rattlers; a disk lifted off its lower neighbours
+    /// keeps only its two upper contacts and rattles.
+    #[test]
+    fn a_particle_lifted_off_its_neighbours_is_a_rattler() {
+        // A triangular crystal of touching disks, periodic: every disk has
+        // six contacts all round.
+        let (nx, ny) = (6, 6);
+        let h = 3f64.sqrt() / 2.0;
+        let simbox = SimBox {
+            size: [nx as f64, ny as f64 * h],
+            boundary: [Boundary::Periodic; 2],
+        };
+        let mut pos = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                pos.push([i as f64 + 0.5 * (j % 2) as f64, j as f64 * h]);
+            }
+        }
+        let radii = vec![0.5; pos.len()];
+        for c in [
+            contacts(&simbox, &pos, &radii, 1e-9),
+            stable_contacts(&simbox, &pos, &radii, 1e-9),
+        ] {
+            assert_eq!(c.rattlers(), 0);
+            assert!((c.backbone_z - 6.0).abs() < 1e-12);
+        }
+        let k = 3 * nx + 2;
+        let mut moved = pos.clone();
+        moved[k][1] += 0.01;
+        let c = contacts(&simbox, &moved, &radii, 1e-9);
+        assert!(c.rattler[k], "contacts {}", c.z[k]);
+        assert_eq!(c.z[k], 2, "two upper neighbours still touch it");
+    }
     use crate::init::lattice;
 
     #[test]

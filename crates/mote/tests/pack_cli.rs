@@ -61,10 +61,14 @@ fn packs_writes_and_analyses() {
         .arg(&xyz)
         .arg("--gr")
         .arg(dir.path().join("gr.csv"))
+        .arg("--picture")
+        .arg(dir.path().join("analysed.png"))
         .output()
         .unwrap();
     let a = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{a}");
+    let png = std::fs::read(dir.path().join("analysed.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     // read back from the file (exact numbers, periodic box from pbc="T T T"),
     // the contacts at a gap of 1e-7 are those of the packing in memory
     let out = mote()

@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use mote_edmd::analyse::{bond_order, contacts, deepest_overlap, pair_correlation};
+use mote_edmd::analyse::{
+    bond_order, contacts, deepest_overlap, pair_correlation, stable_contacts,
+};
 use mote_edmd::{Boundary, SimBox};
 use mote_front::packing::{Naming, PackFiles, PackingSpec};
 use mote_front::{Ending, Monitor};
@@ -122,6 +124,9 @@ struct AnalyseArgs {
     /// Largest r of g(r), in mean diameters.
     #[arg(long, default_value_t = 3.0)]
     rmax: f64,
+    /// Ray-trace the packing into this PNG (800×800, as `mote pack --picture`).
+    #[arg(long, value_name = "FILE.png")]
+    picture: Option<PathBuf>,
 }
 
 pub fn run(global: &GlobalOpts, args: PackArgs) -> anyhow::Result<ExitCode> {
@@ -248,6 +253,9 @@ fn analyse_cmd(global: &GlobalOpts, a: &AnalyseArgs) -> anyhow::Result<ExitCode>
         a.tol >= 0.0 && a.bond > 1.0 && a.rmax > 0.0,
         "--tol must be ≥ 0, --bond > 1 and --rmax > 0"
     );
+    if let Some(png) = &a.picture {
+        mote_render::frame::picture(frame, png, 800, 800)?;
+    }
     let flat = frame.positions.iter().all(|p| p[2] == 0.0) && !frame.pbc[2];
     if flat {
         analyse_dim::<2>(frame, a, quiet)
@@ -330,6 +338,13 @@ fn analyse_dim<const D: usize>(
             100.0 * c.rattlers() as f64 / n as f64,
             c.backbone_z,
             2 * D
+        );
+        let s = stable_contacts(&simbox, &pos, radii, a.tol);
+        println!(
+            "force balance         {} rattlers ({:.2} %) when contacts all in one hemisphere also rattle, recursively; backbone mean {:.4}",
+            s.rattlers(),
+            100.0 * s.rattlers() as f64 / n as f64,
+            s.backbone_z
         );
         println!(
             "{}                   {q:.4} over {bonds} bonds < {}·(r_i + r_j) ({})",
