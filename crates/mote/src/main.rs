@@ -77,7 +77,20 @@ fn stop_cleanly_on_signals() {
     }
 }
 
+/// Output into a closed pipe (`mote pack analyse F | head`) ends the
+/// program as it ends every Unix filter, by SIGPIPE, instead of a panic
+/// from `println!` (Rust ignores SIGPIPE by default).
+fn end_quietly_on_closed_pipes() {
+    #[cfg(unix)]
+    // SAFETY: restoring a signal's default disposition before any thread
+    // is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    end_quietly_on_closed_pipes();
     let cli = Cli::parse();
     if matches!(
         cli.command,

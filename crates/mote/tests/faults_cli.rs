@@ -147,3 +147,34 @@ fn an_output_folder_that_cannot_be_made_is_named() {
         .unwrap();
     assert_refused(&out, "/sys/mote-out", "");
 }
+
+/// Output into a closed pipe ends the program by SIGPIPE, as `head` expects
+/// of a Unix filter, not with a panic (found piping `mote pack analyse`
+/// into `head`).
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = mote()
+        .args(["examples"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader goes away at once
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    let status = child.wait().unwrap();
+    assert!(!err.contains("panicked"), "{err}");
+    use std::os::unix::process::ExitStatusExt;
+    // Either it wrote everything before the pipe closed, or SIGPIPE ended it.
+    assert!(
+        status.success() || status.signal() == Some(13),
+        "{status:?}: {err}"
+    );
+}
