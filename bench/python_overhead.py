@@ -62,3 +62,16 @@ copy0 = time.perf_counter()
 y = np.array(x)
 copy = time.perf_counter() - copy0
 print(f"{n} positions: handed over in {hand_over * 1e6:.1f} µs (view: base is the simulation: {x.base is big}, shares memory with a second access: {np.shares_memory(x, big.positions)}); a copy would take {copy * 1e3:.1f} ms")
+
+# The cost of a callback: every step, a no-op, against the same run without.
+def with_callback(every):
+    sim = mote.Simulation.from_toml(LJ.format(cells="[5, 5, 10]"))
+    sim.run(steps=100)
+    t0 = time.process_time()
+    sim.run(steps=STEPS, callback=(lambda s: None) if every else None, every=every or 100)
+    return time.process_time() - t0
+
+
+plain = statistics.median(with_callback(0) for _ in range(5))
+called = statistics.median(with_callback(1) for _ in range(5))
+print(f"a callback every step: {(called - plain) / STEPS * 1e6:.1f} µs per call ({100 * (called / plain - 1):+.1f} % on this run)")
