@@ -38,6 +38,7 @@ fn _mote(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::pack, m)?)?;
     m.add_function(wrap_pyfunction!(tools::rcp, m)?)?;
     m.add_function(wrap_pyfunction!(tools::render, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::rcp_optimise, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

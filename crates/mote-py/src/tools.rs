@@ -262,3 +262,68 @@ pub fn render<'py>(
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     image_out(py, image, output)
 }
+
+/// The size distribution that packs densest (or closest to `target`) by
+/// the rod-packing estimator, as `mote rcp optimise`: populations of
+/// `diameters` (d43 of lognormals of log-width `sigmas`, 0 for
+/// monodisperse; default all monodisperse) starting at `volumes`; the
+/// volume fractions are varied, and the widths too with `widths=True`
+/// (Nelder–Mead). Returns a dict: volumes (fractions), sigmas, phi,
+/// evaluations.
+#[pyfunction]
+#[pyo3(signature = (diameters, *, sigmas=None, volumes=None, target=None, widths=false, rods=16000, max_evaluations=600))]
+#[allow(clippy::too_many_arguments)]
+pub fn rcp_optimise<'py>(
+    py: Python<'py>,
+    diameters: Vec<f64>,
+    sigmas: Option<Vec<f64>>,
+    volumes: Option<Vec<f64>>,
+    target: Option<f64>,
+    widths: bool,
+    rods: usize,
+    max_evaluations: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mote_rcp::design::{optimise, Objective, Search};
+    use mote_rcp::{Population, RodPacking};
+    let p = diameters.len();
+    let sigmas = sigmas.unwrap_or_else(|| vec![0.0; p]);
+    let volumes = volumes.unwrap_or_else(|| vec![1.0; p]);
+    if sigmas.len() != p || volumes.len() != p {
+        return Err(PyValueError::new_err(format!(
+            "{p} diameters need {p} sigmas and {p} volumes (got {} and {})",
+            sigmas.len(),
+            volumes.len()
+        )));
+    }
+    let base: Vec<Population> = (0..p)
+        .map(|k| {
+            if sigmas[k] > 0.0 {
+                Population::lognormal(diameters[k], sigmas[k], volumes[k])
+            } else {
+                Population::monodisperse(diameters[k], volumes[k])
+            }
+        })
+        .collect();
+    let search = Search {
+        widths,
+        max_evaluations,
+        ..Search::default()
+    };
+    let objective = target.map_or(Objective::Maximise, Objective::Target);
+    let estimator = RodPacking::default().rods(rods);
+    let best = py
+        .detach(|| optimise(&base, &estimator, objective, &search))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let d = PyDict::new(py);
+    d.set_item(
+        "volumes",
+        PyArray1::from_vec(py, best.populations.iter().map(|q| q.volume()).collect()),
+    )?;
+    d.set_item(
+        "sigmas",
+        PyArray1::from_vec(py, best.populations.iter().map(|q| q.sigma()).collect()),
+    )?;
+    d.set_item("phi", best.phi)?;
+    d.set_item("evaluations", best.evaluations)?;
+    Ok(d)
+}

@@ -214,3 +214,16 @@ def test_pictures_as_arrays_and_files(tmp_path):
     assert again.shape == (48, 64, 3)
     with pytest.raises(ValueError, match="no frame 9"):
         mote.render(tmp_path / "run" / "trajectory.xyz", frame=9)
+
+
+def test_rcp_optimiser_finds_the_densest_binary_mixture():
+    best = mote.rcp_optimise([1.0, 4.0])
+    assert best["volumes"].sum() == pytest.approx(1.0)
+    # No composition of the sweep packs denser than the optimum.
+    sweep = [mote.rcp(diameters=[1.0, 4.0], volumes=[1 - f, f]) for f in np.linspace(0.05, 0.95, 19)]
+    assert best["phi"] >= max(sweep) - 1e-6
+    assert 0.5 < best["volumes"][1] < 0.9
+    near = mote.rcp_optimise([1.0, 4.0], target=0.7)
+    assert near["phi"] == pytest.approx(0.7, abs=1e-4)
+    with pytest.raises(ValueError, match="2 sigmas"):
+        mote.rcp_optimise([1.0, 4.0], sigmas=[0.1])

@@ -13,11 +13,12 @@ from ._mote import (  # noqa: F401
     __version__,
     pack,
     rcp,
+    rcp_optimise,
     render,
     run,
 )
 
-__all__ = ["MoteError", "Simulation", "UnstableError", "pack", "rcp", "render", "run"]
+__all__ = ["MoteError", "Simulation", "UnstableError", "pack", "rcp", "rcp_optimise", "render", "run"]
 
 
 def from_ase(atoms, scene=None, seed=None):

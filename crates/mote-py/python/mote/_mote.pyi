@@ -141,3 +141,17 @@ def render(
 ) -> Optional[npt.NDArray[np.uint8]]:
     """Ray-traces a frame of a trajectory file: a (height, width, 3) image, or
     a PNG written to ``output``."""
+
+def rcp_optimise(
+    diameters: list[float],
+    *,
+    sigmas: Optional[list[float]] = None,
+    volumes: Optional[list[float]] = None,
+    target: Optional[float] = None,
+    widths: bool = False,
+    rods: int = 16000,
+    max_evaluations: int = 600,
+) -> dict[str, Any]:
+    """The volume fractions (and widths) that pack densest, or closest to
+    ``target``, by the rod-packing estimator; returns volumes, sigmas, phi,
+    evaluations."""
