@@ -19,6 +19,7 @@ pub mod packing;
 mod particles;
 mod rigid;
 pub mod seed;
+mod terminal;
 
 use std::path::PathBuf;
 
@@ -26,6 +27,7 @@ pub use engine::Engine;
 pub use error::FrontError;
 pub use input::Input;
 pub use particles::resume_state;
+pub use terminal::Terminal;
 
 /// The options of `mote run`, common to every engine.
 #[derive(Debug, Clone, Default)]

@@ -80,6 +80,16 @@ impl Engine {
     /// Advances `n` steps; measures on the schedule and, with `end_sample`,
     /// after the last step.
     fn advance(&mut self, n: u64, end_sample: bool) -> Result<(), mote_md::MdError> {
+        self.advance_showing(n, end_sample, &mut |_, _| {})
+    }
+
+    /// [`Engine::advance`], calling `progress(step, time)` every 16 steps.
+    fn advance_showing(
+        &mut self,
+        n: u64,
+        end_sample: bool,
+        progress: &mut (dyn FnMut(u64, f64) + Send),
+    ) -> Result<(), mote_md::MdError> {
         self.prepare()?;
         let last = self.sim.system.step + n;
         let every = self.observables_every;
@@ -99,6 +109,9 @@ impl Engine {
             if end || (every > 0 && step.is_multiple_of(every)) {
                 let s = self.sim.measure();
                 self.samples.push(s);
+            }
+            if step.is_multiple_of(16) {
+                progress(step, self.sim.system.time);
             }
         }
         self.seen.clone_from(&self.sim.system.particles.position);
@@ -266,14 +279,16 @@ impl Simulation {
 
     /// Runs `steps` steps or until time `until` (the scene's run length
     /// when neither is given), calling `callback(sim)` every `every` steps
-    /// when given. The GIL is released while mote computes.
-    #[pyo3(signature = (steps=None, until=None, callback=None, every=100))]
+    /// when given; `progress=True` shows `mote run`'s progress bar on
+    /// stderr. The GIL is released while mote computes.
+    #[pyo3(signature = (steps=None, until=None, callback=None, every=100, progress=false))]
     fn run(
         slf: Bound<'_, Self>,
         steps: Option<u64>,
         until: Option<f64>,
         callback: Option<Bound<'_, PyAny>>,
         every: u64,
+        progress: bool,
     ) -> PyResult<()> {
         let py = slf.py();
         let total = {
@@ -319,6 +334,21 @@ impl Simulation {
         } else {
             total.max(1)
         };
+        let mut terminal = mote_front::Terminal::new(!progress);
+        let first = {
+            let s = slf.borrow();
+            let e = s.engine()?;
+            mote_front::Monitor::start(
+                &mut terminal,
+                &format!(
+                    "mote (Python) {}: {} particles, dt = {}, {total} steps",
+                    e.label,
+                    e.sim.system.particles.len(),
+                    e.sim.dt
+                ),
+            );
+            e.sim.system.step
+        };
         let mut done = 0;
         while done < total {
             let n = chunk.min(total - done);
@@ -327,13 +357,21 @@ impl Simulation {
                 let mut guard = s.engine()?;
                 let engine = &mut *guard;
                 let last = done + n == total;
-                py.detach(|| engine.advance(n, last)).map_err(md_error)?;
+                let terminal = &mut terminal;
+                py.detach(|| {
+                    engine.advance_showing(n, last, &mut |step, t| {
+                        let note = format!("t = {t:.6e}");
+                        mote_front::Monitor::progress(terminal, step - first, total, &note)
+                    })
+                })
+                .map_err(md_error)?;
             }
             done += n;
             if let Some(f) = &callback {
                 f.call1((slf.clone(),))?;
             }
         }
+        mote_front::Monitor::finish(&mut terminal);
         Ok(())
     }
 

@@ -15,9 +15,10 @@ use crate::convert::{dict_to_toml, front_error};
 /// `example:NAME`, TOML text (when it holds a newline) or a dict. Returns a
 /// dict: engine, seed, dir, summary (lines), ending ("finished",
 /// "unstable: ...", "interrupted: ..."). `resume` continues a checkpoint
-/// of any engine instead. The GIL is released while it runs.
+/// of any engine instead; `progress=True` shows `mote run`'s opening line
+/// and progress bar on stderr. The GIL is released while it runs.
 #[pyfunction]
-#[pyo3(signature = (scene=None, *, output=None, seed=None, steps=None, until=None, dt=None, checkpoint_every=None, trajectory_format=None, resume=None))]
+#[pyo3(signature = (scene=None, *, output=None, seed=None, steps=None, until=None, dt=None, checkpoint_every=None, trajectory_format=None, resume=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn run<'py>(
     py: Python<'py>,
@@ -30,6 +31,7 @@ pub fn run<'py>(
     checkpoint_every: Option<u64>,
     trajectory_format: Option<String>,
     resume: Option<PathBuf>,
+    progress: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = mote_front::RunOptions {
         output,
@@ -71,7 +73,8 @@ pub fn run<'py>(
     };
     let outcome = py
         .detach(|| {
-            let mut monitor = mote_front::Silent;
+            // `mote run`'s opening line and progress bar on stderr when asked.
+            let mut monitor = mote_front::Terminal::new(!progress);
             match &input {
                 Some(i) => mote_front::run_input(i, &options, &mut monitor),
                 None => mote_front::run(&options, &mut monitor),

@@ -227,3 +227,14 @@ def test_rcp_optimiser_finds_the_densest_binary_mixture():
     assert near["phi"] == pytest.approx(0.7, abs=1e-4)
     with pytest.raises(ValueError, match="2 sigmas"):
         mote.rcp_optimise([1.0, 4.0], sigmas=[0.1])
+
+
+def test_progress_shows_the_opening_line_on_stderr(capfd, tmp_path):
+    sim = mote.Simulation.from_toml(LJ)
+    sim.run(steps=10)
+    assert capfd.readouterr().err == ""
+    sim.run(steps=10, progress=True)
+    assert "256 particles, dt = 0.005, 10 steps" in capfd.readouterr().err
+    out = mote.run(LJ, steps=5, progress=True, output=tmp_path)
+    assert "mote run <string>" in capfd.readouterr().err
+    assert out["ending"] == "finished"

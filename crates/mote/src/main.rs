@@ -5,7 +5,6 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cmd;
-mod progress;
 
 /// mote — many-particle simulation toolkit.
 #[derive(Parser, Debug)]

@@ -44,6 +44,7 @@ class Simulation:
         until: Optional[float] = None,
         callback: Optional[Callable[["Simulation"], Any]] = None,
         every: int = 100,
+        progress: bool = False,
     ) -> None:
         """Runs ``steps`` steps or until time ``until`` (the scene's length when
         neither is given), calling ``callback(sim)`` every ``every`` steps."""
@@ -101,6 +102,7 @@ def run(
     checkpoint_every: Optional[int] = None,
     trajectory_format: Optional[str] = None,
     resume: Optional[Path] = None,
+    progress: bool = False,
 ) -> dict[str, Any]:
     """Runs a scene of any engine to its end as ``mote run`` does; returns
     engine, seed, dir, summary and ending."""

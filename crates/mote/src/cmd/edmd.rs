@@ -12,7 +12,7 @@ use mote_edmd::scene::{example, EXAMPLES};
 use mote_front::event_driven::EdmdWords;
 use mote_front::{Input, RunOptions};
 
-use crate::progress::Terminal;
+use mote_front::Terminal;
 
 /// The old command's words (its help text is the `Edmd` variant's in main.rs).
 #[derive(clap::Args, Debug)]

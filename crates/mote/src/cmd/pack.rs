@@ -17,7 +17,7 @@ use mote_front::packing::{Naming, PackFiles, PackingSpec};
 use mote_front::{Ending, Monitor};
 
 use super::GlobalOpts;
-use crate::progress::Terminal;
+use mote_front::Terminal;
 
 /// The words of `mote pack` (its help text is the `Pack` variant's in main.rs).
 #[derive(clap::Args, Debug)]

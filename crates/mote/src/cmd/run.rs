@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use mote_front::{Ending, RunOptions};
 
-use crate::progress::Terminal;
+use mote_front::Terminal;
 
 #[derive(clap::Args, Debug, Clone)]
 #[command(allow_negative_numbers = true)]

@@ -34,7 +34,7 @@ impl Terminal {
     }
 }
 
-impl mote_front::Monitor for Terminal {
+impl crate::Monitor for Terminal {
     fn start(&mut self, line: &str) {
         if !self.quiet {
             eprintln!("{line}");
