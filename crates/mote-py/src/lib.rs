@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 
 mod convert;
 mod simulation;
+mod stepping;
 mod tools;
 
 pyo3::create_exception!(

@@ -24,17 +24,15 @@ use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
 
 use crate::convert::{dict_to_toml, md_error, parse_error};
+use crate::stepping::{run_loop, HasEngine, Stepped, Stepping};
 
 /// The stepping state behind a Python `Simulation` (no Python types: it
 /// runs with the GIL released).
-struct Engine {
-    sim: mote_md::Simulation,
+pub struct Engine {
+    stepping: Stepping<mote_md::Simulation>,
     /// Scene label and text, kept for checkpoints.
     label: String,
     text: String,
-    observables_every: u64,
-    primed: bool,
-    samples: Vec<Observables>,
     /// Positions after the last step, to see writes from Python (which
     /// make the carried accelerations stale).
     seen: Vec<DVec3>,
@@ -51,71 +49,68 @@ impl Engine {
             )));
         }
         Ok(Engine {
-            sim: built.simulation,
+            stepping: Stepping::new(built.simulation, scene.output.observables_every),
             label: label.to_string(),
             text: text.to_string(),
-            observables_every: scene.output.observables_every,
-            primed: false,
-            samples: Vec::new(),
             seen: Vec::new(),
         })
     }
 
+    fn sim(&self) -> &mote_md::Simulation {
+        &self.stepping.state
+    }
+
+    fn sim_mut(&mut self) -> &mut mote_md::Simulation {
+        &mut self.stepping.state
+    }
+
     /// Primes on the first call, and again after Python moved particles.
     fn prepare(&mut self) -> Result<(), mote_md::MdError> {
-        let p = &self.sim.system.particles.position;
-        if self.primed && self.seen != *p {
-            self.sim.system.carried_acceleration.clear();
-            self.sim.system.carried_angular_acceleration.clear();
+        if self.stepping.primed && self.seen != self.sim().system.particles.position {
+            let sys = &mut self.sim_mut().system;
+            sys.carried_acceleration.clear();
+            sys.carried_angular_acceleration.clear();
         }
-        self.sim.prime(&mut |_| {})?;
-        if !self.primed {
-            let s = self.sim.measure();
-            self.samples.push(s);
-            self.primed = true;
-        }
-        Ok(())
+        self.stepping.prepare()
     }
 
-    /// Advances `n` steps; measures on the schedule and, with `end_sample`,
-    /// after the last step.
+    /// Advances `n` steps (see [`Stepping::advance`]).
     fn advance(&mut self, n: u64, end_sample: bool) -> Result<(), mote_md::MdError> {
-        self.advance_showing(n, end_sample, &mut |_, _| {})
+        Stepped::advance(self, n, end_sample, &mut |_, _| {})
     }
+}
 
-    /// [`Engine::advance`], calling `progress(step, time)` every 16 steps.
-    fn advance_showing(
+impl Stepped for Engine {
+    fn advance(
         &mut self,
         n: u64,
         end_sample: bool,
         progress: &mut (dyn FnMut(u64, f64) + Send),
     ) -> Result<(), mote_md::MdError> {
         self.prepare()?;
-        let last = self.sim.system.step + n;
-        let every = self.observables_every;
-        while self.sim.system.step < last {
-            self.sim.advance()?;
-            let step = self.sim.system.step;
-            if let Some((particle, what)) = self.sim.unstable() {
-                self.seen.clone_from(&self.sim.system.particles.position);
-                return Err(mote_md::MdError::Unstable {
-                    step,
-                    time: self.sim.system.time,
-                    particle,
-                    what,
-                });
-            }
-            let end = end_sample && step == last;
-            if end || (every > 0 && step.is_multiple_of(every)) {
-                let s = self.sim.measure();
-                self.samples.push(s);
-            }
-            if step.is_multiple_of(16) {
-                progress(step, self.sim.system.time);
-            }
-        }
-        self.seen.clone_from(&self.sim.system.particles.position);
-        Ok(())
+        let result = self.stepping.advance(n, end_sample, progress);
+        self.seen
+            .clone_from(&self.stepping.state.system.particles.position);
+        result
+    }
+
+    fn clock(&self) -> (u64, f64, f64) {
+        let sim = self.sim();
+        (sim.system.step, sim.system.time, sim.dt)
+    }
+
+    fn scene_length(&self) -> PyResult<Option<RunLength>> {
+        let scene = Scene::parse(&self.text, &self.label).map_err(parse_error)?;
+        let src = mote_io::Source::new(&self.label, &self.text);
+        Ok(scene.run.schedule(src).map_err(parse_error)?.2)
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "{}: {} particles",
+            self.label,
+            self.sim().system.particles.len()
+        )
     }
 }
 
@@ -139,18 +134,15 @@ impl Simulation {
         }
     }
 
-    /// The engine, unless another thread is running it (waiting for it
-    /// while holding the GIL could deadlock with that thread's return).
     fn engine(&self) -> PyResult<MutexGuard<'_, Engine>> {
-        match self.engine.try_lock() {
-            Ok(g) => Ok(g),
-            // A panic while holding the lock leaves the state as it was at
-            // that point: still readable.
-            Err(std::sync::TryLockError::Poisoned(p)) => Ok(p.into_inner()),
-            Err(std::sync::TryLockError::WouldBlock) => Err(crate::MoteError::new_err(
-                "the simulation is running in another thread",
-            )),
-        }
+        crate::stepping::lock(&self.engine)
+    }
+}
+
+impl HasEngine for Simulation {
+    type Engine = Engine;
+    fn engine(&self) -> PyResult<MutexGuard<'_, Engine>> {
+        crate::stepping::lock(&self.engine)
     }
 }
 
@@ -160,7 +152,7 @@ fn view<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let s = this.borrow();
     let e = s.engine()?;
-    let v = which(&e.sim.system.particles);
+    let v = which(&e.sim().system.particles);
     // DVec3 is three f64 in a row (repr(C)): an (N, 3) array.
     let arr = unsafe { ArrayView2::from_shape_ptr((v.len(), 3), v.as_ptr() as *const f64) };
     // SAFETY: the particle arrays are never reallocated (a time-stepped
@@ -174,7 +166,7 @@ fn view1<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let s = this.borrow();
     let e = s.engine()?;
-    let v = which(&e.sim.system.particles);
+    let v = which(&e.sim().system.particles);
     let arr = ArrayView1::from(v);
     // SAFETY: as in `view`.
     Ok(unsafe { PyArray1::borrow_from_array(&arr, this.clone().into_any()) })
@@ -233,15 +225,15 @@ impl Simulation {
         }
         let mut engine = Engine::from_text(&cp.input_text, &cp.input_label, Some(cp.seed))?;
         if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
-            engine.sim.dt = dt;
+            engine.sim_mut().dt = dt;
         }
-        mote_front::resume_state(&cp, &mut engine.sim, &cp.input_label)
+        mote_front::resume_state(&cp, engine.sim_mut(), &cp.input_label)
             .map_err(crate::convert::front_error)?;
         // The checkpoint's run already measured its start.
-        engine.primed = true;
+        engine.stepping.primed = true;
         engine
             .seen
-            .clone_from(&engine.sim.system.particles.position);
+            .clone_from(&engine.stepping.state.system.particles.position);
         Ok(Simulation::new(engine))
     }
 
@@ -253,19 +245,19 @@ impl Simulation {
         e.prepare().map_err(md_error)?;
         let mut cp = Checkpoint {
             program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
-            seed: e.sim.seed,
+            seed: e.sim().seed,
             options: vec![
                 ("name".into(), "python".into()),
                 ("plist".into(), "false".into()),
-                ("total-steps".into(), e.sim.system.step.to_string()),
-                ("dt".into(), mote_io::checkpoint::hex(e.sim.dt)),
+                ("total-steps".into(), e.sim().system.step.to_string()),
+                ("dt".into(), mote_io::checkpoint::hex(e.sim().dt)),
                 ("output".into(), ".".into()),
             ],
             input_label: e.label.clone(),
             input_text: e.text.clone(),
             ..Checkpoint::default()
         };
-        e.sim.save(&mut cp).map_err(md_error)?;
+        e.sim_mut().save(&mut cp).map_err(md_error)?;
         mote_io::checkpoint::write(&path, &cp).map_err(|e| crate::MoteError::new_err(e.to_string()))
     }
 
@@ -290,95 +282,13 @@ impl Simulation {
         every: u64,
         progress: bool,
     ) -> PyResult<()> {
-        let py = slf.py();
-        let total = {
-            let s = slf.borrow();
-            let e = s.engine()?;
-            let length = match (steps, until) {
-                (Some(_), Some(_)) => {
-                    return Err(PyValueError::new_err("give steps or until, not both"))
-                }
-                (Some(n), None) => RunLength::Steps(n),
-                (None, Some(t)) => {
-                    if !t.is_finite() {
-                        return Err(PyValueError::new_err(format!(
-                            "until = {t}: must be a finite time"
-                        )));
-                    }
-                    RunLength::Until(t)
-                }
-                (None, None) => {
-                    let scene = Scene::parse(&e.text, &e.label).map_err(parse_error)?;
-                    match scene
-                        .run
-                        .schedule(mote_io::Source::new(&e.label, &e.text))
-                        .map_err(parse_error)?
-                        .2
-                    {
-                        Some(l) => l,
-                        None => {
-                            return Err(PyValueError::new_err(
-                                "the scene gives no run length: give steps= or until=",
-                            ))
-                        }
-                    }
-                }
-            };
-            length.steps_from(e.sim.system.time, e.sim.dt)
-        };
-        if every == 0 {
-            return Err(PyValueError::new_err("every must be at least 1"));
-        }
-        let chunk = if callback.is_some() {
-            every
-        } else {
-            total.max(1)
-        };
-        let mut terminal = mote_front::Terminal::new(!progress);
-        let first = {
-            let s = slf.borrow();
-            let e = s.engine()?;
-            mote_front::Monitor::start(
-                &mut terminal,
-                &format!(
-                    "mote (Python) {}: {} particles, dt = {}, {total} steps",
-                    e.label,
-                    e.sim.system.particles.len(),
-                    e.sim.dt
-                ),
-            );
-            e.sim.system.step
-        };
-        let mut done = 0;
-        while done < total {
-            let n = chunk.min(total - done);
-            {
-                let s = slf.borrow();
-                let mut guard = s.engine()?;
-                let engine = &mut *guard;
-                let last = done + n == total;
-                let terminal = &mut terminal;
-                py.detach(|| {
-                    engine.advance_showing(n, last, &mut |step, t| {
-                        let note = format!("t = {t:.6e}");
-                        mote_front::Monitor::progress(terminal, step - first, total, &note)
-                    })
-                })
-                .map_err(md_error)?;
-            }
-            done += n;
-            if let Some(f) = &callback {
-                f.call1((slf.clone(),))?;
-            }
-        }
-        mote_front::Monitor::finish(&mut terminal);
-        Ok(())
+        run_loop(&slf, steps, until, callback, every, progress)
     }
 
     /// Simulated time (settable between runs).
     #[getter]
     fn time(&self) -> PyResult<f64> {
-        Ok(self.engine()?.sim.system.time)
+        Ok(self.engine()?.sim().system.time)
     }
 
     #[setter]
@@ -386,14 +296,14 @@ impl Simulation {
         if !t.is_finite() {
             return Err(PyValueError::new_err("time must be finite"));
         }
-        self.engine()?.sim.system.time = t;
+        self.engine()?.sim_mut().system.time = t;
         Ok(())
     }
 
     /// Time step (settable between runs).
     #[getter]
     fn dt(&self) -> PyResult<f64> {
-        Ok(self.engine()?.sim.dt)
+        Ok(self.engine()?.sim().dt)
     }
 
     #[setter]
@@ -403,24 +313,24 @@ impl Simulation {
                 "dt = {dt}: must be positive and finite"
             )));
         }
-        self.engine()?.sim.dt = dt;
+        self.engine()?.sim_mut().dt = dt;
         Ok(())
     }
 
     /// Steps taken.
     #[getter]
     fn steps(&self) -> PyResult<u64> {
-        Ok(self.engine()?.sim.system.step)
+        Ok(self.engine()?.sim().system.step)
     }
 
     /// The seed of the run's random numbers.
     #[getter]
     fn seed(&self) -> PyResult<u64> {
-        Ok(self.engine()?.sim.seed)
+        Ok(self.engine()?.sim().seed)
     }
 
     fn __len__(&self) -> PyResult<usize> {
-        Ok(self.engine()?.sim.system.particles.len())
+        Ok(self.engine()?.sim().system.particles.len())
     }
 
     /// Positions, (N, 3): a view of mote's memory; writes reach the next step.
@@ -468,7 +378,7 @@ impl Simulation {
     /// The species names of the particles.
     #[getter]
     fn species(&self) -> PyResult<Vec<String>> {
-        Ok(self.engine()?.sim.system.species.clone())
+        Ok(self.engine()?.sim().system.species.clone())
     }
 
     /// The observables measured so far (the columns of `mote run`'s
@@ -478,7 +388,7 @@ impl Simulation {
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let guard = self.engine()?;
-        let s = &guard.samples;
+        let s = &guard.stepping.samples;
         let d = PyDict::new(py);
         let col = |f: fn(&Observables) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
         let vec3 = |f: fn(&Observables) -> DVec3| {
@@ -508,7 +418,7 @@ impl Simulation {
         width: u32,
         height: u32,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let frame = mote_md::output::frame_of(&self.engine()?.sim.system);
+        let frame = mote_md::output::frame_of(&self.engine()?.sim().system);
         let image = py
             .detach(|| mote_render::frame::picture_image(&frame, width, height))
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -520,10 +430,10 @@ impl Simulation {
         Ok(format!(
             "<mote.Simulation {}: {} particles, t = {}, step {}, dt = {}>",
             e.label,
-            e.sim.system.particles.len(),
-            e.sim.system.time,
-            e.sim.system.step,
-            e.sim.dt
+            e.sim().system.particles.len(),
+            e.sim().system.time,
+            e.sim().system.step,
+            e.sim().dt
         ))
     }
 }
