@@ -10,6 +10,7 @@
 use pyo3::prelude::*;
 
 mod convert;
+mod rigid;
 mod simulation;
 mod stepping;
 mod tools;
@@ -35,6 +36,7 @@ fn _mote(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MoteError", py.get_type::<MoteError>())?;
     m.add("UnstableError", py.get_type::<UnstableError>())?;
     m.add_class::<simulation::Simulation>()?;
+    m.add_class::<rigid::RigidSimulation>()?;
     m.add_function(wrap_pyfunction!(tools::run, m)?)?;
     m.add_function(wrap_pyfunction!(tools::pack, m)?)?;
     m.add_function(wrap_pyfunction!(tools::rcp, m)?)?;

@@ -238,3 +238,31 @@ def test_progress_shows_the_opening_line_on_stderr(capfd, tmp_path):
     out = mote.run(LJ, steps=5, progress=True, output=tmp_path)
     assert "mote run <string>" in capfd.readouterr().err
     assert out["ending"] == "finished"
+
+
+def test_rigid_clumps_step_from_python_with_the_bits_of_mote_run(tmp_path):
+    here = __import__("pathlib").Path(__file__).resolve().parents[3]
+    text = (here / "examples/rigid/clumps-settling.toml").read_text().replace("until = 0.5", "steps = 200")
+    text = text.replace("observables_every = 200", "observables_every = 20")
+    sim = mote.RigidSimulation.from_toml(text)
+    seen = []
+    sim.run(callback=lambda s: seen.append(s.steps), every=30)
+    assert sim.steps == 200 and seen[-1] == 200
+    out = mote.run(text, output=tmp_path)
+    assert out["ending"] == "finished", out
+    table = csv_columns(tmp_path / "observables.csv")
+    obs = sim.observables
+    assert np.array_equal(table["time"], obs["time"])
+    assert np.array_equal(table["total_energy"], obs["total"])
+    assert np.array_equal(table["px"], obs["momentum"][:, 0])
+    # Bodies: centres, unit quaternions, spheres with their body.
+    n = len(sim)
+    assert sim.positions.shape == (n, 3) and sim.positions.base is sim
+    q = sim.orientations
+    assert q.shape == (n, 4) and np.allclose((q**2).sum(1), 1.0)
+    spheres = sim.spheres()
+    assert spheres["radii"].shape[0] == spheres["positions"].shape[0] > n
+    assert set(spheres["body"]) == set(range(n))
+    assert (sim.masses > 0).all()
+    with pytest.raises(ValueError, match="not a rigid scene"):
+        mote.RigidSimulation.from_toml(LJ)

@@ -8,6 +8,7 @@ random close packing fractions. See docs/python.md.
 
 from ._mote import (  # noqa: F401
     MoteError,
+    RigidSimulation,
     Simulation,
     UnstableError,
     __version__,
@@ -18,7 +19,7 @@ from ._mote import (  # noqa: F401
     run,
 )
 
-__all__ = ["MoteError", "Simulation", "UnstableError", "pack", "rcp", "rcp_optimise", "render", "run"]
+__all__ = ["MoteError", "RigidSimulation", "Simulation", "UnstableError", "pack", "rcp", "rcp_optimise", "render", "run"]
 
 
 def from_ase(atoms, scene=None, seed=None):

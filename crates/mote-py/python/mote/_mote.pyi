@@ -91,6 +91,51 @@ class Simulation:
         """The observables measured so far: time, kinetic, potential, total,
         rotational, kT, pressure, momentum, angular_momentum, magnetisation."""
 
+class RigidSimulation:
+    """Rigid clumps of overlapping spheres (a scene with ``[rigid]``) stepped
+    by the Fast Rigid Bodies Integrator, on ``mote run``'s schedule."""
+
+    @staticmethod
+    def from_file(path: Path, seed: Optional[int] = None) -> "RigidSimulation": ...
+    @staticmethod
+    def from_toml(text: str, seed: Optional[int] = None, name: str = "<string>") -> "RigidSimulation": ...
+    @staticmethod
+    def from_dict(scene: dict[str, Any], seed: Optional[int] = None) -> "RigidSimulation": ...
+    def step(self, n: int = 1) -> None: ...
+    def run(
+        self,
+        steps: Optional[int] = None,
+        until: Optional[float] = None,
+        callback: Optional[Callable[["RigidSimulation"], Any]] = None,
+        every: int = 100,
+        progress: bool = False,
+    ) -> None: ...
+    @property
+    def time(self) -> float: ...
+    dt: float
+    @property
+    def steps(self) -> int: ...
+    def __len__(self) -> int: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]:
+        """(N, 3) centres of mass, a writable view."""
+    @property
+    def velocities(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def omegas(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def rotations(self) -> npt.NDArray[np.float64]:
+        """(N, 3) rotation vectors r = n tan(φ/2), a writable view."""
+    @property
+    def orientations(self) -> npt.NDArray[np.float64]:
+        """(N, 4) unit quaternions (w, x, y, z), a copy."""
+    @property
+    def masses(self) -> npt.NDArray[np.float64]: ...
+    def spheres(self) -> dict[str, npt.NDArray[Any]]:
+        """positions, velocities, radii and body of every sphere."""
+    @property
+    def observables(self) -> dict[str, npt.NDArray[np.float64]]: ...
+
 def run(
     scene: Union[Path, str, dict[str, Any], None] = None,
     *,

@@ -1,0 +1,303 @@
+//! `mote.RigidSimulation`: a `[rigid]` scene (clumps of overlapping
+//! spheres moved by the FRBI) that Python steps and reads, on `mote run`'s
+//! measurement schedule (see [`crate::stepping`]).
+
+use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard};
+
+use mote_md::rigid::run::{sphere_frame, RigidDynamics, RigidSample};
+use mote_md::rigid::scene::RigidScene;
+use mote_md::{DVec3, MdError, RunLength};
+use numpy::ndarray::ArrayView2;
+use numpy::prelude::*;
+use numpy::{PyArray1, PyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{dict_to_toml, front_error, md_error, parse_error};
+use crate::stepping::{run_loop, HasEngine, Stepped, Stepping};
+
+pub struct RigidEngine {
+    stepping: Stepping<RigidDynamics>,
+    label: String,
+}
+
+impl RigidEngine {
+    fn from_text(text: &str, label: &str, seed: Option<u64>) -> PyResult<Self> {
+        let scene = RigidScene::parse(text, label).map_err(parse_error)?;
+        let built = scene.build(text, label, seed).map_err(parse_error)?;
+        let every = scene.output.observables_every.max(1);
+        let dynamics = RigidDynamics {
+            bodies: built.bodies,
+            frbi: built.frbi,
+            contacts: built.contacts,
+            dt: built.dt,
+            step: 0,
+            last_step: built.steps,
+        };
+        Ok(RigidEngine {
+            stepping: Stepping::new(dynamics, every),
+            label: label.into(),
+        })
+    }
+
+    fn dynamics(&self) -> &RigidDynamics {
+        &self.stepping.state
+    }
+}
+
+impl Stepped for RigidEngine {
+    fn advance(
+        &mut self,
+        n: u64,
+        end_sample: bool,
+        progress: &mut (dyn FnMut(u64, f64) + Send),
+    ) -> Result<(), MdError> {
+        self.stepping.advance(n, end_sample, progress)
+    }
+
+    fn clock(&self) -> (u64, f64, f64) {
+        let d = self.dynamics();
+        (d.step, d.bodies.time, d.dt)
+    }
+
+    fn scene_length(&self) -> PyResult<Option<RunLength>> {
+        // A rigid scene always gives its length (steps or until).
+        Ok(Some(RunLength::Steps(self.dynamics().last_step)))
+    }
+
+    fn describe(&self) -> String {
+        format!("{}: {} bodies", self.label, self.dynamics().bodies.len())
+    }
+}
+
+/// Rigid clumps of overlapping spheres (a scene with `[rigid]`, see
+/// docs/rigid.md) stepped by the Fast Rigid Bodies Integrator.
+///
+/// >>> sim = mote.RigidSimulation.from_file("example:magnet-in-field")
+/// >>> sim.run(steps=1000)
+/// >>> sim.orientations      # unit quaternions (w, x, y, z) of the bodies
+#[pyclass(module = "mote")]
+pub struct RigidSimulation {
+    engine: Mutex<RigidEngine>,
+}
+
+impl HasEngine for RigidSimulation {
+    type Engine = RigidEngine;
+    fn engine(&self) -> PyResult<MutexGuard<'_, RigidEngine>> {
+        crate::stepping::lock(&self.engine)
+    }
+}
+
+fn body_view<'py>(
+    this: &Bound<'py, RigidSimulation>,
+    which: fn(&mote_md::rigid::RigidBodies) -> &[DVec3],
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let s = this.borrow();
+    let e = s.engine()?;
+    let v = which(&e.dynamics().bodies);
+    // SAFETY: DVec3 is three f64 in a row; the bodies' arrays are never
+    // reallocated after the scene is built, and the array keeps `this` alive.
+    let arr = unsafe { ArrayView2::from_shape_ptr((v.len(), 3), v.as_ptr() as *const f64) };
+    Ok(unsafe { PyArray2::borrow_from_array(&arr, this.clone().into_any()) })
+}
+
+#[pymethods]
+impl RigidSimulation {
+    /// A rigid scene file or `example:NAME`; `seed` replaces the scene's.
+    #[staticmethod]
+    #[pyo3(signature = (path, seed=None))]
+    fn from_file(path: PathBuf, seed: Option<u64>) -> PyResult<Self> {
+        let input = mote_front::Input::read(&path.to_string_lossy()).map_err(front_error)?;
+        Self::from_toml(&input.text, seed, &input.label)
+    }
+
+    /// A rigid scene given as TOML text; `name` labels its messages.
+    #[staticmethod]
+    #[pyo3(signature = (text, seed=None, name="<string>"))]
+    fn from_toml(text: &str, seed: Option<u64>, name: &str) -> PyResult<Self> {
+        if mote_front::Engine::of_scene(text) != mote_front::Engine::Rigid {
+            return Err(PyValueError::new_err(format!(
+                "{name}: not a rigid scene (no [rigid] table): use mote.Simulation or mote.run"
+            )));
+        }
+        Ok(RigidSimulation {
+            engine: Mutex::new(RigidEngine::from_text(text, name, seed)?),
+        })
+    }
+
+    /// A rigid scene given as a dict of the scene file's tables and keys.
+    #[staticmethod]
+    #[pyo3(signature = (scene, seed=None))]
+    fn from_dict(scene: &Bound<'_, PyDict>, seed: Option<u64>) -> PyResult<Self> {
+        Self::from_toml(&dict_to_toml(scene)?, seed, "<dict>")
+    }
+
+    /// Advances `n` steps (the GIL is released meanwhile).
+    #[pyo3(signature = (n=1))]
+    fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
+        let mut guard = self.engine()?;
+        let engine = &mut *guard;
+        py.detach(|| engine.advance(n, false, &mut |_, _| {}))
+            .map_err(md_error)
+    }
+
+    /// Runs `steps` steps or until time `until` (the scene's length when
+    /// neither is given), calling `callback(sim)` every `every` steps;
+    /// `progress=True` shows `mote run`'s progress bar.
+    #[pyo3(signature = (steps=None, until=None, callback=None, every=100, progress=false))]
+    fn run(
+        slf: Bound<'_, Self>,
+        steps: Option<u64>,
+        until: Option<f64>,
+        callback: Option<Bound<'_, PyAny>>,
+        every: u64,
+        progress: bool,
+    ) -> PyResult<()> {
+        run_loop(&slf, steps, until, callback, every, progress)
+    }
+
+    /// Simulated time.
+    #[getter]
+    fn time(&self) -> PyResult<f64> {
+        Ok(self.engine()?.dynamics().bodies.time)
+    }
+
+    /// Time step (settable between runs).
+    #[getter]
+    fn dt(&self) -> PyResult<f64> {
+        Ok(self.engine()?.dynamics().dt)
+    }
+
+    #[setter]
+    fn set_dt(&self, dt: f64) -> PyResult<()> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "dt = {dt}: must be positive and finite"
+            )));
+        }
+        self.engine()?.stepping.state.dt = dt;
+        Ok(())
+    }
+
+    /// Steps taken.
+    #[getter]
+    fn steps(&self) -> PyResult<u64> {
+        Ok(self.engine()?.dynamics().step)
+    }
+
+    /// Number of bodies.
+    fn __len__(&self) -> PyResult<usize> {
+        Ok(self.engine()?.dynamics().bodies.len())
+    }
+
+    /// Centres of mass, (N, 3): a writable view of mote's memory.
+    #[getter]
+    fn positions<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        body_view(this, |b| &b.position)
+    }
+
+    /// Velocities of the centres of mass, (N, 3), a writable view.
+    #[getter]
+    fn velocities<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        body_view(this, |b| &b.velocity)
+    }
+
+    /// Angular velocities ω, (N, 3), a writable view.
+    #[getter]
+    fn omegas<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        body_view(this, |b| &b.omega)
+    }
+
+    /// Rotation vectors r = n·tan(φ/2) of the bodies' placements (seed
+    /// 000), (N, 3), a writable view.
+    #[getter]
+    fn rotations<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        body_view(this, |b| &b.rotation)
+    }
+
+    /// Orientations as unit quaternions (w, x, y, z) = (1, r)/√(1 + r²),
+    /// (N, 4) (a copy).
+    #[getter]
+    fn orientations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let e = self.engine()?;
+        let r = &e.dynamics().bodies.rotation;
+        let flat: Vec<f64> = r
+            .iter()
+            .flat_map(|r| {
+                let c = 1.0 / (1.0 + r.length_squared()).sqrt();
+                [c, r.x * c, r.y * c, r.z * c]
+            })
+            .collect();
+        PyArray1::from_vec(py, flat).reshape([r.len(), 4])
+    }
+
+    /// Masses of the bodies, (N,) (a copy: they belong to the templates).
+    #[getter]
+    fn masses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let e = self.engine()?;
+        let b = &e.dynamics().bodies;
+        Ok(PyArray1::from_vec(
+            py,
+            (0..b.len()).map(|i| b.template(i).mass()).collect(),
+        ))
+    }
+
+    /// The spheres in the world: dict of positions (M, 3), velocities
+    /// (M, 3), radii (M,), body (M,) index of the body of each.
+    fn spheres<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let f = sphere_frame(&self.engine()?.dynamics().bodies);
+        let m = f.positions.len();
+        let flat = |v: &[[f64; 3]]| v.iter().flat_map(|x| *x).collect::<Vec<f64>>();
+        let d = PyDict::new(py);
+        d.set_item(
+            "positions",
+            PyArray1::from_vec(py, flat(&f.positions)).reshape([m, 3])?,
+        )?;
+        d.set_item(
+            "velocities",
+            PyArray1::from_vec(py, flat(&f.velocities)).reshape([m, 3])?,
+        )?;
+        d.set_item("radii", PyArray1::from_vec(py, f.radii))?;
+        d.set_item("body", PyArray1::from_vec(py, f.bodies))?;
+        Ok(d)
+    }
+
+    /// The observables measured so far (the columns of `mote run`'s
+    /// observables.csv): time, kinetic, translational, rotational,
+    /// potential, total (n,), momentum, angular_momentum (n, 3).
+    #[getter]
+    fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let guard = self.engine()?;
+        let s = &guard.stepping.samples;
+        let d = PyDict::new(py);
+        let col = |f: fn(&RigidSample) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
+        let vec3 = |f: fn(&RigidSample) -> DVec3| {
+            let flat: Vec<f64> = s.iter().flat_map(|o| f(o).to_array()).collect();
+            PyArray1::from_vec(py, flat).reshape([s.len(), 3])
+        };
+        d.set_item("time", col(|o| o.time))?;
+        d.set_item("kinetic", col(|o| o.kinetic_energy()))?;
+        d.set_item("translational", col(|o| o.translational_energy))?;
+        d.set_item("rotational", col(|o| o.rotational_energy))?;
+        d.set_item("potential", col(|o| o.potential_energy))?;
+        d.set_item("total", col(|o| o.kinetic_energy() + o.potential_energy))?;
+        d.set_item("momentum", vec3(|o| o.linear_momentum)?)?;
+        d.set_item("angular_momentum", vec3(|o| o.angular_momentum)?)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let e = self.engine()?;
+        let d = e.dynamics();
+        Ok(format!(
+            "<mote.RigidSimulation {}: {} bodies, t = {}, step {}, dt = {}>",
+            e.label,
+            d.bodies.len(),
+            d.bodies.time,
+            d.step,
+            d.dt
+        ))
+    }
+}
