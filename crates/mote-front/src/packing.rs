@@ -621,12 +621,25 @@ pub(crate) fn run(
         picture: options.picture.clone(),
         resume: None,
     };
-    let provenance = crate::provenance(&input.label, seed);
+    packed_outcome(&input.label, seed, spec, settings, &files, dir, monitor)
+}
+
+/// Packs and says what `mote run` says of it.
+fn packed_outcome(
+    label: &str,
+    seed: u64,
+    spec: &PackingSpec,
+    settings: PackSettings,
+    files: &PackFiles,
+    dir: PathBuf,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    let provenance = crate::provenance(label, seed);
     let packed = pack(
         spec.dimension,
         settings,
         spec.tol,
-        &files,
+        files,
         &provenance,
         monitor,
     )?;
@@ -701,20 +714,5 @@ pub(crate) fn resume(
         }),
         resume: Some(cp.clone()),
     };
-    let provenance = crate::provenance(&cp.input_label, seed);
-    let packed = pack(
-        spec.dimension,
-        settings,
-        spec.tol,
-        &files,
-        &provenance,
-        monitor,
-    )?;
-    Ok(Outcome {
-        engine: Engine::Packing,
-        seed,
-        dir,
-        summary: packed.summary,
-        ending: packed.ending,
-    })
+    packed_outcome(&cp.input_label, seed, spec, settings, &files, dir, monitor)
 }

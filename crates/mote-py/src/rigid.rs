@@ -172,12 +172,7 @@ impl RigidSimulation {
 
     #[setter]
     fn set_dt(&self, dt: f64) -> PyResult<()> {
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(PyValueError::new_err(format!(
-                "dt = {dt}: must be positive and finite"
-            )));
-        }
-        self.engine()?.stepping.state.dt = dt;
+        self.engine()?.stepping.state.dt = crate::stepping::checked_dt(dt)?;
         Ok(())
     }
 

@@ -308,12 +308,7 @@ impl Simulation {
 
     #[setter]
     fn set_dt(&self, dt: f64) -> PyResult<()> {
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(PyValueError::new_err(format!(
-                "dt = {dt}: must be positive and finite"
-            )));
-        }
-        self.engine()?.sim_mut().dt = dt;
+        self.engine()?.sim_mut().dt = crate::stepping::checked_dt(dt)?;
         Ok(())
     }
 

@@ -190,3 +190,14 @@ pub fn lock<E>(engine: &Mutex<E>) -> PyResult<MutexGuard<'_, E>> {
         )),
     }
 }
+
+/// A time step a run can take: positive and finite.
+pub fn checked_dt(dt: f64) -> PyResult<f64> {
+    if dt > 0.0 && dt.is_finite() {
+        Ok(dt)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "dt = {dt}: must be positive and finite"
+        )))
+    }
+}
