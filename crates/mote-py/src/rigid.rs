@@ -28,16 +28,8 @@ impl RigidEngine {
         let scene = RigidScene::parse(text, label).map_err(parse_error)?;
         let built = scene.build(text, label, seed).map_err(parse_error)?;
         let every = scene.output.observables_every.max(1);
-        let dynamics = RigidDynamics {
-            bodies: built.bodies,
-            frbi: built.frbi,
-            contacts: built.contacts,
-            dt: built.dt,
-            step: 0,
-            last_step: built.steps,
-        };
         Ok(RigidEngine {
-            stepping: Stepping::new(dynamics, every),
+            stepping: Stepping::new(RigidDynamics::new(built), every),
             label: label.into(),
         })
     }

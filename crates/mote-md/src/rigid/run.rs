@@ -57,6 +57,20 @@ pub struct RigidDynamics {
     pub last_step: u64,
 }
 
+impl RigidDynamics {
+    /// The bodies and integrator a scene built, before their first step.
+    pub fn new(built: super::scene::BuiltRigid) -> Self {
+        RigidDynamics {
+            bodies: built.bodies,
+            frbi: built.frbi,
+            contacts: built.contacts,
+            dt: built.dt,
+            step: 0,
+            last_step: built.steps,
+        }
+    }
+}
+
 /// The observables of the bodies at one instant.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RigidSample {
@@ -428,18 +442,11 @@ pub fn run_rigid_scene(
     }
     driver.checkpoints = options.checkpoints.clone();
     driver.sample_at_start = !append;
-    let mut dynamics = RigidDynamics {
-        bodies: built.bodies,
-        frbi: built.frbi,
-        contacts: built.contacts,
-        dt: built.dt,
-        step: 0,
-        last_step: built.steps,
-    };
+    let (seed, dt, last_step) = (built.seed, built.dt, built.steps);
+    let mut dynamics = RigidDynamics::new(built);
     if let Some(cp) = &options.resume {
         dynamics.resume(cp, file_label)?;
     }
-    let last_step = built.steps;
     let report = driver.run(
         &mut dynamics,
         |_| last_step,
@@ -459,8 +466,8 @@ pub fn run_rigid_scene(
         angular_momentum: last.angular_momentum,
         wall_forces: last.wall_forces,
         files: report.files.iter().map(PathBuf::from).collect(),
-        seed: built.seed,
-        dt: built.dt,
+        seed,
+        dt,
         final_frame: sphere_frame(b),
     })
 }
