@@ -21,6 +21,9 @@ use crate::stepping::{run_loop, HasEngine, Stepped, Stepping};
 pub struct RigidEngine {
     stepping: Stepping<RigidDynamics>,
     label: String,
+    /// The scene text and seed, for checkpoints.
+    text: String,
+    seed: u64,
 }
 
 impl RigidEngine {
@@ -28,9 +31,12 @@ impl RigidEngine {
         let scene = RigidScene::parse(text, label).map_err(parse_error)?;
         let built = scene.build(text, label, seed).map_err(parse_error)?;
         let every = scene.output.observables_every.max(1);
+        let seed = built.seed;
         Ok(RigidEngine {
             stepping: Stepping::new(RigidDynamics::new(built), every),
             label: label.into(),
+            text: text.into(),
+            seed,
         })
     }
 
@@ -124,6 +130,52 @@ impl RigidSimulation {
     #[pyo3(signature = (scene, seed=None))]
     fn from_dict(scene: &Bound<'_, PyDict>, seed: Option<u64>) -> PyResult<Self> {
         Self::from_toml(&dict_to_toml(scene)?, seed, "<dict>")
+    }
+
+    /// The rigid simulation a checkpoint (`save_checkpoint`) holds: bodies,
+    /// spins and contact histories, ready to go on bit for bit.
+    #[staticmethod]
+    fn resume(path: PathBuf) -> PyResult<Self> {
+        let cp =
+            mote_io::checkpoint::read(&path).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        if cp.option("engine") != Some("rigid") {
+            return Err(PyValueError::new_err(format!(
+                "{}: not a checkpoint of a rigid run",
+                path.display()
+            )));
+        }
+        let mut engine = RigidEngine::from_text(&cp.input_text, &cp.input_label, Some(cp.seed))?;
+        let state = &mut engine.stepping.state;
+        if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
+            state.dt = dt;
+        }
+        state.resume(&cp, &cp.input_label).map_err(md_error)?;
+        // The checkpoint's run already measured its start.
+        engine.stepping.primed = true;
+        Ok(RigidSimulation {
+            engine: Mutex::new(engine),
+        })
+    }
+
+    /// Writes a checkpoint that `RigidSimulation.resume` continues bit for bit.
+    fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
+        let mut guard = self.engine()?;
+        let e = &mut *guard;
+        e.stepping.prepare().map_err(md_error)?;
+        let mut cp = mote_io::checkpoint::Checkpoint {
+            program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
+            seed: e.seed,
+            options: vec![
+                ("engine".into(), "rigid".into()),
+                ("name".into(), "python".into()),
+                ("output".into(), ".".into()),
+            ],
+            input_label: e.label.clone(),
+            input_text: e.text.clone(),
+            ..Default::default()
+        };
+        mote_run::Propagator::save(&mut e.stepping.state, &mut cp).map_err(md_error)?;
+        mote_io::checkpoint::write(&path, &cp).map_err(|e| crate::MoteError::new_err(e.to_string()))
     }
 
     /// Advances `n` steps (the GIL is released meanwhile).

@@ -266,6 +266,14 @@ def test_rigid_clumps_step_from_python_with_the_bits_of_mote_run(tmp_path):
     assert (sim.masses > 0).all()
     with pytest.raises(ValueError, match="not a rigid scene"):
         mote.RigidSimulation.from_toml(LJ)
+    # Checkpoints: bodies, spins and contact histories, bit for bit.
+    sim.save_checkpoint(tmp_path / "r.mote")
+    sim.step(40)
+    again = mote.RigidSimulation.resume(tmp_path / "r.mote")
+    assert again.steps == 200
+    again.step(40)
+    assert np.array_equal(sim.positions, again.positions)
+    assert np.array_equal(sim.rotations, again.rotations)
 
 
 def test_pack_gives_the_packing_of_a_packing_scene(tmp_path):

@@ -170,7 +170,7 @@ impl Propagator for RigidDynamics {
 
 impl RigidDynamics {
     /// Puts a checkpoint's state into freshly built bodies and integrator.
-    fn resume(&mut self, cp: &Checkpoint, label: &str) -> Result<(), MdError> {
+    pub fn resume(&mut self, cp: &Checkpoint, label: &str) -> Result<(), MdError> {
         let b = &mut self.bodies;
         let n = b.len();
         if cp.positions.len() != n || cp.velocities.len() != n || cp.angular.len() != n {
