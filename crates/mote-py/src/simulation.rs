@@ -172,6 +172,42 @@ fn view1<'py>(
     Ok(unsafe { PyArray1::borrow_from_array(&arr, this.clone().into_any()) })
 }
 
+/// Copies an (N, 3) array of floats into `target`, or says the shape it
+/// needs.
+fn copy_in(values: &Bound<'_, PyAny>, target: &mut [DVec3], what: &str) -> PyResult<()> {
+    let n = target.len();
+    let wrong = |got: &str| {
+        PyValueError::new_err(format!(
+            "{what}: expected an array of shape ({n}, 3), got {got}"
+        ))
+    };
+    // Lists and other sequences become arrays first, as numpy would take them.
+    let numpy = values.py().import("numpy")?;
+    let converted = numpy
+        .call_method1("asarray", (values, "float64"))
+        .map_err(|_| wrong("something that is not an array of numbers"))?;
+    let array = converted
+        .extract::<numpy::PyReadonlyArray2<f64>>()
+        .map_err(|_| {
+            wrong(&format!(
+                "{} dimensions",
+                converted
+                    .getattr("ndim")
+                    .map(|d| d.to_string())
+                    .unwrap_or_default()
+            ))
+        })?;
+    let shape = array.shape();
+    if shape != [n, 3] {
+        return Err(wrong(&format!("shape {shape:?}")));
+    }
+    let a = array.as_array();
+    for (i, t) in target.iter_mut().enumerate() {
+        *t = DVec3::new(a[[i, 0]], a[[i, 1]], a[[i, 2]]);
+    }
+    Ok(())
+}
+
 #[pymethods]
 impl Simulation {
     /// A scene file or `example:NAME`; `seed` replaces the scene's.
@@ -332,6 +368,28 @@ impl Simulation {
     #[getter]
     fn positions<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         view(this, |p| &p.position)
+    }
+
+    /// `sim.positions = array`: copies an (N, 3) array in.
+    #[setter]
+    fn set_positions(&self, values: Bound<'_, PyAny>) -> PyResult<()> {
+        let mut e = self.engine()?;
+        copy_in(
+            &values,
+            &mut e.sim_mut().system.particles.position,
+            "positions",
+        )
+    }
+
+    /// `sim.velocities = array`: copies an (N, 3) array in.
+    #[setter]
+    fn set_velocities(&self, values: Bound<'_, PyAny>) -> PyResult<()> {
+        let mut e = self.engine()?;
+        copy_in(
+            &values,
+            &mut e.sim_mut().system.particles.velocity,
+            "velocities",
+        )
     }
 
     /// Velocities, (N, 3), a writable view.

@@ -97,6 +97,15 @@ def test_views_are_mote_memory_and_writes_reach_the_next_step():
     sim.step(4)
     assert np.array_equal(sim.positions[0], [14.0, 10.0, 8.0])
     assert sim.time == pytest.approx(2.5)
+    # Whole arrays assigned are copied in; a wrong shape says the right one.
+    sim.positions = np.zeros((1, 3))
+    sim.velocities = [[0.0, 0.0, 1.0]]
+    sim.step(4)
+    assert np.array_equal(sim.positions[0], [0.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match=r"expected an array of shape \(1, 3\), got shape \[2, 3\]"):
+        sim.positions = np.zeros((2, 3))
+    with pytest.raises(ValueError, match=r"shape \(1, 3\)"):
+        sim.velocities = "fast"
 
 
 def test_the_gil_is_released_while_mote_computes():

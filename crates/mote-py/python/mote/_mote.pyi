@@ -59,12 +59,11 @@ class Simulation:
     def seed(self) -> int:
         """The seed of the run's random numbers."""
     def __len__(self) -> int: ...
-    @property
-    def positions(self) -> npt.NDArray[np.float64]:
-        """(N, 3) view of mote's memory; writes reach the next step."""
-    @property
-    def velocities(self) -> npt.NDArray[np.float64]:
-        """(N, 3) writable view."""
+    positions: npt.NDArray[np.float64]
+    """(N, 3) view of mote's memory; writes reach the next step; assigning
+    an (N, 3) array copies it in (another shape raises ValueError)."""
+    velocities: npt.NDArray[np.float64]
+    """(N, 3) writable view; assignable like ``positions``."""
     @property
     def omegas(self) -> npt.NDArray[np.float64]:
         """(N, 3) angular velocities, writable view."""
