@@ -197,3 +197,96 @@ fn mdanalysis_files_start_a_scene() {
     assert_eq!(sys.particles.position, want);
     assert_eq!(sys.species, ["Ar", "Fe", "Ar"]);
 }
+
+/// `replicate = [nx, ny, nz]`: copies of a periodic frame shifted by
+/// whole box lengths. The copies join without a seam, so a Lennard-Jones
+/// liquid replicated 2 × 3 × 2 has the same potential energy per particle
+/// as the original to rounding (every pair distance of the copy is one of
+/// the original's images); an axis that is not periodic, no box, or zero
+/// copies are refused at the scene's line.
+#[test]
+fn replicate_copies_a_periodic_frame_without_a_seam() {
+    use rand::{Rng, SeedableRng};
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(5);
+    // 64 atoms at density 0.3 in a 5.97³ box (≥ 2 (cutoff + skin)), kept
+    // apart by rejection so no pair is closer than 0.9 σ.
+    let l = (64.0f64 / 0.3).cbrt();
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    while positions.len() < 64 {
+        let x = [
+            rng.gen::<f64>() * l,
+            rng.gen::<f64>() * l,
+            rng.gen::<f64>() * l,
+        ];
+        let close = positions.iter().any(|y| {
+            let d2: f64 = (0..3)
+                .map(|k| {
+                    let d = x[k] - y[k];
+                    let d = d - l * (d / l).round();
+                    d * d
+                })
+                .sum();
+            d2 < 0.81
+        });
+        if !close {
+            positions.push(x);
+        }
+    }
+    let n = positions.len();
+    let frame = Frame {
+        cell: [[l, 0.0, 0.0], [0.0, l, 0.0], [0.0, 0.0, l]],
+        pbc: [true, true, false],
+        species: vec!["Ar".into(); n],
+        velocities: vec![[0.0; 3]; n],
+        masses: vec![1.0; n],
+        positions,
+        ..Frame::default()
+    };
+    let path = dir.path().join("liquid.xyz");
+    let mut w = TrajectoryWriter::create(&path, Format::Xyz, Provenance::default(), true).unwrap();
+    w.write(0, &frame).unwrap();
+    drop(w);
+    let energy = |replicate: &str| {
+        let label = dir.path().join("scene.toml");
+        let label = label.to_str().unwrap();
+        let text = format!(
+            "{RUN}[lennard_jones]\ncutoff = 2.5\n[[from_file]]\nfile = \"liquid.xyz\"\n{replicate}"
+        );
+        let scene = Scene::parse(&text, label).map_err(|e| e.to_string())?;
+        let mut sim = scene
+            .build(&text, label, 1)
+            .map_err(|e| e.to_string())?
+            .simulation;
+        let sys = &sim.system;
+        let state = mote_md::force::State::of(
+            sys,
+            &sys.particles.position,
+            &sys.particles.velocity,
+            0.0,
+            0.0,
+        );
+        let (u, _) = sim.forces.potential_energy(&state);
+        Ok::<_, String>((u / sys.particles.len() as f64, sys.clone()))
+    };
+    let (u1, one) = energy("").unwrap();
+    let (u6, six) = energy("replicate = [2, 3, 1]\n").unwrap();
+    assert_eq!(six.particles.len(), 6 * n);
+    assert_eq!(six.boundary.lo, one.boundary.lo);
+    assert_eq!(six.boundary.hi, DVec3::new(2.0 * l, 3.0 * l, l));
+    assert_eq!(six.boundary.periodic, [true, true, false]);
+    // Copy (i, j) = (1, 2) is the fifth block of n: shifted by (L, 2L, 0).
+    assert_eq!(
+        six.particles.position[5 * n + 7],
+        one.particles.position[7] + DVec3::new(l, 2.0 * l, 0.0)
+    );
+    assert_eq!(six.species[5 * n], "Ar");
+    assert!(u1 < 0.0 && ((u6 - u1) / u1).abs() < 1e-12, "{u1} {u6}");
+    let e = energy("replicate = [1, 1, 2]\n").unwrap_err();
+    assert!(
+        e.contains("scene.toml:6:") && e.contains("not periodic along z"),
+        "{e}"
+    );
+    let e = energy("replicate = [0, 1, 1]\n").unwrap_err();
+    assert!(e.contains("at least one copy"), "{e}");
+}

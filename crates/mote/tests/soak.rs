@@ -24,21 +24,39 @@ fn resident(pid: u32) -> Option<u64> {
     Some(kib * 1024)
 }
 
-fn soak(scene: &str, particles: u64) {
+/// Soaks `scene` (in bench/), first running `bed` (in bench/, when given)
+/// into `soak-bed/` beside a copy of the scene, whose `[[from_file]]`
+/// starts from that bed's last frame.
+fn soak(scene: &str, particles: u64, bed: Option<&str>) {
     let seconds: u64 = std::env::var("MOTE_SOAK_SECONDS")
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(3600);
     let threads = std::env::var("MOTE_SOAK_THREADS").unwrap_or_else(|_| "1".into());
     let out = tempfile::tempdir().unwrap();
-    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../bench")
-        .join(scene);
+    let bench = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../bench");
+    let scene = out.path().join(scene);
+    std::fs::copy(bench.join(scene.file_name().unwrap()), &scene).unwrap();
+    if let Some(bed) = bed {
+        let made = Command::new(env!("CARGO_BIN_EXE_mote"))
+            .args(["-q", "--threads", &threads, "run"])
+            .arg(bench.join(bed))
+            .arg("-o")
+            .arg(out.path().join("soak-bed"))
+            .output()
+            .unwrap();
+        assert!(
+            made.status.success(),
+            "{bed}: {}",
+            String::from_utf8_lossy(&made.stderr)
+        );
+    }
+    let run = out.path().join("run");
     let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
         .args(["-q", "--threads", &threads, "run"])
         .arg(&scene)
         .arg("-o")
-        .arg(out.path())
+        .arg(&run)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -73,7 +91,7 @@ fn soak(scene: &str, particles: u64) {
         "SIGTERM must end the run cleanly: {}",
         String::from_utf8_lossy(&status.stderr)
     );
-    let rows = std::fs::read_to_string(out.path().join("observables.csv"))
+    let rows = std::fs::read_to_string(run.join("observables.csv"))
         .unwrap()
         .lines()
         .filter(|l| !l.starts_with('#'))
@@ -113,11 +131,11 @@ fn soak(scene: &str, particles: u64) {
 #[test]
 #[ignore = "an hour: the 10^6-atom LJ soak"]
 fn lennard_jones_million_soak() {
-    soak("soak-lj.toml", 1_000_188);
+    soak("soak-lj.toml", 1_000_188, None);
 }
 
 #[test]
 #[ignore = "an hour: the 10^6-sphere granular soak"]
 fn granular_million_soak() {
-    soak("soak-granular.toml", 1_000_000);
+    soak("soak-granular.toml", 1_000_000, Some("soak-bed.toml"));
 }

@@ -233,6 +233,9 @@ pub struct DataSpec {
     pub frame: Option<i64>,
     /// Take a data file's box, periodic on these axes.
     pub periodic: Option<[bool; 3]>,
+    /// Copies of the file's periodic box along x, y, z (LAMMPS'
+    /// `replicate`): a settled bed or an equilibrated liquid made large.
+    pub replicate: Option<[usize; 3]>,
     /// The atom style of a data file whose `Atoms` line names none
     /// (MDAnalysis writes none): atomic, charge, molecular, full, sphere.
     pub atom_style: Option<String>,
@@ -405,6 +408,60 @@ fn from_file(
         })
         .collect();
     Ok((out, names, boundary))
+}
+
+/// LAMMPS' `replicate`: the particles copied `copies` times along the
+/// axes of their periodic box, each copy shifted by whole box lengths,
+/// x' = x + (i Lx, j Ly, k Lz); the box grows to hold them. An axis copied
+/// more than once must be periodic, so the copies join without a seam.
+fn replicate(
+    made: &mut Vec<ParticleInit>,
+    names: &mut Vec<String>,
+    file_box: Option<crate::boundary::Boundary>,
+    copies: [usize; 3],
+) -> Result<crate::boundary::Boundary, String> {
+    const AXES: [&str; 3] = ["x", "y", "z"];
+    if copies.contains(&0) {
+        return Err(format!(
+            "replicate = {copies:?} needs at least one copy along every axis"
+        ));
+    }
+    let Some(b) = file_box else {
+        return Err("replicate needs the file's box: a trajectory frame with periodic axes, or a data file with periodic = [..]".into());
+    };
+    for k in 0..3 {
+        if copies[k] > 1 && !b.periodic[k] {
+            return Err(format!(
+                "replicate copies along {0} but the file's box is not periodic along {0}",
+                AXES[k]
+            ));
+        }
+    }
+    let total = made.len() as f64 * copies.iter().map(|&c| c as f64).product::<f64>();
+    mote_io::system::check_fits(
+        &format!("replicate = {copies:?} makes {total:.0} particles, which"),
+        total * BYTES_PER_PARTICLE,
+    )?;
+    let l = b.lengths();
+    let (one, one_names) = (std::mem::take(made), std::mem::take(names));
+    for i in 0..copies[0] {
+        for j in 0..copies[1] {
+            for k in 0..copies[2] {
+                let shift = DVec3::new(i as f64 * l.x, j as f64 * l.y, k as f64 * l.z);
+                made.extend(one.iter().map(|p| ParticleInit {
+                    position: p.position + shift,
+                    ..p.clone()
+                }));
+                names.extend(one_names.iter().cloned());
+            }
+        }
+    }
+    let n = DVec3::new(copies[0] as f64, copies[1] as f64, copies[2] as f64);
+    Ok(crate::boundary::Boundary {
+        lo: b.lo,
+        hi: b.lo + l * n,
+        periodic: b.periodic,
+    })
 }
 
 /// `[[fcc]]`: a face-centred cubic crystal at a number density, with
@@ -797,7 +854,12 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
             .unwrap_or(std::path::Path::new("."))
             .join(&s.file);
         let at = |m: String| err(spec.span(), m);
-        let (made, names, file_box) = from_file(s, &path, data, &at)?;
+        let (mut made, mut names, mut file_box) = from_file(s, &path, data, &at)?;
+        if let Some(copies) = s.replicate {
+            let b = replicate(&mut made, &mut names, file_box, copies)
+                .map_err(|m| at(format!("{}: {m}", path.display())))?;
+            file_box = Some(b);
+        }
         if fcc_box.is_none() {
             fcc_box = file_box;
         }
