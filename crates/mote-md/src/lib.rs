@@ -23,6 +23,7 @@ pub mod particles;
 pub mod rigid;
 pub mod scene;
 pub mod simulation;
+pub mod soft_pack;
 pub mod thermostat;
 pub mod tree;
 pub mod units;

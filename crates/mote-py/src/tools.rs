@@ -100,7 +100,7 @@ pub fn run<'py>(
 /// radii (N,), box (D,), phi, pressure, summary (lines). `output` also
 /// writes it (format by extension) with its CSV of windows.
 #[pyfunction]
-#[pyo3(signature = (n=1000, *, dimension=3, dist="mono", rate=0.01, max_pressure=1e12, phi=None, walls="", jam=true, seed=None, start=None, output=None))]
+#[pyo3(signature = (n=1000, *, dimension=3, dist="mono", rate=0.01, max_pressure=1e12, phi=None, walls="", jam=true, seed=None, start=None, output=None, method="hard", min_pressure=1e-7))]
 #[allow(clippy::too_many_arguments)]
 pub fn pack<'py>(
     py: Python<'py>,
@@ -115,6 +115,8 @@ pub fn pack<'py>(
     seed: Option<u64>,
     start: Option<String>,
     output: Option<PathBuf>,
+    method: &str,
+    min_pressure: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use mote_front::packing::{pack, Naming, PackFiles, PackingSpec};
     let spec = PackingSpec {
@@ -127,12 +129,15 @@ pub fn pack<'py>(
         walls: walls.into(),
         jam,
         start,
+        method: method.into(),
+        min_pressure,
         ..PackingSpec::default()
     };
     let (seed, _) = mote_front::seed::resolve(seed, None);
     let settings = spec
         .settings(seed, Naming::Options, std::path::Path::new("."))
         .map_err(front_error)?;
+    let method = spec.method(Naming::Options).map_err(front_error)?;
     let provenance = mote_io::Provenance {
         program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
         scene: format!("mote.pack(n={n}, dist={dist:?}, rate={rate})"),
@@ -146,6 +151,7 @@ pub fn pack<'py>(
         .detach(|| {
             pack(
                 dimension,
+                method,
                 settings,
                 None,
                 &files,

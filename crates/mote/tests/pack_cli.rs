@@ -472,3 +472,94 @@ fn a_packing_grows_from_a_file() {
         "{err}"
     );
 }
+
+/// `--method soft` (the SP method): the barostat's stages, the jamming
+/// finish and both extrapolations in the summary, the packing and its CSV
+/// written, the same run as a `[packing]` scene; what it cannot do is
+/// refused with the rule.
+#[test]
+fn the_soft_method_packs_and_says_what_it_found() {
+    let dir = tempfile::tempdir().unwrap();
+    let xyz = dir.path().join("soft.xyz");
+    let out = mote()
+        .args(["--seed", "4", "pack", "--method", "soft", "-n", "400", "-o"])
+        .arg(&xyz)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for needle in [
+        "400 spheres by the soft (SP) method",
+        "Barostat extrapolated to zero pressure",
+        "Jamming finish",
+        "Finish extrapolated to zero pressure: phi_J = 0.6",
+        "(isostatic 6)",
+    ] {
+        assert!(text.contains(needle), "{needle}: {text}");
+    }
+    let frames = mote_io::trajectory::read_frames(&xyz).unwrap();
+    assert_eq!(frames[0].radii.len(), 400);
+    let csv = std::fs::read_to_string(dir.path().join("soft.csv")).unwrap();
+    assert!(csv.contains("steps,phi,pressure,minimised"), "{csv}");
+    // The same packing from a scene under `mote run`.
+    std::fs::write(
+        dir.path().join("soft.toml"),
+        "seed = 4\n[packing]\nmethod = \"soft\"\nn = 400\n",
+    )
+    .unwrap();
+    let run = mote()
+        .arg("run")
+        .arg(dir.path().join("soft.toml"))
+        .arg("-o")
+        .arg(dir.path().join("run"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let again = mote_io::trajectory::read_frames(&dir.path().join("run/packing.xyz")).unwrap();
+    assert_eq!(again[0].positions, frames[0].positions);
+    for (args, why) in [
+        (
+            &["--method", "squishy"][..],
+            "--method squishy: use hard or soft",
+        ),
+        (
+            &["--method", "soft", "--dim", "2"][..],
+            "packs spheres (dimension 3)",
+        ),
+        (
+            &["--method", "soft", "--walls", "z"][..],
+            "periodic box (no walls)",
+        ),
+        (
+            &["--method", "soft", "--min-pressure", "0"][..],
+            "must lie in [1e-12, 1e-2]",
+        ),
+    ] {
+        let out = mote().arg("pack").args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(why),
+            "{args:?}: {err}"
+        );
+    }
+    std::fs::write(
+        dir.path().join("bad.toml"),
+        "[packing]\nmethod = \"soft\"\nn = 400\nwalls = \"x\"\n",
+    )
+    .unwrap();
+    let out = mote()
+        .arg("run")
+        .arg(dir.path().join("bad.toml"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.toml:4: [packing] walls = \"x\""), "{err}");
+}

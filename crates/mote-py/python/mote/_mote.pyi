@@ -168,9 +168,12 @@ def pack(
     seed: Optional[int] = None,
     start: Optional[str] = None,
     output: Optional[Path] = None,
+    method: str = "hard",
+    min_pressure: float = 1e-7,
 ) -> dict[str, Any]:
-    """A packing by growing hard spheres; returns positions, radii, box, phi,
-    pressure, seed and summary."""
+    """A packing by growing hard spheres (method="hard") or by soft spheres
+    under a barostat (method="soft", phi extrapolated to zero pressure);
+    returns positions, radii, box, phi, pressure, seed and summary."""
 
 def rcp(
     *,

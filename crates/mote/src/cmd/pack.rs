@@ -39,6 +39,17 @@ pub struct PackArgs {
     /// fraction of the large), lognormal:SIGMA, or file:PATH (one radius per line).
     #[arg(long, default_value = "mono")]
     dist: String,
+    /// `hard`: grow hard spheres (Lubachevsky–Stillinger, event-driven);
+    /// `soft`: the SP method, Hertzian spheres under a barostat stepped
+    /// down to --min-pressure, φ extrapolated to zero pressure (3-D,
+    /// periodic).
+    #[arg(long, default_value = "hard", value_name = "hard|soft")]
+    method: String,
+    /// Soft method: the lowest pressure P/K (K = 4E*/3): the barostat
+    /// holds 1e-2 … 1e-4, then the jamming finish (energy minimisation)
+    /// decompresses a decade at a time to this.
+    #[arg(long, default_value_t = 1e-7, value_name = "P")]
+    min_pressure: f64,
     /// Growth rate Γ = (1/v_th) d⟨d⟩/dt (smaller: denser, slower).
     #[arg(long, default_value_t = 0.01)]
     rate: f64,
@@ -157,6 +168,8 @@ impl PackArgs {
             phi_start: self.phi_start,
             tol: self.tol,
             start: self.start.clone(),
+            method: self.method.clone(),
+            min_pressure: self.min_pressure,
         }
     }
 }
@@ -168,17 +181,23 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     let spec = a.spec();
     let (seed, chosen) = mote_front::seed::resolve(global.seed, None);
     let settings = spec.settings(seed, Naming::Options, Path::new("."))?;
+    let method = spec.method(Naming::Options)?;
     let start = match &a.start {
         Some(file) => format!("--start {file}"),
         None => format!("--n {} --dist {}", a.n, a.dist),
     };
-    let label = format!(
-        "mote pack --dim {} {start} --rate {} --max-pressure {:e}{}",
-        a.dim,
-        a.rate,
-        a.max_pressure,
-        if a.no_jam { " --no-jam" } else { "" }
-    );
+    let label = match method {
+        mote_front::packing::Method::Hard => format!(
+            "mote pack --dim {} {start} --rate {} --max-pressure {:e}{}",
+            a.dim,
+            a.rate,
+            a.max_pressure,
+            if a.no_jam { " --no-jam" } else { "" }
+        ),
+        mote_front::packing::Method::Soft { min_pressure } => {
+            format!("mote pack {start} --method soft --min-pressure {min_pressure:e}")
+        }
+    };
     let mut terminal = Terminal::new(quiet);
     terminal.start(&format!(
         "mote pack: {label}, seed {seed}{}",
@@ -219,6 +238,7 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     };
     let packed = mote_front::packing::pack(
         spec.dimension,
+        method,
         settings,
         spec.tol,
         &files,
