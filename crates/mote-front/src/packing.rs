@@ -460,7 +460,7 @@ fn pack_soft(
         seed: settings.seed,
     })
     .map_err(FrontError::request)?;
-    let stem = files.xyz.as_ref().map(|p| p.with_extension(""));
+    let stem = files.xyz.as_ref().map(|p| Stem(p.with_extension("")));
     if let Some(dir) = files.xyz.as_ref().and_then(|p| p.parent()) {
         if !dir.as_os_str().is_empty() {
             std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
@@ -468,7 +468,7 @@ fn pack_soft(
     }
     let mut csv = match &stem {
         Some(s) => Some(mote_io::csv::CsvWriter::create(
-            &s.with_extension("csv"),
+            &s.with("csv"),
             provenance,
             &["steps", "phi", "pressure", "minimised"].map(String::from),
             &["", "", "K", ""].map(String::from),
@@ -556,7 +556,7 @@ fn pack_soft(
         use mote_io::trajectory::{Format, TrajectoryWriter};
         let format = Format::of_path(path).unwrap_or_default();
         TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, &frame)?;
-        write_pov(&frame, &s.with_extension("pov"))?;
+        write_pov(&frame, &s.with("pov"))?;
     }
     if let Some(p) = &files.picture {
         mote_render::frame::picture(&frame, p, 800, 800)?;
@@ -652,7 +652,7 @@ fn pack_dim<const D: usize>(
         Some(cp) => Packer::<D>::resume(settings, &PackState::from_checkpoint(cp, D)?)?,
         None => Packer::<D>::new(settings)?,
     };
-    let stem = files.xyz.as_ref().map(|p| p.with_extension(""));
+    let stem = files.xyz.as_ref().map(|p| Stem(p.with_extension("")));
     if let Some(dir) = files.xyz.as_ref().and_then(|p| p.parent()) {
         if !dir.as_os_str().is_empty() {
             std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
@@ -660,12 +660,12 @@ fn pack_dim<const D: usize>(
     }
     let mut csv = match (&stem, &files.resume) {
         (Some(s), Some(cp)) => {
-            let path = s.with_extension("csv");
+            let path = s.with("csv");
             crate::checkpoints::trim_table(&path, u64::MAX, cp.time)?;
             Some(mote_io::csv::CsvWriter::append(&path, 4)?)
         }
         (Some(s), None) => Some(mote_io::csv::CsvWriter::create(
-            &s.with_extension("csv"),
+            &s.with("csv"),
             provenance,
             &["collisions", "time", "phi", "pressure"].map(String::from),
             &["", "", "", ""].map(String::from),
@@ -721,7 +721,7 @@ fn pack_dim<const D: usize>(
         use mote_io::trajectory::{Format, TrajectoryWriter};
         let format = Format::of_path(path).unwrap_or_default();
         TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, &frame)?;
-        write_pov(&frame, &s.with_extension("pov"))?;
+        write_pov(&frame, &s.with("pov"))?;
     }
     if let Some(p) = &files.picture {
         mote_render::frame::picture(&frame, p, 800, 800)?;
@@ -799,6 +799,20 @@ fn pack_dim<const D: usize>(
         phi: outcome.phi,
         pressure: outcome.pressure,
     })
+}
+
+/// A packing's path without its extension, to which the CSV and POV-Ray
+/// files add theirs (`pack.0.1.xyz` gives `pack.0.1.csv`, where
+/// `with_extension` would give `pack.0.csv`).
+struct Stem(PathBuf);
+
+impl Stem {
+    fn with(&self, extension: &str) -> PathBuf {
+        let mut name = self.0.clone().into_os_string();
+        name.push(".");
+        name.push(extension);
+        PathBuf::from(name)
+    }
 }
 
 /// The POV-Ray scene of a packing, framed and lit as the pictures are.

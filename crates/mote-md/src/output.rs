@@ -211,7 +211,10 @@ impl Observer<Simulation> for Trajectory {
     }
 
     fn observe(&mut self, sim: &Simulation, _obs: &Observables) -> Result<(), MdError> {
-        Ok(self.writer.write(sim.system.step, &frame_of(&sim.system))?)
+        let written = self.writer.write(sim.system.step, &frame_of(&sim.system));
+        // The frame was a transient copy: its pages go back at once.
+        mote_io::system::release_free_memory();
+        Ok(written?)
     }
 
     fn files(&self) -> Vec<String> {

@@ -480,7 +480,8 @@ fn a_packing_grows_from_a_file() {
 #[test]
 fn the_soft_method_packs_and_says_what_it_found() {
     let dir = tempfile::tempdir().unwrap();
-    let xyz = dir.path().join("soft.xyz");
+    // A name with dots: the CSV goes beside it as soft.n400.csv, not soft.csv.
+    let xyz = dir.path().join("soft.n400.xyz");
     let out = mote()
         .args(["--seed", "4", "pack", "--method", "soft", "-n", "400", "-o"])
         .arg(&xyz)
@@ -503,7 +504,8 @@ fn the_soft_method_packs_and_says_what_it_found() {
     }
     let frames = mote_io::trajectory::read_frames(&xyz).unwrap();
     assert_eq!(frames[0].radii.len(), 400);
-    let csv = std::fs::read_to_string(dir.path().join("soft.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("soft.n400.csv")).unwrap();
+    assert!(dir.path().join("soft.n400.pov").exists());
     assert!(csv.contains("steps,phi,pressure,minimised"), "{csv}");
     // The same packing from a scene under `mote run`.
     std::fs::write(
