@@ -71,6 +71,22 @@ pub fn request_stop(signal: i32) {
     stop_flag().store(signal as usize, Ordering::Relaxed);
 }
 
+/// Hands freed heap pages back to the system (glibc's `malloc_trim`, which
+/// also releases whole free pages inside the heap). A trajectory frame of
+/// 10⁶ particles is a transient copy with one small allocation per species
+/// name; freed, those chunks stay resident wherever later allocations pin
+/// the heap, so a long run's resident memory steps up by the size of a
+/// frame once (61 MiB at 10⁶ spheres in the granular soak) unless they are
+/// given back. A no-op elsewhere.
+pub fn release_free_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free memory of the allocator's own
+    // arenas to the kernel; it touches no live allocation.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,21 +103,5 @@ mod tests {
             .unwrap_err()
             .contains("needs at least"));
         assert!(check_fits("a request", 1.0).is_ok());
-    }
-}
-
-/// Hands freed heap pages back to the system (glibc's `malloc_trim`, which
-/// also releases whole free pages inside the heap). A trajectory frame of
-/// 10⁶ particles is a transient copy with one small allocation per species
-/// name; freed, those chunks stay resident wherever later allocations pin
-/// the heap, so a long run's resident memory steps up by the size of a
-/// frame once (61 MiB at 10⁶ spheres in the granular soak) unless they are
-/// given back. A no-op elsewhere.
-pub fn release_free_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: malloc_trim only returns free memory of the allocator's own
-    // arenas to the kernel; it touches no live allocation.
-    unsafe {
-        libc::malloc_trim(0);
     }
 }
