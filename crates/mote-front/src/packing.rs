@@ -92,7 +92,7 @@ impl Default for PackingSpec {
             tol: None,
             start: None,
             method: "hard".into(),
-            min_pressure: 1e-7,
+            min_pressure: 1e-8,
         }
     }
 }

@@ -100,7 +100,7 @@ pub fn run<'py>(
 /// radii (N,), box (D,), phi, pressure, summary (lines). `output` also
 /// writes it (format by extension) with its CSV of windows.
 #[pyfunction]
-#[pyo3(signature = (n=1000, *, dimension=3, dist="mono", rate=0.01, max_pressure=1e12, phi=None, walls="", jam=true, seed=None, start=None, output=None, method="hard", min_pressure=1e-7))]
+#[pyo3(signature = (n=1000, *, dimension=3, dist="mono", rate=0.01, max_pressure=1e12, phi=None, walls="", jam=true, seed=None, start=None, output=None, method="hard", min_pressure=1e-8))]
 #[allow(clippy::too_many_arguments)]
 pub fn pack<'py>(
     py: Python<'py>,

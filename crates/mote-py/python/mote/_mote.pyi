@@ -169,7 +169,7 @@ def pack(
     start: Optional[str] = None,
     output: Optional[Path] = None,
     method: str = "hard",
-    min_pressure: float = 1e-7,
+    min_pressure: float = 1e-8,
 ) -> dict[str, Any]:
     """A packing by growing hard spheres (method="hard") or by soft spheres
     under a barostat (method="soft", phi extrapolated to zero pressure);

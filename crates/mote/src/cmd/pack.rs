@@ -48,7 +48,7 @@ pub struct PackArgs {
     /// Soft method: the lowest pressure P/K (K = 4E*/3): the barostat
     /// holds 1e-2 … 1e-4, then the jamming finish (energy minimisation)
     /// decompresses a decade at a time to this.
-    #[arg(long, default_value_t = 1e-7, value_name = "P")]
+    #[arg(long, default_value_t = 1e-8, value_name = "P")]
     min_pressure: f64,
     /// Growth rate Γ = (1/v_th) d⟨d⟩/dt (smaller: denser, slower).
     #[arg(long, default_value_t = 0.01)]
