@@ -335,6 +335,39 @@ pub struct PackFiles {
     pub resume: Option<Checkpoint>,
 }
 
+impl PackFiles {
+    /// The packing's path without its extension (the CSV and POV-Ray
+    /// scene go beside it), its folder made; `None` without `xyz`.
+    fn stem(&self) -> Result<Option<Stem>, FrontError> {
+        if let Some(dir) = self.xyz.as_ref().and_then(|p| p.parent()) {
+            if !dir.as_os_str().is_empty() {
+                std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
+            }
+        }
+        Ok(self.xyz.as_ref().map(|p| Stem(p.with_extension(""))))
+    }
+
+    /// Writes the packing (the format follows the extension: .xyz, .dump,
+    /// .gsd, .pvd, in numbers that read back bit for bit), its POV-Ray
+    /// scene and the picture, as asked.
+    fn write(
+        &self,
+        frame: &mote_io::xyz::Frame,
+        provenance: &mote_io::Provenance,
+    ) -> Result<(), FrontError> {
+        if let Some(path) = &self.xyz {
+            use mote_io::trajectory::{Format, TrajectoryWriter};
+            let format = Format::of_path(path).unwrap_or_default();
+            TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, frame)?;
+            write_pov(frame, &Stem(path.with_extension("")).with("pov"))?;
+        }
+        if let Some(p) = &self.picture {
+            mote_render::frame::picture(frame, p, 800, 800)?;
+        }
+        Ok(())
+    }
+}
+
 /// Checkpoints of a packing: every `every` pressure windows to `path`, with
 /// the options and input of `template` (see [`checkpoint_template`]).
 #[derive(Debug, Clone)]
@@ -460,12 +493,7 @@ fn pack_soft(
         seed: settings.seed,
     })
     .map_err(FrontError::request)?;
-    let stem = files.xyz.as_ref().map(|p| Stem(p.with_extension("")));
-    if let Some(dir) = files.xyz.as_ref().and_then(|p| p.parent()) {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
-        }
-    }
+    let stem = files.stem()?;
     let mut csv = match &stem {
         Some(s) => Some(mote_io::csv::CsvWriter::create(
             &s.with("csv"),
@@ -552,15 +580,7 @@ fn pack_soft(
         radii: radii.clone(),
         ..mote_io::xyz::Frame::default()
     };
-    if let (Some(path), Some(s)) = (&files.xyz, &stem) {
-        use mote_io::trajectory::{Format, TrajectoryWriter};
-        let format = Format::of_path(path).unwrap_or_default();
-        TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, &frame)?;
-        write_pov(&frame, &s.with("pov"))?;
-    }
-    if let Some(p) = &files.picture {
-        mote_render::frame::picture(&frame, p, 800, 800)?;
-    }
+    files.write(&frame, provenance)?;
     let mut summary = vec![format!(
         "{} spheres by the soft (SP) method: {} steps in {cpu:.2} s CPU. Barostat (Hertz, radial dissipation, Stokes friction): pressure P/K, packing fraction, overlapping neighbours per sphere:",
         radii.len(),
@@ -592,9 +612,10 @@ fn pack_soft(
         summary.push("Jamming finish (FIRE energy minimisation at fixed box, decompressed a decade of pressure at a time):".into());
         for s in &finish {
             summary.push(format!(
-                "  P/K = {:.3e}  phi = {:.6}  ({} FIRE steps{})",
+                "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} FIRE steps{})",
                 s.pressure,
                 s.phi,
+                s.z,
                 s.steps,
                 if s.converged {
                     ""
@@ -652,12 +673,7 @@ fn pack_dim<const D: usize>(
         Some(cp) => Packer::<D>::resume(settings, &PackState::from_checkpoint(cp, D)?)?,
         None => Packer::<D>::new(settings)?,
     };
-    let stem = files.xyz.as_ref().map(|p| Stem(p.with_extension("")));
-    if let Some(dir) = files.xyz.as_ref().and_then(|p| p.parent()) {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
-        }
-    }
+    let stem = files.stem()?;
     let mut csv = match (&stem, &files.resume) {
         (Some(s), Some(cp)) => {
             let path = s.with("csv");
@@ -715,17 +731,7 @@ fn pack_dim<const D: usize>(
     let (pos, radii) = (sys.positions(), sys.radii());
     let overlap = deepest_overlap(&simbox, &pos, &radii);
     let frame = mote_edmd::scene::frame(sys);
-    if let (Some(path), Some(s)) = (&files.xyz, &stem) {
-        // The format follows the extension (.xyz, .dump, .gsd, .pvd), in
-        // numbers that read back bit for bit.
-        use mote_io::trajectory::{Format, TrajectoryWriter};
-        let format = Format::of_path(path).unwrap_or_default();
-        TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, &frame)?;
-        write_pov(&frame, &s.with("pov"))?;
-    }
-    if let Some(p) = &files.picture {
-        mote_render::frame::picture(&frame, p, 800, 800)?;
-    }
+    files.write(&frame, provenance)?;
     let tol = tol.unwrap_or(1e3 / max_pressure);
     let c = contacts(&simbox, &pos, &radii, tol);
     let (q, _) = bond_order(&simbox, &pos, &radii, 1.2);

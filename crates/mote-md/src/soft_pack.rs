@@ -505,12 +505,12 @@ impl SoftPacker {
     ) -> Vec<Stage> {
         let mut out: Vec<Stage> = Vec::new();
         let record = |p: &mut Self, steps: u64, target: f64, converged: bool| {
-            let pressure = p.static_pressure();
+            let (pressure, z) = p.at_rest();
             Stage {
                 target,
                 pressure,
                 phi: p.phi(),
-                z: 0.0,
+                z,
                 steps,
                 time: p.time,
                 converged,
@@ -565,9 +565,17 @@ impl SoftPacker {
 
     /// The reduced pressure P/K of the spheres at rest (virial only).
     pub fn static_pressure(&mut self) -> f64 {
+        self.at_rest().0
+    }
+
+    /// The pressure at rest and the overlapping neighbours per sphere.
+    fn at_rest(&mut self) -> (f64, f64) {
         self.refresh_list();
         let sums = self.pair_forces_with(false);
-        sums.virial / (3.0 * self.boundary.volume())
+        (
+            sums.virial / (3.0 * self.boundary.volume()),
+            2.0 * sums.contacts as f64 / self.position.len() as f64,
+        )
     }
 }
 
