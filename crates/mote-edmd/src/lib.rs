@@ -14,6 +14,7 @@
 pub mod analyse;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
+mod cells;
 pub mod init;
 pub mod pack;
 pub mod queue;

@@ -450,6 +450,29 @@ pub struct PackCheckpoints<'a> {
     pub save: &'a mut dyn FnMut(&PackState) -> Result<(), EdmdError>,
 }
 
+/// Periodic lengths per largest diameter the event system needs (three
+/// cells of the shell factor's floor, 1.05).
+const MIN_CELLS: f64 = 3.15;
+
+/// φ a growth of `sizes` is expected to jam at, a little above it: the rod
+/// estimate of `mote rcp` (10⁴ rods, milliseconds) + 0.01 for spheres of a
+/// known distribution, else 0.70 (spheres) or 0.86 (disks).
+fn jamming_estimate<const D: usize>(sizes: &SizeSpec) -> f64 {
+    let fallback = if D == 2 { 0.86 } else { 0.70 };
+    if D != 3 {
+        return fallback;
+    }
+    sizes
+        .rcp_distribution()
+        .and_then(|dist| {
+            mote_rcp::RodPacking::default()
+                .rods(10_000)
+                .estimate(&dist)
+                .ok()
+        })
+        .map_or(fallback, |p| p.phi + 0.01)
+}
+
 /// Relative growth of the radii over one epoch: lists are built for radii
 /// this much larger, so a bigger step costs more neighbours per list.
 fn epoch_growth(phi: f64, dim: usize) -> f64 {
@@ -543,15 +566,25 @@ impl<const D: usize> Packer<D> {
                 (simbox, pos, radii)
             }
         };
-        // The largest diameter when grown to φ ≈ φ_J, against the box.
+        // The largest diameter when grown to jamming, against the box: the
+        // event system needs each periodic length to exceed 3.15 largest
+        // diameters at the end of its last epoch (2 % ahead of the radii),
+        // so a run that cannot finish is refused now, not when it gets there.
         let phi_now = radii.iter().map(|r| ball_volume(D, *r)).sum::<f64>() / simbox.volume();
-        let growth = (phi_guess / phi_now).powf(1.0 / D as f64);
-        let side = simbox.size.iter().cloned().fold(f64::INFINITY, f64::min);
+        let phi_end = settings
+            .target_phi
+            .unwrap_or_else(|| jamming_estimate::<D>(&settings.sizes));
+        let growth = (phi_end / phi_now).powf(1.0 / D as f64) * (1.0 + epoch_growth(phi_end, D));
+        let side = (0..D)
+            .filter(|&d| boundary[d] == Boundary::Periodic)
+            .map(|d| simbox.size[d])
+            .fold(f64::INFINITY, f64::min);
         let largest = 2.0 * radii.iter().cloned().fold(0.0, f64::max) * growth;
-        if largest >= 0.3 * side {
+        if largest * MIN_CELLS > side {
             return Err(invalid(format!(
-                "{n} particles are too few for the largest diameter ({:.3} of the box side at jamming): use more particles or a narrower distribution",
-                largest / side
+                "{n} particles are too few for this size distribution: grown to φ ≈ {phi_end:.3} the largest diameter would be {:.3} of the periodic box side, and the event system needs less than 1/{MIN_CELLS} (try about {:.0} particles, or a narrower distribution)",
+                largest / side,
+                (n as f64 * (largest * MIN_CELLS / side).powi(D as i32)).ceil()
             )));
         }
         let masses = vec![1.0; n];

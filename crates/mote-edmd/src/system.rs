@@ -7,12 +7,15 @@
 //! the root is taken in the cancellation-free form `c / (−b + √(b² − ac))`).
 //! Scheduling: one event per particle in an indexed binary heap, invalidated
 //! by per-particle collision counters (Smallenburg, arXiv:2201.01099);
-//! neighbours from symmetric neighbour lists with a shell: particle i lists
-//! every j with |x_i − x_j| < s(r_i + r_j) (s from [`shell_factor`]) at the moment it
-//! builds its list, and rebuilds it (a "neighbour-list event", the analogue
-//! of a cell crossing) when it has moved (s − 1) r_i from where it built it,
-//! so two unlisted particles cannot touch. Lists are built from a cell list
-//! of cells at least s·(largest diameter) wide. Free flight is lazy (each
+//! neighbours from symmetric neighbour lists with a skin: particle i lists
+//! every j with |x_i − x_j| < r_i + k_i + r_j + k_j at the moment it builds
+//! its list, and rebuilds it (a "neighbour-list event", the analogue of a
+//! cell crossing) when it has moved its skin k_i from where it built it, so
+//! two unlisted particles cannot touch. k_i = (s − 1)·min(r_i, 2 r_median)
+//! (s from [`shell_factor`]): Smallenburg's shell s(r_i + r_j) for all but
+//! the largest spheres, which keep a typical sphere's skin. Lists are built
+//! from a hierarchy of cell grids, one per size class ([`crate::cells`]).
+//! Free flight is lazy (each
 //! particle keeps its own time `t_i` and is advanced only when it takes part
 //! in an event).
 //!
@@ -26,6 +29,7 @@
 //! t_h; the caller (the packer, [`crate::pack`]) starts a fresh system there.
 //! The event loop itself does not change; δ = 0 runs the original code.
 
+use crate::cells::{Cells, ListPos};
 use crate::queue::EventQueue;
 use crate::vecd::{add_scaled, dot, sub};
 use crate::EdmdError;
@@ -87,7 +91,7 @@ const NONE: u32 = u32::MAX;
 
 /// Hints the CPU to load `x` into cache (no effect on results).
 #[inline(always)]
-fn prefetch<T>(x: &T) {
+pub(crate) fn prefetch<T>(x: &T) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: prefetching is a hint; the pointer comes from a valid reference.
     unsafe {
@@ -124,14 +128,6 @@ pub(crate) fn huge_vec<T: Clone>(n: usize, value: T) -> Vec<T> {
     v
 }
 
-/// A list-building position and the radius: what a neighbour-list scan reads.
-#[derive(Debug, Clone, Copy)]
-#[repr(C, align(32))]
-struct ListPos<const D: usize> {
-    x: [f64; D],
-    r: f64,
-}
-
 /// Neighbour shell factor s at packing fraction η: pairs closer than
 /// s(r_i + r_j) are listed (Smallenburg's `shellsize`, 1.5 in his code).
 /// Chosen so that a particle has about 16 (3-D) or 10 (2-D) listed
@@ -150,6 +146,23 @@ pub fn shell_factor(dim: usize, eta: f64) -> f64 {
     } else {
         4.0
     }
+}
+
+/// The skin k_i of a particle of list radius `r`: it renews its list when
+/// it has moved k_i from where it built it, so pairs farther apart than
+/// R_i + k_i + R_j + k_j then cannot touch before one of them renews.
+/// k = (s − 1)·min(R, cap): for sizes up to `cap` the list reach is
+/// s·R (Smallenburg's shell); larger spheres, which move as fast in a
+/// packing (equal masses), keep a skin of a typical sphere's.
+#[inline]
+fn skin(r: f64, shell: f64, cap: f64) -> f64 {
+    (shell - 1.0) * r.min(cap)
+}
+
+/// The reach ρ_i = R_i + k_i: pairs with |x_i − x_j| < ρ_i + ρ_j are listed.
+#[inline]
+fn list_reach(r: f64, shell: f64, cap: f64) -> f64 {
+    r + skin(r, shell, cap)
 }
 
 /// Position `x` at the particle's own time `t`, velocity `v`, radius `r`.
@@ -203,21 +216,10 @@ pub struct System<const D: usize> {
     /// Collisions (and other velocity changes) of each particle, wrapping:
     /// an event is stale when its partner's count moved on.
     count: Vec<u32>,
-    // cells
-    ncell: [usize; D],
-    cwidth: [f64; D],
-    stride: [usize; D],
-    cidx: Vec<[u32; D]>,
-    /// Cell f holds `cell_len[f]` particles in slots `f·ccap ..`: their
-    /// list positions (copies of `xn`, so a scan reads one contiguous run
-    /// per cell instead of chasing a linked list) and internal indices.
-    cell_pos: Vec<ListPos<D>>,
-    cell_id: Vec<u32>,
-    cell_len: Vec<u32>,
-    ccap: usize,
-    /// Slot of each particle within its cell.
-    at: Vec<u32>,
-    offsets: Vec<[i32; D]>,
+    /// Cell lists for the list builds, one grid per size class.
+    cells: Cells<D>,
+    /// Slot ranges of the cells a list build visits (reused).
+    ranges: Vec<(u32, u32)>,
     // neighbour lists: row i of `nbr` (capacity `cap`) holds nn[i] entries
     /// Where each particle built its neighbour list, with its radius.
     xn: Vec<ListPos<D>>,
@@ -237,6 +239,9 @@ pub struct System<const D: usize> {
     horizon: f64,
     /// r_i(horizon)/r_i(0): lists are built for radii R_i = r_i(0)·factor.
     list_factor: f64,
+    /// Skins are capped at (s − 1)·`skin_cap` (twice the median list
+    /// radius), so a large sphere lists a thin shell of small ones.
+    skin_cap: f64,
     /// Scan neighbour lists with AVX-512 (same results as the scalar loop).
     simd: bool,
 }
@@ -416,9 +421,6 @@ impl<const D: usize> System<D> {
                 2.0 * max_list_radius
             )));
         }
-        let dmax = shell * 2.0 * max_list_radius;
-        let mut ncell = [1usize; D];
-        let mut cwidth = [0.0; D];
         for d in 0..D {
             let l = simbox.size[d];
             if !(l > 0.0 && l.is_finite()) {
@@ -426,71 +428,37 @@ impl<const D: usize> System<D> {
                     "box length {l} on axis {d} must be positive"
                 )));
             }
-            let nc = if dmax > 0.0 {
-                ((l / (dmax * (1.0 + 1e-9))).floor() as usize).max(1)
+        }
+        let skin_cap = {
+            let mut r: Vec<f64> = radii.iter().map(|r| r * g_end).collect();
+            if r.is_empty() {
+                f64::INFINITY
             } else {
-                1
-            };
-            if simbox.boundary[d] == Boundary::Periodic && nc < 3 {
-                return Err(EdmdError::Invalid(format!(
-                    "periodic axis {d}: box length {l} must exceed {} largest diameters ({})",
-                    3.0 * shell,
-                    3.0 * dmax
-                )));
+                2.0 * *r.select_nth_unstable_by(n / 2, f64::total_cmp).1
             }
-            // Keep the cell count moderate: at most about 2 cells per particle.
-            ncell[d] = nc.min(1 << 20);
-            cwidth[d] = l / ncell[d] as f64;
-        }
-        let total: usize = ncell.iter().product();
-        // reduce cells if far more cells than particles (dilute gas)
-        let mut tot = total;
-        while tot > 4 * n.max(1) + 64 {
-            let (dmx, _) = ncell
-                .iter()
-                .enumerate()
-                .max_by_key(|(_, &c)| c)
-                .expect("D > 0");
-            let keep3 = simbox.boundary[dmx] == Boundary::Periodic;
-            let nn = ncell[dmx] / 2;
-            if nn < 1 || (keep3 && nn < 3) {
-                break;
-            }
-            ncell[dmx] = nn;
-            cwidth[dmx] = simbox.size[dmx] / nn as f64;
-            tot = ncell.iter().product();
-        }
-        let mut stride = [1usize; D];
-        for d in 1..D {
-            stride[d] = stride[d - 1] * ncell[d - 1];
-        }
-        let mut offsets = Vec::new();
-        let n3 = 3usize.pow(D as u32);
-        for k in 0..n3 {
-            let mut o = [0i32; D];
-            let mut kk = k;
-            for item in o.iter_mut() {
-                *item = (kk % 3) as i32 - 1;
-                kk /= 3;
-            }
-            offsets.push(o);
-        }
-        // Store particles in Morton (Z) order of their cells, so that
-        // neighbours in space are mostly neighbours in memory; the public
-        // API keeps the caller's numbering (`id`, `slot`).
+        };
+        let reach = |r: f64| list_reach(r * g_end, shell, skin_cap);
+        let reaches: Vec<f64> = radii.iter().map(|&r| reach(r)).collect();
+        let cells = Cells::new(&simbox, &reaches);
+        // Store particles in Morton (Z) order of their cells on the finest
+        // grid, so that neighbours in space are mostly neighbours in memory;
+        // the public API keeps the caller's numbering (`id`, `slot`).
         let key = |x: &[f64; D]| -> u64 {
-            let mut k = 0u64;
-            let bits = 64 / D;
+            let mut y = *x;
             for d in 0..D {
                 let l = simbox.size[d];
-                let xd = if x[d].is_finite() {
-                    x[d].rem_euclid(l)
+                y[d] = if y[d].is_finite() {
+                    y[d].rem_euclid(l)
                 } else {
                     0.0
                 };
-                let c = ((xd / cwidth[d]) as u64).min(ncell[d] as u64 - 1);
+            }
+            let c = cells.finest_cell(&y);
+            let mut k = 0u64;
+            let bits = 64 / D;
+            for d in 0..D {
                 for b in 0..bits {
-                    k |= ((c >> b) & 1) << (b * D + d);
+                    k |= ((c[d] as u64 >> b) & 1) << (b * D + d);
                 }
             }
             k
@@ -523,6 +491,9 @@ impl<const D: usize> System<D> {
             mass[k] = masses[i];
         }
         let id = order.iter().map(|&i| i as u32).collect();
+        // the same grids, with each particle's level in internal order
+        let internal: Vec<f64> = order.iter().map(|&i| reaches[i]).collect();
+        let cells = Cells::new(&simbox, &internal);
         let mut sys = System {
             simbox,
             p,
@@ -530,29 +501,9 @@ impl<const D: usize> System<D> {
             id,
             slot,
             count: huge_vec(n, 0),
-            ncell,
-            cwidth,
-            stride,
-            cidx: vec![[0; D]; n],
-            cell_pos: huge_vec(
-                tot * 8,
-                ListPos {
-                    x: [0.0; D],
-                    r: 0.0,
-                },
-            ),
-            cell_id: huge_vec(tot * 8, NONE),
-            cell_len: vec![0; tot],
-            ccap: 8,
-            at: vec![0; n],
-            offsets,
-            xn: huge_vec(
-                n,
-                ListPos {
-                    x: [0.0; D],
-                    r: 0.0,
-                },
-            ),
+            cells,
+            ranges: Vec::new(),
+            xn: huge_vec(n, ListPos::ZERO),
             nbr: huge_vec(n * 16, 0),
             nn: vec![0; n],
             cap: 16,
@@ -565,6 +516,7 @@ impl<const D: usize> System<D> {
             growth,
             horizon,
             list_factor: g_end,
+            skin_cap,
             simd: simd_available::<D>(),
         };
         for i in 0..n {
@@ -589,13 +541,11 @@ impl<const D: usize> System<D> {
                     }
                 }
             }
-            let c = sys.cell_of(&sys.p[i].x);
-            sys.cidx[i] = c;
             sys.xn[i] = ListPos {
                 x: sys.p[i].x,
-                r: sys.p[i].r * g_end,
+                r: reach(sys.p[i].r),
             };
-            sys.insert(i);
+            sys.cells.insert(i, sys.xn[i]);
         }
         for i in 0..n {
             sys.scan_neighbours(i, true);
@@ -632,95 +582,6 @@ impl<const D: usize> System<D> {
         };
         let dt = 32.0 * tau / n.max(1) as f64;
         self.queue.retune(self.now, dt);
-    }
-
-    fn cell_of(&self, x: &[f64; D]) -> [u32; D] {
-        let mut c = [0u32; D];
-        for d in 0..D {
-            let k = (x[d] / self.cwidth[d]).floor();
-            c[d] = (k.max(0.0) as usize).min(self.ncell[d] - 1) as u32;
-        }
-        c
-    }
-
-    /// The cell at `offset` from cell `ci`, wrapped on periodic axes; `None`
-    /// past a wall.
-    #[inline]
-    fn neighbour_cell(&self, ci: &[u32; D], offset: &[i32; D]) -> Option<[u32; D]> {
-        let mut cc = [0u32; D];
-        for d in 0..D {
-            let k = ci[d] as i64 + offset[d] as i64;
-            let m = self.ncell[d] as i64;
-            cc[d] = if (0..m).contains(&k) {
-                k as u32
-            } else if self.simbox.boundary[d] == Boundary::Periodic {
-                k.rem_euclid(m) as u32
-            } else {
-                return None;
-            };
-        }
-        Some(cc)
-    }
-
-    #[inline]
-    fn flat(&self, c: &[u32; D]) -> usize {
-        let mut f = 0;
-        for d in 0..D {
-            f += c[d] as usize * self.stride[d];
-        }
-        f
-    }
-
-    /// Puts particle `i` (with its list position `xn[i]`) into cell `cidx[i]`.
-    #[inline]
-    fn insert(&mut self, i: usize) {
-        let f = self.flat(&self.cidx[i]);
-        if self.cell_len[f] as usize == self.ccap {
-            self.grow_cells();
-        }
-        let k = self.cell_len[f] as usize;
-        self.cell_pos[f * self.ccap + k] = self.xn[i];
-        self.cell_id[f * self.ccap + k] = i as u32;
-        self.at[i] = k as u32;
-        self.cell_len[f] += 1;
-    }
-
-    /// Takes particle `i` out of cell `cidx[i]` (the cell's last entry
-    /// fills the hole).
-    #[inline]
-    fn remove(&mut self, i: usize) {
-        let f = self.flat(&self.cidx[i]);
-        let base = f * self.ccap;
-        let k = self.at[i] as usize;
-        let last = self.cell_len[f] as usize - 1;
-        let moved = self.cell_id[base + last];
-        self.cell_pos[base + k] = self.cell_pos[base + last];
-        self.cell_id[base + k] = moved;
-        self.at[moved as usize] = k as u32;
-        self.cell_len[f] -= 1;
-    }
-
-    /// Doubles the slots per cell.
-    fn grow_cells(&mut self) {
-        let cap = 2 * self.ccap;
-        let cells = self.cell_len.len();
-        let mut pos = huge_vec(
-            cells * cap,
-            ListPos {
-                x: [0.0; D],
-                r: 0.0,
-            },
-        );
-        let mut id = huge_vec(cells * cap, NONE);
-        for f in 0..cells {
-            let k = self.cell_len[f] as usize;
-            let old = f * self.ccap;
-            pos[f * cap..f * cap + k].copy_from_slice(&self.cell_pos[old..old + k]);
-            id[f * cap..f * cap + k].copy_from_slice(&self.cell_id[old..old + k]);
-        }
-        self.cell_pos = pos;
-        self.cell_id = id;
-        self.ccap = cap;
     }
 
     // ----- accessors -----------------------------------------------------
@@ -775,9 +636,10 @@ impl<const D: usize> System<D> {
     pub fn counters(&self) -> &Counters {
         &self.counters
     }
-    /// Cells per axis of the neighbour grid.
-    pub fn cells(&self) -> [usize; D] {
-        self.ncell
+    /// Cells per axis of each grid of the cell hierarchy, finest first
+    /// (one grid unless the list radii span a factor of 2 or more).
+    pub fn cell_grids(&self) -> Vec<[usize; D]> {
+        self.cells.shapes()
     }
     /// The neighbour shell factor s in use.
     pub fn shell(&self) -> f64 {
@@ -961,23 +823,17 @@ impl<const D: usize> System<D> {
                 }
             }
         }
+        // every pair in contact is on the neighbour lists
         for i in 0..n {
-            let ci = self.cidx[i];
-            for off in &self.offsets {
-                let Some(cc) = self.neighbour_cell(&ci, off) else {
-                    continue;
-                };
-                let f = self.flat(&cc);
-                for &j in &self.cell_id[f * self.ccap..f * self.ccap + self.cell_len[f] as usize] {
-                    let ju = j as usize;
-                    if ju > i {
-                        let r = self.sep_int(i, ju);
-                        let s = self.rad(i) + self.rad(ju);
-                        let dist = dot(&r, &r).sqrt();
-                        if dist < s * (1.0 - rel_tol) {
-                            let (a, b) = (self.id[i] as usize, self.id[ju] as usize);
-                            return Some((a.min(b), a.max(b), dist / s - 1.0));
-                        }
+            for &j in &self.nbr[i * self.cap..i * self.cap + self.nn[i] as usize] {
+                let ju = j as usize;
+                if ju > i {
+                    let r = self.sep_int(i, ju);
+                    let s = self.rad(i) + self.rad(ju);
+                    let dist = dot(&r, &r).sqrt();
+                    if dist < s * (1.0 - rel_tol) {
+                        let (a, b) = (self.id[i] as usize, self.id[ju] as usize);
+                        return Some((a.min(b), a.max(b), dist / s - 1.0));
                     }
                 }
             }
@@ -1039,9 +895,9 @@ impl<const D: usize> System<D> {
         let mut best = f64::INFINITY;
         let mut ev = NO_EVENT;
         if a > 0.0 {
-            // |x + v t − x_n| = (s − 1) R_i, the outer root
+            // |x + v t − x_n| = k_i (the skin), the outer root
             let dr = sub(&xi, &self.xn[i].x);
-            let m = (self.shell - 1.0) * self.xn[i].r;
+            let m = skin(self.p[i].r * self.list_factor, self.shell, self.skin_cap);
             let c = dot(&dr, &dr) - m * m;
             best = if c >= 0.0 {
                 0.0
@@ -1202,30 +1058,17 @@ impl<const D: usize> System<D> {
     /// within the shell of its list position; with `only_greater`, only
     /// j > i (for the first build of all lists).
     fn scan_neighbours(&mut self, i: usize, only_greater: bool) {
-        let ci = self.cidx[i];
         let xi = self.xn[i].x;
         let ri = self.xn[i].r;
-        for off in &self.offsets {
-            if let Some(cc) = self.neighbour_cell(&ci, off) {
-                let base = self.flat(&cc) * self.ccap;
-                prefetch(&self.cell_pos[base]);
-                prefetch(&self.cell_pos[base + 2]);
-                prefetch(&self.cell_id[base]);
-            }
-        }
+        let mut ranges = std::mem::take(&mut self.ranges);
+        ranges.clear();
+        self.cells.near(&xi, ri, &mut ranges);
         let periodic = self.simbox.boundary.map(|b| b == Boundary::Periodic);
-        for o in 0..self.offsets.len() {
-            let off = self.offsets[o];
-            let Some(cc) = self.neighbour_cell(&ci, &off) else {
-                continue;
-            };
-            let f = self.flat(&cc);
-            let base = f * self.ccap;
-            for slot in base..base + self.cell_len[f] as usize {
-                let j = self.cell_id[slot];
+        for &(start, end) in &ranges {
+            for slot in start as usize..end as usize {
+                let (j, ListPos { x: xj, r: rj }) = self.cells.entry(slot);
                 let ju = j as usize;
                 if ju != i && (!only_greater || ju > i) {
-                    let ListPos { x: xj, r: rj } = self.cell_pos[slot];
                     let mut r = sub(&xi, &xj);
                     for (d, rd) in r.iter_mut().enumerate() {
                         if periodic[d] {
@@ -1237,7 +1080,7 @@ impl<const D: usize> System<D> {
                             }
                         }
                     }
-                    let s = self.shell * (ri + rj);
+                    let s = ri + rj;
                     if dot(&r, &r) < s * s {
                         if self.nn[i] as usize == self.cap || self.nn[ju] as usize == self.cap {
                             self.grow_lists();
@@ -1251,6 +1094,7 @@ impl<const D: usize> System<D> {
                 }
             }
         }
+        self.ranges = ranges;
     }
 
     fn grow_lists(&mut self) {
@@ -1281,11 +1125,10 @@ impl<const D: usize> System<D> {
         }
         self.xn[i] = ListPos {
             x: self.p[i].x,
-            r: self.p[i].r * self.list_factor,
+            r: list_reach(self.p[i].r * self.list_factor, self.shell, self.skin_cap),
         };
-        self.remove(i);
-        self.cidx[i] = self.cell_of(&self.xn[i].x);
-        self.insert(i);
+        self.cells.remove(i);
+        self.cells.insert(i, self.xn[i]);
         let cap = self.cap;
         for k in 0..self.nn[i] as usize {
             prefetch(&self.nbr[self.nbr[i * cap + k] as usize * cap]);

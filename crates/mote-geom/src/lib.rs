@@ -24,6 +24,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod grids;
 mod inertia;
 mod objects;
 mod placement;

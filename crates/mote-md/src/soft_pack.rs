@@ -40,7 +40,7 @@ use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use crate::boundary::Boundary;
-use crate::neighbor::VerletList;
+use crate::neighbor::SizedList;
 
 /// What a soft-sphere packing is asked for.
 #[derive(Debug, Clone)]
@@ -101,7 +101,9 @@ pub struct SoftPacker {
     mass: Vec<f64>,
     force: Vec<DVec3>,
     pub boundary: Boundary,
-    list: VerletList,
+    list: SizedList,
+    /// The largest diameter.
+    d_max: f64,
     /// Positions and box side at the last list build.
     reference: Vec<DVec3>,
     reference_side: f64,
@@ -183,7 +185,8 @@ impl SoftPacker {
             force: vec![DVec3::ZERO; n],
             reference: Vec::new(),
             reference_side: side,
-            list: VerletList::half(d_max, skin),
+            list: SizedList::new(skin),
+            d_max,
             position,
             radius,
             mass,
@@ -218,14 +221,15 @@ impl SoftPacker {
                 let d = self.boundary.minimum_image(*r - (lo + (*r0 - lo) * scale));
                 worst = worst.max(d.length_squared());
             }
-            let reach = self.list.cutoff + self.list.skin;
+            let reach = self.d_max + self.list.skin;
             2.0 * worst.sqrt() + reach * (1.0 - scale).max(0.0) > self.list.skin
         };
         if stale {
             for r in &mut self.position {
                 *r = self.boundary.wrap(*r);
             }
-            self.list.build(&self.position, &self.boundary);
+            self.list
+                .build(&self.position, &self.radius, &self.boundary);
             self.reference.clone_from(&self.position);
             self.reference_side = side;
         }

@@ -15,7 +15,9 @@ use crate::boundary::Boundary;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx512;
 mod ghosts;
+mod sized;
 pub use ghosts::{Copy4, GhostList};
+pub use sized::SizedList;
 
 /// A Verlet neighbour list in compressed rows.
 #[derive(Debug, Clone, Default)]
