@@ -507,6 +507,19 @@ fn the_soft_method_packs_and_says_what_it_found() {
     let csv = std::fs::read_to_string(dir.path().join("soft.n400.csv")).unwrap();
     assert!(dir.path().join("soft.n400.pov").exists());
     assert!(csv.contains("steps,phi,pressure,minimised"), "{csv}");
+    // one row per stage, steps counted to that stage: rising, and the last
+    // row's count is the summary's total
+    let steps: Vec<u64> = csv
+        .lines()
+        .filter(|l| l.starts_with(|c: char| c.is_ascii_digit()))
+        .map(|l| l.split(',').next().unwrap().parse::<f64>().unwrap() as u64)
+        .collect();
+    assert!(
+        steps.len() > 3 && steps.windows(2).all(|w| w[0] < w[1]),
+        "{csv}"
+    );
+    let total = format!("method: {} steps in", steps.last().unwrap());
+    assert!(text.contains(&total), "{total}: {text}");
     // The same packing from a scene under `mote run`.
     std::fs::write(
         dir.path().join("soft.toml"),

@@ -101,6 +101,7 @@ pub(super) fn pack_soft(
         (simbox, pos, counted)
     };
     let before = analyse(&packer).2;
+    let barostat_steps = packer.steps;
     let finish = if held && min_pressure < 1e-4 && !stop() {
         let slope = barostat_phi_j.map_or(3.0, |(_, c)| c);
         monitor.progress(done, total, "jamming finish: minimising");
@@ -108,9 +109,12 @@ pub(super) fn pack_soft(
     } else {
         Vec::new()
     };
+    // the steps column counts every step so far, FIRE's included
+    let mut steps = barostat_steps;
     for s in &finish {
+        steps += s.steps;
         if let Some(w) = csv.as_mut() {
-            if let Err(e) = w.row(&[packer.steps as f64, s.phi, s.pressure, 1.0]) {
+            if let Err(e) = w.row(&[steps as f64, s.phi, s.pressure, 1.0]) {
                 csv_err.get_or_insert(e);
             }
         }
