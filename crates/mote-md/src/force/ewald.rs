@@ -1,9 +1,10 @@
-//! Ewald summation for point charges and point dipoles in a cubic periodic
-//! box of side L with tin-foil (conducting) boundary conditions.
+//! Ewald summation for point charges and point dipoles in a periodic box
+//! (orthorhombic, sides L_x, L_y, L_z; cubic by default) with tin-foil
+//! (conducting) boundary conditions.
 //!
 //! Gaussian form (prefactor 1; interactions multiply by the unit system's
-//! constant, 1/(4πε₀) or μ₀/4π). With splitting parameter α, k = 2πn/L,
-//! A(k) = exp(−k²/4α²)/k², V = L³ (Frenkel & Smit, *Understanding
+//! constant, 1/(4πε₀) or μ₀/4π). With splitting parameter α,
+//! k = 2π(n_x/L_x, n_y/L_y, n_z/L_z), A(k) = exp(−k²/4α²)/k², V = L_x L_y L_z (Frenkel & Smit, *Understanding
 //! Molecular Simulation*, §12.1; dipoles after Wang & Holm 2001, J. Chem.
 //! Phys. 115, 6351, Eqs. 5–9):
 //!
@@ -16,19 +17,21 @@
 //!     C = [3 erfc(αr) + (2αr/√π)(3 + 2α²r²) e^{−α²r²}]/r⁵,
 //!     D = [15 erfc(αr) + (2αr/√π)(15 + 10α²r² + 4α⁴r⁴) e^{−α²r²}]/r⁷,
 //!
-//! with r = r_i − r_j + nL and the prime omitting i = j at n = 0. Forces are
+//! with r = r_i − r_j + (n_x L_x, n_y L_y, n_z L_z) and the prime omitting i = j at n = 0. Forces are
 //! −∂U/∂r_i, dipole fields H_i = −∂U/∂μ_i and torques τ_i = μ_i × H_i.
 //!
 //! Parameters from a requested RMS force error δ (Kolafa & Perram 1992,
 //! Mol. Simul. 9, 351, Eqs. 18 and 32, in LAMMPS' form; for dipoles Wang &
 //! Holm 2001, Eqs. 38 and 46): for charges, with Q₂ = Σ q²,
 //! δ_real = 2 Q₂ e^{−α²r_c²}/√(N r_c L³) = δ/√2 fixes α for the given cut-off r_c,
-//! and the smallest integer n_max (k-vectors |n| ≤ n_max) with
+//! and the smallest integer n_max (k-vectors |k| ≤ k_max = 2π n_max/L) with
 //! δ_k = (2 Q₂ α/L) (π n_max N)^{−1/2} e^{−(π n_max/αL)²} ≤ δ/√2; for dipoles,
 //! with M₂ = Σ μ², a = α r_c,
 //! δ_real = M₂ (N V α⁴ r_c⁹)^{−1/2} [13/6 C² + 2/15 D² − 13/15 C D]^{1/2} e^{−a²},
 //! C = 4a⁴ + 6a² + 3, D = 8a⁶ + 20a⁴ + 30a² + 15, and
-//! δ_k = (8π M₂ α/V) [2π n_max³/(15 N)]^{1/2} e^{−(π n_max/αL)²}.
+//! δ_k = (8π M₂ α/V) [2π n_max³/(15 N)]^{1/2} e^{−(π n_max/αL)²}. In a
+//! box that is not cubic, L in these estimates is V^{1/3} and the k-vectors
+//! fill the sphere |k| ≤ k_max.
 //!
 //! The real-space sum runs over all pairs and the periodic images within
 //! r_c (O(N²); fine up to a few thousand particles). The k-space sum is
@@ -47,16 +50,16 @@ use libm::erfc;
 
 const SQRT_PI: f64 = 1.772_453_850_905_516;
 
-/// Ewald parameters for a cubic box.
+/// Ewald parameters for a periodic box.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ewald {
-    /// Box side L (the box is [0, L)³, positions are wrapped).
-    pub box_length: f64,
+    /// Box sides (L_x, L_y, L_z); positions need not be wrapped.
+    pub cell: DVec3,
     /// Splitting parameter α.
     pub alpha: f64,
     /// Real-space cut-off r_c.
     pub r_cut: f64,
-    /// k-vectors 2πn/L with 0 < |n| ≤ n_max.
+    /// k-vectors with 0 < |k| ≤ k_max = 2π n_max/V^{1/3}.
     pub n_max: i32,
     /// Estimated RMS force error of the real-space sum (Kolafa–Perram).
     pub real_error: f64,
@@ -111,15 +114,15 @@ fn solve_alpha(accuracy: f64, rc: f64, error: impl Fn(f64) -> f64) -> f64 {
 
 impl Ewald {
     fn with_errors(
-        l: f64,
+        cell: DVec3,
         rc: f64,
         accuracy: f64,
         real: impl Fn(f64) -> f64,
         kspace: impl Fn(f64, i32) -> f64,
     ) -> Self {
         assert!(
-            l > 0.0 && rc > 0.0 && accuracy > 0.0,
-            "Ewald: L, r_c and accuracy must be positive"
+            cell.min_element() > 0.0 && rc > 0.0 && accuracy > 0.0,
+            "Ewald: box sides, r_c and accuracy must be positive"
         );
         // Each part gets δ/√2, so that √(δ_real² + δ_k²) ≤ δ.
         let part = accuracy / std::f64::consts::SQRT_2;
@@ -129,7 +132,7 @@ impl Ewald {
             n_max += 1;
         }
         Self {
-            box_length: l,
+            cell,
             alpha,
             r_cut: rc,
             n_max,
@@ -138,34 +141,67 @@ impl Ewald {
         }
     }
 
-    /// Parameters for `charge` in a box of side L with real-space cut-off
-    /// r_c (L/2 is a good default) and requested RMS force error `accuracy`
-    /// (in units of charge²/length², Gaussian prefactor 1).
+    /// Parameters for `charge` in a cubic box of side L with real-space
+    /// cut-off r_c (L/2 is a good default) and requested RMS force error
+    /// `accuracy` (in units of charge²/length², Gaussian prefactor 1).
     pub fn for_charges(box_length: f64, r_cut: f64, accuracy: f64, charge: &[f64]) -> Self {
+        Self::for_charges_in(DVec3::splat(box_length), r_cut, accuracy, charge)
+    }
+
+    /// [`Ewald::for_charges`] in a box of sides `cell`.
+    pub fn for_charges_in(cell: DVec3, r_cut: f64, accuracy: f64, charge: &[f64]) -> Self {
         let n = charge.len().max(1) as f64;
         let q2: f64 = charge.iter().map(|q| q * q).sum();
         let q2 = q2.max(f64::MIN_POSITIVE);
+        let l = cell.element_product().cbrt();
         Self::with_errors(
-            box_length,
+            cell,
             r_cut,
             accuracy,
-            |a| charge_real_error(a, r_cut, box_length, n, q2),
-            |a, k| charge_kspace_error(a, k, box_length, n, q2),
+            |a| charge_real_error(a, r_cut, l, n, q2),
+            |a, k| charge_kspace_error(a, k, l, n, q2),
         )
     }
 
-    /// Parameters for point dipoles `dipole` (accuracy in units of μ²/length⁴).
+    /// Parameters for point dipoles `dipole` in a cubic box (accuracy in
+    /// units of μ²/length⁴).
     pub fn for_dipoles(box_length: f64, r_cut: f64, accuracy: f64, dipole: &[DVec3]) -> Self {
         let n = dipole.len().max(1) as f64;
         let m2: f64 = dipole.iter().map(|m| m.length_squared()).sum();
         let m2 = m2.max(f64::MIN_POSITIVE);
         Self::with_errors(
-            box_length,
+            DVec3::splat(box_length),
             r_cut,
             accuracy,
             |a| dipole_real_error(a, r_cut, box_length, n, m2),
             |a, k| dipole_kspace_error(a, k, box_length, n, m2),
         )
+    }
+
+    /// The box volume V.
+    fn volume(&self) -> f64 {
+        self.cell.element_product()
+    }
+
+    /// The largest |k| summed, 2π n_max/V^{1/3}.
+    fn k_max(&self) -> f64 {
+        2.0 * std::f64::consts::PI * self.n_max as f64 / self.volume().cbrt()
+    }
+
+    /// The largest index along each axis, ⌊k_max L_a/2π⌋.
+    fn axis_max(&self) -> [i32; 3] {
+        let scale = self.k_max() / (2.0 * std::f64::consts::PI) * (1.0 + 1e-12);
+        [0, 1, 2].map(|a| (scale * self.cell[a]).floor() as i32)
+    }
+
+    /// The phase table's half width: the largest index on any axis.
+    fn table_max(&self) -> i32 {
+        self.axis_max().into_iter().max().unwrap_or(0)
+    }
+
+    /// 2π/L_a per axis.
+    fn tau(&self) -> DVec3 {
+        2.0 * std::f64::consts::PI / self.cell
     }
 
     /// Estimated total RMS force error √(δ_real² + δ_k²).
@@ -174,15 +210,17 @@ impl Ewald {
     }
 
     /// Half of the k-vectors (n_x > 0, or n_x = 0 < n_y, or n_x = n_y = 0 < n_z)
-    /// with |n| ≤ n_max, as integer triples.
+    /// with |k| ≤ k_max, as integer triples.
     fn half_kvectors(&self) -> Vec<[i32; 3]> {
-        let m = self.n_max;
+        let [mx, my, mz] = self.axis_max();
+        let (tau, k2max) = (self.tau(), self.k_max().powi(2) * (1.0 + 1e-12));
         let mut out = Vec::new();
-        for nx in 0..=m {
-            for ny in -m..=m {
-                for nz in -m..=m {
+        for nx in 0..=mx {
+            for ny in -my..=my {
+                for nz in -mz..=mz {
                     let positive = nx > 0 || (nx == 0 && (ny > 0 || (ny == 0 && nz > 0)));
-                    if positive && nx * nx + ny * ny + nz * nz <= m * m {
+                    let k = DVec3::new(nx as f64, ny as f64, nz as f64) * tau;
+                    if positive && k.length_squared() <= k2max {
                         out.push([nx, ny, nz]);
                     }
                 }
@@ -191,18 +229,19 @@ impl Ewald {
         out
     }
 
-    /// e^{i 2π m x_a/L} for m = −n_max..=n_max and each axis a, per particle,
-    /// as (cos, sin) pairs: index [(i · 3 + a) · (2 n_max + 1) + m + n_max].
+    /// e^{i 2π m x_a/L_a} for m = −M..=M (M the largest index on any axis)
+    /// and each axis a, per particle, as (cos, sin) pairs: index
+    /// [(i · 3 + a) · (2M + 1) + m + M].
     fn phases(&self, position: &[DVec3]) -> Vec<(f64, f64)> {
-        let m = self.n_max as usize;
+        let m = self.table_max() as usize;
         let w = 2 * m + 1;
         let mut out = vec![(1.0, 0.0); position.len() * 3 * w];
-        let tau = 2.0 * std::f64::consts::PI / self.box_length;
+        let tau = self.tau();
         out.par_chunks_mut(3 * w)
             .zip(position.par_iter())
             .for_each(|(row, r)| {
                 for a in 0..3 {
-                    let (s, c) = (tau * r[a]).sin_cos();
+                    let (s, c) = (tau[a] * r[a]).sin_cos();
                     let axis = &mut row[a * w..(a + 1) * w];
                     for k in 1..=m {
                         let (pc, ps) = axis[m + k - 1];
@@ -222,9 +261,9 @@ impl Ewald {
         W: Fn(usize, DVec3) -> f64 + Sync,
     {
         let ph = self.phases(position);
-        let m = self.n_max;
+        let m = self.table_max();
         let w = (2 * m + 1) as usize;
-        let tau = 2.0 * std::f64::consts::PI / self.box_length;
+        let tau = self.tau();
         let n = position.len();
         let structure: Vec<(f64, f64)> = kv
             .par_iter()
@@ -248,20 +287,20 @@ impl Ewald {
 
     /// A(k) = exp(−k²/4α²)/k² and k of a half-space vector.
     fn damping(&self, nk: &[i32; 3]) -> (f64, DVec3) {
-        let tau = 2.0 * std::f64::consts::PI / self.box_length;
-        let k = DVec3::new(nk[0] as f64, nk[1] as f64, nk[2] as f64) * tau;
+        let k = DVec3::new(nk[0] as f64, nk[1] as f64, nk[2] as f64) * self.tau();
         let k2 = k.length_squared();
         ((-k2 / (4.0 * self.alpha * self.alpha)).exp() / k2, k)
     }
 
-    /// Image offsets nL within reach of the cut-off for a minimum-image separation.
+    /// Image offsets (n_x L_x, n_y L_y, n_z L_z) within reach of the
+    /// cut-off for a minimum-image separation.
     fn images(&self) -> Vec<DVec3> {
-        let l = self.box_length;
-        let reach = (self.r_cut / l + 0.5).ceil() as i32;
+        let l = self.cell;
+        let reach = [0, 1, 2].map(|a| (self.r_cut / l[a] + 0.5).ceil() as i32);
         let mut out = Vec::new();
-        for a in -reach..=reach {
-            for b in -reach..=reach {
-                for c in -reach..=reach {
+        for a in -reach[0]..=reach[0] {
+            for b in -reach[1]..=reach[1] {
+                for c in -reach[2]..=reach[2] {
                     out.push(DVec3::new(a as f64, b as f64, c as f64) * l);
                 }
             }
@@ -270,7 +309,7 @@ impl Ewald {
     }
 
     fn minimum_image(&self, d: DVec3) -> DVec3 {
-        let l = self.box_length;
+        let l = self.cell;
         d - (d / l).round() * l
     }
 
@@ -278,30 +317,25 @@ impl Ewald {
     pub fn charges(&self, position: &[DVec3], charge: &[f64], force: Option<&mut [DVec3]>) -> f64 {
         let n = position.len();
         let (alpha, rc2) = (self.alpha, self.r_cut * self.r_cut);
-        let images = self.images();
-        let v = self.box_length.powi(3);
+        let near = RealSpace::new(self, position);
+        let v = self.volume();
         // Real space, parallel over i, each pair seen from both ends.
         let real: Vec<(f64, DVec3)> = (0..n)
             .into_par_iter()
             .map(|i| {
                 let mut u = 0.0;
                 let mut f = DVec3::ZERO;
-                for j in 0..n {
-                    let d0 = self.minimum_image(position[i] - position[j]);
-                    for img in &images {
-                        let r = d0 + *img;
-                        let r2 = r.length_squared();
-                        if r2 >= rc2 || (i == j && r2 == 0.0) {
-                            continue;
-                        }
-                        let rr = r2.sqrt();
-                        let e = erfc(alpha * rr);
-                        let qq = charge[i] * charge[j];
-                        u += 0.5 * qq * e / rr;
-                        let g = 2.0 * alpha / SQRT_PI * (-alpha * alpha * r2).exp();
-                        f += r * (qq * (e / rr + g) / r2);
+                near.visit(self, position, i, |j, r, r2| {
+                    if r2 >= rc2 {
+                        return;
                     }
-                }
+                    let rr = r2.sqrt();
+                    let e = erfc(alpha * rr);
+                    let qq = charge[i] * charge[j];
+                    u += 0.5 * qq * e / rr;
+                    let g = 2.0 * alpha / SQRT_PI * (-alpha * alpha * r2).exp();
+                    f += r * (qq * (e / rr + g) / r2);
+                });
                 (u, f)
             })
             .collect();
@@ -318,12 +352,12 @@ impl Ewald {
         let u_self = -alpha / SQRT_PI * q2
             - std::f64::consts::PI * q_total * q_total / (2.0 * v * alpha * alpha);
         if let Some(force) = force {
-            let w = (2 * self.n_max + 1) as usize;
+            let (m, w) = (self.table_max(), (2 * self.table_max() + 1) as usize);
             let damp: Vec<(f64, DVec3)> = kv.iter().map(|nk| self.damping(nk)).collect();
             force.par_iter_mut().enumerate().for_each(|(i, fi)| {
                 let mut f = DVec3::ZERO;
                 for ((nk, s), (a, k)) in kv.iter().zip(&ks.structure).zip(&damp) {
-                    let (c, sn) = phase(&ks.phases, i, w, self.n_max, nk);
+                    let (c, sn) = phase(&ks.phases, i, w, m, nk);
                     f += *k * (a * (sn * s.0 - c * s.1));
                 }
                 *fi += real[i].1 + f * (8.0 * std::f64::consts::PI * charge[i] / v);
@@ -344,36 +378,31 @@ impl Ewald {
         let n = position.len();
         let (alpha, rc2) = (self.alpha, self.r_cut * self.r_cut);
         let a2 = alpha * alpha;
-        let images = self.images();
-        let v = self.box_length.powi(3);
+        let near = RealSpace::new(self, position);
+        let v = self.volume();
         let pi = std::f64::consts::PI;
         let real: Vec<(f64, DVec3, DVec3)> = (0..n)
             .into_par_iter()
             .map(|i| {
                 let (mut u, mut f, mut h) = (0.0, DVec3::ZERO, DVec3::ZERO);
                 let mi = dipole[i];
-                for j in 0..n {
+                near.visit(self, position, i, |j, r, r2| {
                     let mj = dipole[j];
-                    let d0 = self.minimum_image(position[i] - position[j]);
-                    for img in &images {
-                        let r = d0 + *img;
-                        let r2 = r.length_squared();
-                        if r2 >= rc2 || (i == j && r2 == 0.0) {
-                            continue;
-                        }
-                        let rr = r2.sqrt();
-                        let e = erfc(alpha * rr);
-                        let g = 2.0 * alpha * rr / SQRT_PI * (-a2 * r2).exp();
-                        let b = (e + g) / (r2 * rr);
-                        let c = (3.0 * e + g * (3.0 + 2.0 * a2 * r2)) / (r2 * r2 * rr);
-                        let dd = (15.0 * e + g * (15.0 + 10.0 * a2 * r2 + 4.0 * a2 * a2 * r2 * r2))
-                            / (r2 * r2 * r2 * rr);
-                        let (mir, mjr, mm) = (mi.dot(r), mj.dot(r), mi.dot(mj));
-                        u += 0.5 * (mm * b - mir * mjr * c);
-                        f += r * (mm * c - dd * mir * mjr) + (mi * mjr + mj * mir) * c;
-                        h += r * (c * mjr) - mj * b;
+                    if r2 >= rc2 {
+                        return;
                     }
-                }
+                    let rr = r2.sqrt();
+                    let e = erfc(alpha * rr);
+                    let g = 2.0 * alpha * rr / SQRT_PI * (-a2 * r2).exp();
+                    let b = (e + g) / (r2 * rr);
+                    let c = (3.0 * e + g * (3.0 + 2.0 * a2 * r2)) / (r2 * r2 * rr);
+                    let dd = (15.0 * e + g * (15.0 + 10.0 * a2 * r2 + 4.0 * a2 * a2 * r2 * r2))
+                        / (r2 * r2 * r2 * rr);
+                    let (mir, mjr, mm) = (mi.dot(r), mj.dot(r), mi.dot(mj));
+                    u += 0.5 * (mm * b - mir * mjr * c);
+                    f += r * (mm * c - dd * mir * mjr) + (mi * mjr + mj * mir) * c;
+                    h += r * (c * mjr) - mj * b;
+                });
                 (u, f, h)
             })
             .collect();
@@ -388,7 +417,7 @@ impl Ewald {
         let m2: f64 = dipole.iter().map(|m| m.length_squared()).sum();
         let self_coeff = 2.0 * alpha * a2 / (3.0 * SQRT_PI);
         let u_self = -self_coeff * m2;
-        let w = (2 * self.n_max + 1) as usize;
+        let (m, w) = (self.table_max(), (2 * self.table_max() + 1) as usize);
         force
             .par_iter_mut()
             .zip(field.par_iter_mut())
@@ -396,7 +425,7 @@ impl Ewald {
             .for_each(|(i, (fi, hi))| {
                 let (mut f, mut h) = (DVec3::ZERO, DVec3::ZERO);
                 for ((nk, s), (a, k)) in kv.iter().zip(&ks.structure).zip(&damp) {
-                    let (c, sn) = phase(&ks.phases, i, w, self.n_max, nk);
+                    let (c, sn) = phase(&ks.phases, i, w, m, nk);
                     f += *k * (a * dipole[i].dot(*k) * (sn * s.0 - c * s.1));
                     h -= *k * (a * (c * s.0 + sn * s.1));
                 }
@@ -407,12 +436,115 @@ impl Ewald {
     }
 }
 
+/// The real-space pairs: linked cells when r_c ≤ L_a/3 on every axis (then
+/// only a pair's minimum image can lie within r_c, in one of the 27 cells
+/// around a particle's), otherwise every pair with every image in reach.
+struct RealSpace {
+    images: Vec<DVec3>,
+    /// Cells per axis (0: no cells).
+    dims: [usize; 3],
+    /// Particles of cell c are `order[start[c]..start[c + 1]]`, in index order.
+    start: Vec<u32>,
+    order: Vec<u32>,
+    cell_of: Vec<[usize; 3]>,
+}
+
+impl RealSpace {
+    fn new(ewald: &Ewald, position: &[DVec3]) -> Self {
+        let l = ewald.cell;
+        let dims = [0, 1, 2].map(|a| (l[a] / ewald.r_cut).floor() as usize);
+        if dims.iter().any(|&d| d < 3) || position.len() < 64 {
+            return Self {
+                images: ewald.images(),
+                dims: [0; 3],
+                start: Vec::new(),
+                order: Vec::new(),
+                cell_of: Vec::new(),
+            };
+        }
+        let cell_of: Vec<[usize; 3]> = position
+            .iter()
+            .map(|p| {
+                [0, 1, 2].map(|a| {
+                    let u = p[a] / l[a];
+                    (((u - u.floor()) * dims[a] as f64) as usize).min(dims[a] - 1)
+                })
+            })
+            .collect();
+        let flat = |c: [usize; 3]| (c[0] * dims[1] + c[1]) * dims[2] + c[2];
+        let mut start = vec![0u32; dims[0] * dims[1] * dims[2] + 1];
+        for c in &cell_of {
+            start[flat(*c) + 1] += 1;
+        }
+        for k in 1..start.len() {
+            start[k] += start[k - 1];
+        }
+        let mut fill = start.clone();
+        let mut order = vec![0u32; position.len()];
+        for (i, c) in cell_of.iter().enumerate() {
+            let slot = &mut fill[flat(*c)];
+            order[*slot as usize] = i as u32;
+            *slot += 1;
+        }
+        Self {
+            images: Vec::new(),
+            dims,
+            start,
+            order,
+            cell_of,
+        }
+    }
+
+    /// Calls `pair(j, r, r²)` for every j ≠ i (and every image of i itself)
+    /// that may lie within r_c, with r = r_i − r_j (the image's separation).
+    #[inline]
+    fn visit(
+        &self,
+        ewald: &Ewald,
+        position: &[DVec3],
+        i: usize,
+        mut pair: impl FnMut(usize, DVec3, f64),
+    ) {
+        if self.dims[0] == 0 {
+            for (j, pj) in position.iter().enumerate() {
+                let d0 = ewald.minimum_image(position[i] - *pj);
+                for img in &self.images {
+                    let r = d0 + *img;
+                    let r2 = r.length_squared();
+                    if !(i == j && r2 == 0.0) {
+                        pair(j, r, r2);
+                    }
+                }
+            }
+            return;
+        }
+        let d = self.dims;
+        let c = self.cell_of[i];
+        for dx in [d[0] - 1, 0, 1] {
+            for dy in [d[1] - 1, 0, 1] {
+                for dz in [d[2] - 1, 0, 1] {
+                    let cell = ((c[0] + dx) % d[0] * d[1] + (c[1] + dy) % d[1]) * d[2]
+                        + (c[2] + dz) % d[2];
+                    for &j in &self.order[self.start[cell] as usize..self.start[cell + 1] as usize]
+                    {
+                        let j = j as usize;
+                        if j != i {
+                            let r = ewald.minimum_image(position[i] - position[j]);
+                            pair(j, r, r.length_squared());
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 struct KSpace {
     phases: Vec<(f64, f64)>,
     structure: Vec<(f64, f64)>,
 }
 
-/// e^{ik·r_j} = Π_a e^{i 2π n_a x_a/L} from the per-axis phases.
+/// e^{ik·r_j} = Π_a e^{i 2π n_a x_a/L_a} from the per-axis phases.
 #[inline]
 fn phase(ph: &[(f64, f64)], j: usize, w: usize, m: i32, nk: &[i32; 3]) -> (f64, f64) {
     let at = |a: usize| ph[(j * 3 + a) * w + (nk[a] + m) as usize];

@@ -10,6 +10,7 @@ pub mod ewald;
 pub mod granular;
 mod gravity;
 mod lennard_jones;
+pub mod slab;
 mod springs;
 mod uniform;
 

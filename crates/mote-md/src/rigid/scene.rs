@@ -55,6 +55,12 @@
 //! skin = 0.2                   # Verlet skin (default 0.2 × the largest sphere diameter)
 //! periodic = [true, true, false]  # with box_lo, box_hi: periodic axes
 //!
+//! [rigid.planes]               # conducting planes z = box_lo.z and z = box_hi.z
+//! coulomb = 8.99e9             # k: Coulomb forces between charges with all their images
+//! potential = [0.0, -300.0]    # volts on the lower and the upper plane
+//! accuracy = 1e-12             # RMS force error of the Ewald sum (newtons)
+//! r_cut = 1e-4                 # real-space cut-off (default from the charges' spacing)
+//!
 //! [[rigid.wall]]               # as the granular [[wall]]
 //! kind = "box"
 //! lo = [0.0, 0.0, 0.0]
@@ -84,10 +90,13 @@ use super::bodies::RigidBodies;
 use super::contacts::RigidContacts;
 use super::frbi::{Frbi, FreeFlight, SpinUpdate};
 use super::shapes::{dumbbell, linear_trimer, IrregularClump};
-use super::sources::{AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity};
+use super::sources::{
+    AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity, PlaneCoulomb,
+};
 use super::template::{BodyTemplate, ClumpSpec, Integration};
 use crate::boundary::Boundary;
 use crate::force::granular::{ContactLaw, Damping, Material};
+use crate::force::slab::ConductingPlanes;
 
 /// A whole rigid scene file.
 #[derive(Debug, Deserialize)]
@@ -131,6 +140,25 @@ pub struct RigidSettings {
     #[serde(default)]
     /// `[[rigid.wall]]`: the keys of the granular `[[wall]]`.
     pub wall: Vec<Spanned<crate::scene::WallSpec>>,
+    /// `[rigid.planes]`: conducting planes bounding the box along z.
+    #[serde(default)]
+    pub planes: Option<Spanned<PlaneSettings>>,
+}
+
+/// `[rigid.planes]`: the box's faces z = box_lo.z and z = box_hi.z are
+/// conductors at the given potentials (the box periodic along x and y).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneSettings {
+    /// k = 1/(4πε₀).
+    pub coulomb: f64,
+    /// Potentials of the lower and the upper plane.
+    #[serde(default)]
+    pub potential: [f64; 2],
+    /// Requested RMS force error.
+    pub accuracy: f64,
+    #[serde(default)]
+    pub r_cut: Option<f64>,
 }
 
 /// `[[rigid.template]]`.
@@ -661,6 +689,13 @@ impl RigidScene {
             None => {}
         }
 
+        if let Some(p) = &rigid.planes {
+            frbi.push(Box::new(
+                plane_coulomb(p, &rigid.contacts, &rigid.fields, &bodies)
+                    .map_err(|m| err(p.span(), m))?,
+            ));
+        }
+
         // Run length.
         let (rspan, run) = (self.run.span(), self.run.get_ref());
         if !positive(run.dt) {
@@ -685,6 +720,60 @@ impl RigidScene {
             seed,
         })
     }
+}
+
+/// `[rigid.planes]` on the box of `[rigid.contacts]`.
+fn plane_coulomb(
+    p: &Spanned<PlaneSettings>,
+    contacts: &Option<Spanned<ContactSettings>>,
+    fields: &Option<Spanned<FieldSettings>>,
+    bodies: &RigidBodies,
+) -> Result<PlaneCoulomb, String> {
+    let ps = p.get_ref();
+    if fields
+        .as_ref()
+        .is_some_and(|f| f.get_ref().coulomb.is_some())
+    {
+        return Err("[rigid.planes] sums the Coulomb forces with their images: remove coulomb from [rigid.fields]".into());
+    }
+    let boxed = contacts.as_ref().and_then(|c| {
+        let c = c.get_ref();
+        match (c.periodic, c.box_lo, c.box_hi) {
+            (Some([true, true, false]), Some(lo), Some(hi)) => {
+                Some((DVec3::from(lo), DVec3::from(hi)))
+            }
+            _ => None,
+        }
+    });
+    let Some((lo, hi)) = boxed else {
+        return Err("[rigid.planes] needs [rigid.contacts] with periodic = [true, true, false], box_lo and box_hi (the planes are z = box_lo.z and z = box_hi.z)".into());
+    };
+    if !positive(ps.coulomb) || !positive(ps.accuracy) {
+        return Err("[rigid.planes] needs coulomb > 0 and accuracy > 0".into());
+    }
+    let charge: Vec<f64> = (0..bodies.len())
+        .map(|i| bodies.template(i).charge)
+        .filter(|&q| q != 0.0)
+        .collect();
+    let size = hi - lo;
+    let largest = size.x.min(size.y).min(2.0 * size.z) / 2.0;
+    // About 3.5 spacings of the doubled cell's 2N charges: some 180
+    // neighbours in reach, on linked cells.
+    let spacing = (2.0 * size.element_product() / (2 * charge.len().max(1)) as f64).cbrt();
+    let r_cut = ps.r_cut.unwrap_or((3.5 * spacing).min(largest));
+    if !positive(r_cut) || r_cut > largest * (1.0 + 1e-12) {
+        return Err(format!("[rigid.planes] r_cut must be > 0 and at most {largest} (half the smallest side of the box doubled along z)"));
+    }
+    let planes = ConductingPlanes::new(
+        ps.coulomb,
+        size.z,
+        [size.x, size.y],
+        ps.potential,
+        &charge,
+        r_cut,
+        ps.accuracy,
+    );
+    Ok(PlaneCoulomb { planes, z0: lo.z })
 }
 
 fn template_spec(

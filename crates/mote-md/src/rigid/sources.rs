@@ -14,6 +14,7 @@ use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
+use crate::force::slab::ConductingPlanes;
 
 /// A homogeneous field as a function of time.
 #[derive(Clone)]
@@ -295,5 +296,58 @@ impl BodyInteraction for DipoleDipole {
             }
         }
         self.k * u
+    }
+}
+
+/// Coulomb forces between the bodies' charges (at their centres of mass)
+/// between two conducting planes z = z₀ and z = z₀ + h, periodic along
+/// them: every image and the bias field ([`ConductingPlanes`], Ewald on the
+/// doubled cell). Replaces [`Coulomb`], which knows no planes.
+#[derive(Clone, Debug)]
+pub struct PlaneCoulomb {
+    pub planes: ConductingPlanes,
+    /// The height z₀ of the first plane.
+    pub z0: f64,
+}
+
+impl PlaneCoulomb {
+    /// The charged bodies' indices, positions relative to the first plane
+    /// and charges.
+    fn charged(&self, view: &BodyView<'_>) -> (Vec<usize>, Vec<DVec3>, Vec<f64>) {
+        let b = view.bodies;
+        let index: Vec<usize> = (0..b.len())
+            .filter(|&i| b.template(i).charge != 0.0)
+            .collect();
+        let shift = DVec3::new(0.0, 0.0, self.z0);
+        let position = index.iter().map(|&i| b.position[i] - shift).collect();
+        let charge = index.iter().map(|&i| b.template(i).charge).collect();
+        (index, position, charge)
+    }
+
+    /// The z-forces (F₀, F_h) on the two planes (Maxwell stress with lateral
+    /// modes up to `k_max`).
+    pub fn plane_forces(&self, view: &BodyView<'_>, k_max: f64) -> [f64; 2] {
+        let (_, position, charge) = self.charged(view);
+        self.planes.plane_forces(&position, &charge, k_max)
+    }
+}
+
+impl BodyInteraction for PlaneCoulomb {
+    fn name(&self) -> &str {
+        "Coulomb between conducting planes"
+    }
+
+    fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+        let (index, position, charge) = self.charged(view);
+        let mut force = vec![DVec3::ZERO; index.len()];
+        self.planes.evaluate(&position, &charge, Some(&mut force));
+        for (&i, f) in index.iter().zip(&force) {
+            wrench[i].v += *f;
+        }
+    }
+
+    fn potential_energy(&self, view: &BodyView<'_>, _t: f64) -> f64 {
+        let (_, position, charge) = self.charged(view);
+        self.planes.evaluate(&position, &charge, None).total()
     }
 }
