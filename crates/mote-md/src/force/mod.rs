@@ -9,6 +9,7 @@ mod electric;
 pub mod ewald;
 pub mod granular;
 mod gravity;
+pub mod latent;
 mod lennard_jones;
 pub mod slab;
 mod springs;

@@ -61,6 +61,12 @@
 //! accuracy = 1e-12             # RMS force error of the Ewald sum (newtons)
 //! r_cut = 1e-4                 # real-space cut-off (default from the charges' spacing)
 //!
+//! [rigid.latent_image]         # surface charge on a belt over the lower plane
+//! height = 2e-5                # electrical thickness d/ε_r of the photoconductor
+//! speed = 0.3                  # belt speed along x
+//! background = 0.0             # charge density outside the patches
+//! patches = [[1e-4, 3e-4, -5e-4]]  # [start, end, density]: x-intervals at t = 0
+//!
 //! [[rigid.wall]]               # as the granular [[wall]]
 //! kind = "box"
 //! lo = [0.0, 0.0, 0.0]
@@ -91,11 +97,12 @@ use super::contacts::RigidContacts;
 use super::frbi::{Frbi, FreeFlight, SpinUpdate};
 use super::shapes::{dumbbell, linear_trimer, IrregularClump};
 use super::sources::{
-    AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity, PlaneCoulomb,
+    AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity, LatentField, PlaneCoulomb,
 };
 use super::template::{BodyTemplate, ClumpSpec, Integration};
 use crate::boundary::Boundary;
 use crate::force::granular::{ContactLaw, Damping, Material};
+use crate::force::latent::{LatentImage, Patch};
 use crate::force::slab::ConductingPlanes;
 
 /// A whole rigid scene file.
@@ -143,6 +150,22 @@ pub struct RigidSettings {
     /// `[rigid.planes]`: conducting planes bounding the box along z.
     #[serde(default)]
     pub planes: Option<Spanned<PlaneSettings>>,
+    /// `[rigid.latent_image]`: charge on the belt over the lower plane.
+    #[serde(default)]
+    pub latent_image: Option<Spanned<LatentSettings>>,
+}
+
+/// `[rigid.latent_image]`: patches across the track, moving along x.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatentSettings {
+    pub height: f64,
+    #[serde(default)]
+    pub speed: f64,
+    #[serde(default)]
+    pub background: f64,
+    #[serde(default)]
+    pub patches: Vec<[f64; 3]>,
 }
 
 /// `[rigid.planes]`: the box's faces z = box_lo.z and z = box_hi.z are
@@ -689,11 +712,41 @@ impl RigidScene {
             None => {}
         }
 
+        let mut planes = None;
         if let Some(p) = &rigid.planes {
-            frbi.push(Box::new(
-                plane_coulomb(p, &rigid.contacts, &rigid.fields, &bodies)
-                    .map_err(|m| err(p.span(), m))?,
-            ));
+            let built = plane_coulomb(p, &rigid.contacts, &rigid.fields, &bodies)
+                .map_err(|m| err(p.span(), m))?;
+            planes = Some((built.planes.clone(), built.z0));
+            frbi.push(Box::new(built));
+        }
+        if let Some(l) = &rigid.latent_image {
+            let Some((planes, z0)) = &planes else {
+                return Err(err(
+                    l.span(),
+                    "[rigid.latent_image] needs [rigid.planes] (the belt is the lower plane)"
+                        .into(),
+                ));
+            };
+            let ls = l.get_ref();
+            let image = LatentImage {
+                k: planes.k,
+                gap: planes.gap,
+                height: ls.height,
+                period: planes.lateral[0],
+                speed: ls.speed,
+                background: ls.background,
+                patches: ls
+                    .patches
+                    .iter()
+                    .map(|p| Patch {
+                        start: p[0],
+                        end: p[1],
+                        density: p[2],
+                    })
+                    .collect(),
+            };
+            image.check().map_err(|m| err(l.span(), m))?;
+            frbi.push(Box::new(LatentField { image, z0: *z0 }));
         }
 
         // Run length.

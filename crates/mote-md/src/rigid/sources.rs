@@ -14,6 +14,7 @@ use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
+use crate::force::latent::LatentImage;
 use crate::force::slab::ConductingPlanes;
 
 /// A homogeneous field as a function of time.
@@ -349,5 +350,35 @@ impl BodyInteraction for PlaneCoulomb {
     fn potential_energy(&self, view: &BodyView<'_>, _t: f64) -> f64 {
         let (_, position, charge) = self.charged(view);
         self.planes.evaluate(&position, &charge, None).total()
+    }
+}
+
+/// The latent image's field ([`LatentImage`]) on the bodies' charges:
+/// `F = q E(x − vt, z − z₀)`, the belt's conductor at z = z₀. The field
+/// moves with the belt, so it has no time-independent potential: its work
+/// is not in the energy.
+#[derive(Clone, Debug)]
+pub struct LatentField {
+    pub image: LatentImage,
+    /// The height z₀ of the belt's conducting plane.
+    pub z0: f64,
+}
+
+impl BodyInteraction for LatentField {
+    fn name(&self) -> &str {
+        "latent image"
+    }
+
+    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+        let b = view.bodies;
+        for_each_body(b.len(), wrench, |i| {
+            let q = b.template(i).charge;
+            if q == 0.0 {
+                return DE::ZERO;
+            }
+            let x = b.position[i];
+            let (ex, ez) = self.image.field(x.x, x.z - self.z0, t);
+            DE::new(DVec3::ZERO, q * DVec3::new(ex, 0.0, ez))
+        });
     }
 }

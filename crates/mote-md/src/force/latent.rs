@@ -1,0 +1,175 @@
+//! The field of surface charge on a plane: a uniformly charged rectangle in
+//! open space, and the latent image of a photoconductor belt between two
+//! conducting planes.
+//!
+//! **A rectangle in open space.** A rectangle x′ ∈ [x₁, x₂], y′ ∈ [y₁, y₂]
+//! of the plane z = 0 with charge density σ has, with X = x − x′,
+//! Y = y − y′, R = (X² + Y² + z²)^{1/2} and the corner sum
+//! [[F]] = F(x−x₁, y−y₁) − F(x−x₁, y−y₂) − F(x−x₂, y−y₁) + F(x−x₂, y−y₂)
+//! (Durand, *Électrostatique* I (1964); Hummer, J. Chem. Phys. 105, 2004
+//! (1996), Eq. A1):
+//!
+//! φ = kσ [[X ln(Y + R) + Y ln(X + R) − z atan(XY/(zR))]],
+//! E_x = −kσ [[ln(Y + R)]], E_y = −kσ [[ln(X + R)]], E_z = kσ [[atan(XY/(zR))]],
+//!
+//! k = 1/(4πε₀). Far away it is the point charge σ(x₂−x₁)(y₂−y₁); just
+//! above its interior E_z → 2πkσ = σ/2ε₀.
+//!
+//! **The latent image.** The belt is a grounded conductor z = 0 under a
+//! photoconductor whose top surface z = d carries the image charge
+//! σ(x − vt): background σ_b, and patches [x₁, x₂] of density σ_p that span
+//! the box across the track (in a slice periodic along y, a narrower patch
+//! would be a stripe pattern anyway). The shell z = h is grounded too (its
+//! bias is [`super::slab::ConductingPlanes`]'s). The photoconductor's
+//! dielectric is taken as vacuum of the electrical thickness d = d_pc/ε_r.
+//! The field is two-dimensional; the map ζ = e^{πw/h}, w = x + iz, takes the
+//! gap to the upper half-plane, where the image of a line charge is its
+//! mirror, and integrating the line charges of a strip gives the field of
+//! a charged strip with all its images in both planes in closed form
+//! (z > d; u = π/h, θ₁ = u(z + d), θ₂ = u(z − d)):
+//!
+//! E_x − iE_z = 2kσ [Λ(x₂ − x) − Λ(x₁ − x)],
+//! Λ(s) = ln(1 − e^{us} e^{−iθ₁}) − ln(1 − e^{us} e^{−iθ₂})          (s ≤ 0),
+//! Λ(s) = ln(1 − e^{−us} e^{iθ₁}) − ln(1 − e^{−us} e^{iθ₂}) − 2iud    (s > 0),
+//!
+//! two forms of ln((ζ − ζ̄′)/(ζ − ζ′)) that agree at s = 0 and never
+//! overflow. The whole plane gives the uniform field E_z = 4πkσ d/h. The
+//! periodic copies of a strip along x, at distance s, add e^{−π|s|/h}: they
+//! are summed until that is below 10⁻¹⁷.
+
+use glam::DVec3;
+
+/// ln(Y + R) without cancellation where Y < 0 (R ≥ |Y|, R² − Y² = ρ²).
+#[inline]
+fn log_sum(y: f64, r: f64, rho2: f64) -> f64 {
+    if y >= 0.0 {
+        (y + r).ln()
+    } else {
+        (rho2 / (r - y)).ln()
+    }
+}
+
+/// Potential and field of the rectangle x′ ∈ `x`, y′ ∈ `y` of the plane
+/// z = 0 at the point `p`, per unit kσ (multiply both by kσ). Not defined
+/// on the rectangle itself (z = 0).
+pub fn rectangle(p: DVec3, x: [f64; 2], y: [f64; 2]) -> (f64, DVec3) {
+    let z = p.z;
+    let mut phi = 0.0;
+    let mut e = DVec3::ZERO;
+    for (xs, sx) in [(x[0], 1.0), (x[1], -1.0)] {
+        for (ys, sy) in [(y[0], 1.0), (y[1], -1.0)] {
+            let (a, b) = (p.x - xs, p.y - ys);
+            let r = (a * a + b * b + z * z).sqrt();
+            let s = sx * sy;
+            let ly = log_sum(b, r, a * a + z * z);
+            let lx = log_sum(a, r, b * b + z * z);
+            let t = if z == 0.0 {
+                0.0
+            } else {
+                (a * b / (z * r)).atan()
+            };
+            phi += s * (a * ly + b * lx - z * t);
+            e += s * DVec3::new(-ly, -lx, t);
+        }
+    }
+    (phi, e)
+}
+
+/// A patch of the latent image: x ∈ [start, end) at time 0 (it moves with
+/// the belt), charge density `density`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Patch {
+    pub start: f64,
+    pub end: f64,
+    pub density: f64,
+}
+
+/// The latent image on the belt z = d above the grounded plane z = 0, with
+/// the grounded shell z = h, periodic along x with period L.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LatentImage {
+    /// k = 1/(4πε₀).
+    pub k: f64,
+    /// The gap h between the conducting planes.
+    pub gap: f64,
+    /// The height d of the charged surface above the belt's conductor
+    /// (the photoconductor's electrical thickness).
+    pub height: f64,
+    /// The period L along x.
+    pub period: f64,
+    /// The belt's speed along x.
+    pub speed: f64,
+    /// Charge density σ_b outside the patches.
+    pub background: f64,
+    pub patches: Vec<Patch>,
+}
+
+/// ln(1 − A e^{iθ}) as (re, im), 0 ≤ A ≤ 1.
+#[inline]
+fn log_one_minus(a: f64, theta: f64) -> (f64, f64) {
+    let (s, c) = theta.sin_cos();
+    let (re, im) = (1.0 - a * c, -a * s);
+    (0.5 * (re * re + im * im).ln(), im.atan2(re))
+}
+
+impl LatentImage {
+    /// Checks the geometry: 0 < d < h, L > 0, patches inside one period.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.gap > 0.0 && self.height > 0.0 && self.height < self.gap) {
+            return Err("the latent image needs 0 < height < gap".into());
+        }
+        if self.period.is_nan() || self.period <= 0.0 {
+            return Err("the latent image needs a period > 0".into());
+        }
+        for p in &self.patches {
+            if !(p.end > p.start && p.end - p.start <= self.period) {
+                return Err(format!(
+                    "a patch [{}, {}] must have start < end within one period {}",
+                    p.start, p.end, self.period
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Λ(s) as (re, im) at height z.
+    #[inline]
+    fn lambda(&self, s: f64, z: f64) -> (f64, f64) {
+        let u = std::f64::consts::PI / self.gap;
+        let (t1, t2) = (u * (z + self.height), u * (z - self.height));
+        if s <= 0.0 {
+            let b = (u * s).exp();
+            let (a1, a2) = (log_one_minus(b, -t1), log_one_minus(b, -t2));
+            (a1.0 - a2.0, a1.1 - a2.1)
+        } else {
+            let a = (-u * s).exp();
+            let (a1, a2) = (log_one_minus(a, t1), log_one_minus(a, t2));
+            (a1.0 - a2.0, a1.1 - a2.1 - 2.0 * u * self.height)
+        }
+    }
+
+    /// The field (E_x, E_z) at (x, z), d < z < h, at time t.
+    pub fn field(&self, x: f64, z: f64, t: f64) -> (f64, f64) {
+        let (l, u) = (self.period, std::f64::consts::PI / self.gap);
+        let mut ex = 0.0;
+        let mut ez = 4.0 * std::f64::consts::PI * self.k * self.background * self.height / self.gap;
+        // Copies beyond n periods add e^{−u(nL − w)}; 39.2 = ln 10¹⁷.
+        for p in &self.patches {
+            let w = p.end - p.start;
+            let mid = 0.5 * (p.start + p.end) + self.speed * t - x;
+            let c = mid - (mid / l).round() * l;
+            let reach = ((39.2 / u + w) / l).ceil() as i64 + 1;
+            let (mut re, mut im) = (0.0, 0.0);
+            for n in -reach..=reach {
+                let s = c + n as f64 * l;
+                let (a, b) = (self.lambda(s + 0.5 * w, z), self.lambda(s - 0.5 * w, z));
+                re += a.0 - b.0;
+                im += a.1 - b.1;
+            }
+            let scale = 2.0 * self.k * (p.density - self.background);
+            ex += scale * re;
+            ez -= scale * im;
+        }
+        (ex, ez)
+    }
+}
