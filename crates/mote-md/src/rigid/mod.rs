@@ -10,7 +10,9 @@
 //!   as a structure of arrays — and its observables;
 //! - [`interaction`]: the [`BodyInteraction`] trait and the world-frame view
 //!   of spheres and dipoles it reads (where contact models plug in);
-//! - [`sources`]: fields, gravity, drag, Coulomb, dipole–dipole;
+//! - [`sources`]: fields, gravity, drag, Coulomb (in open space or between
+//!   conducting planes), dipole–dipole, the latent image;
+//! - [`magnet`]: the magnetic roller and the moments it induces;
 //! - [`contacts`]: Hertz–Mindlin contacts between spheres of different
 //!   bodies and with walls;
 //! - [`scene`]: the `[rigid]` scene format and its runner;
@@ -24,6 +26,7 @@ pub mod frbi;
 mod free8;
 pub mod from_file;
 pub mod interaction;
+pub mod magnet;
 pub mod run;
 pub mod scene;
 pub mod shapes;

@@ -67,6 +67,16 @@
 //! background = 0.0             # charge density outside the patches
 //! patches = [[1e-4, 3e-4, -5e-4]]  # [start, end, density]: x-intervals at t = 0
 //!
+//! [rigid.roller]               # magnetic roller inside the upper plane (the shell)
+//! field = 0.08                 # B₀ (T) at the shell's surface
+//! poles = 8
+//! radius = 0.01                # shell radius: the axis is this far above the upper plane
+//! frequency = 5.0              # roller turns per second (negative: the other way)
+//! x = 2e-4                     # x of the axis (default: the box's centre)
+//! dipole_dipole = 1e-7         # μ0/4π: forces between the induced moments (off if absent)
+//! iterations = 2               # passes of mutual induction
+//! magnetic = [{ template = "carrier", permeability = 6.0, saturation = 3.3e5 }]
+//!
 //! [[rigid.wall]]               # as the granular [[wall]]
 //! kind = "box"
 //! lo = [0.0, 0.0, 0.0]
@@ -95,6 +105,7 @@ use toml::Spanned;
 use super::bodies::RigidBodies;
 use super::contacts::RigidContacts;
 use super::frbi::{Frbi, FreeFlight, SpinUpdate};
+use super::magnet::{InducedDipoles, MagneticRoller};
 use super::shapes::{dumbbell, linear_trimer, IrregularClump};
 use super::sources::{
     AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity, LatentField, PlaneCoulomb,
@@ -153,6 +164,38 @@ pub struct RigidSettings {
     /// `[rigid.latent_image]`: charge on the belt over the lower plane.
     #[serde(default)]
     pub latent_image: Option<Spanned<LatentSettings>>,
+    /// `[rigid.roller]`: the magnetic roller above the upper plane.
+    #[serde(default)]
+    pub roller: Option<Spanned<RollerSettings>>,
+}
+
+/// `[rigid.roller]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RollerSettings {
+    pub field: f64,
+    pub poles: u32,
+    pub radius: f64,
+    #[serde(default)]
+    pub frequency: f64,
+    #[serde(default)]
+    pub x: Option<f64>,
+    #[serde(default)]
+    pub dipole_dipole: f64,
+    #[serde(default)]
+    pub iterations: u32,
+    pub magnetic: Vec<MagneticSpec>,
+}
+
+/// A magnetic template of `[rigid.roller]`: relative permeability μ_r and
+/// saturation magnetisation M_s (A/m; absent: none).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MagneticSpec {
+    pub template: String,
+    pub permeability: f64,
+    #[serde(default)]
+    pub saturation: Option<f64>,
 }
 
 /// `[rigid.latent_image]`: patches across the track, moving along x.
@@ -748,6 +791,11 @@ impl RigidScene {
             image.check().map_err(|m| err(l.span(), m))?;
             frbi.push(Box::new(LatentField { image, z0: *z0 }));
         }
+        if let Some(r) = &rigid.roller {
+            let model = induced_dipoles(r.get_ref(), &rigid.contacts, &names, &bodies)
+                .map_err(|m| err(r.span(), m))?;
+            frbi.push(Box::new(model));
+        }
 
         // Run length.
         let (rspan, run) = (self.run.span(), self.run.get_ref());
@@ -773,6 +821,71 @@ impl RigidScene {
             seed,
         })
     }
+}
+
+/// `[rigid.roller]` above the box of `[rigid.contacts]`.
+fn induced_dipoles(
+    rs: &RollerSettings,
+    contacts: &Option<Spanned<ContactSettings>>,
+    names: &[(String, u32)],
+    bodies: &RigidBodies,
+) -> Result<InducedDipoles, String> {
+    let boxed = contacts.as_ref().and_then(|c| {
+        let c = c.get_ref();
+        match (c.periodic, c.box_lo, c.box_hi) {
+            (Some(p), Some(lo), Some(hi)) if p[0] && p[1] => {
+                Some((DVec3::from(lo), DVec3::from(hi)))
+            }
+            _ => None,
+        }
+    });
+    let Some((lo, hi)) = boxed else {
+        return Err("[rigid.roller] needs [rigid.contacts] periodic along x and y with box_lo and box_hi (the shell is z = box_hi.z)".into());
+    };
+    if !positive(rs.field) || !positive(rs.radius) || rs.poles < 2 || !rs.poles.is_multiple_of(2) {
+        return Err(
+            "[rigid.roller] needs field > 0, radius > 0 and an even number of poles".into(),
+        );
+    }
+    let n = bodies.templates.len();
+    let (mut polarisability, mut saturation) = (vec![0.0; n], vec![f64::INFINITY; n]);
+    for m in &rs.magnetic {
+        let Some((_, k)) = names.iter().find(|(name, _)| *name == m.template) else {
+            return Err(format!(
+                "[rigid.roller] names unknown template '{}'",
+                m.template
+            ));
+        };
+        if m.permeability.is_nan()
+            || m.permeability < 1.0
+            || m.saturation.is_some_and(|s| !positive(s))
+        {
+            return Err(
+                "[rigid.roller] magnetic templates need permeability >= 1 and saturation > 0"
+                    .into(),
+            );
+        }
+        let volume = bodies.templates[*k as usize].props.volume;
+        polarisability[*k as usize] = InducedDipoles::polarisability(volume, m.permeability);
+        if let Some(ms) = m.saturation {
+            saturation[*k as usize] = ms * volume;
+        }
+    }
+    let roller = MagneticRoller {
+        field: rs.field,
+        poles: rs.poles,
+        radius: rs.radius,
+        angular_velocity: 2.0 * std::f64::consts::PI * rs.frequency,
+        axis: [rs.x.unwrap_or(0.5 * (lo.x + hi.x)), hi.z + rs.radius],
+    };
+    Ok(InducedDipoles {
+        roller,
+        polarisability,
+        saturation,
+        dipole_dipole: rs.dipole_dipole,
+        iterations: rs.iterations,
+        period: [hi.x - lo.x, hi.y - lo.y],
+    })
 }
 
 /// `[rigid.planes]` on the box of `[rigid.contacts]`.

@@ -1,0 +1,220 @@
+//! The magnetic roller of a magnetic brush and the moments it induces in
+//! soft-magnetic carrier beads.
+//!
+//! **The roller.** A roller with N poles (n = N/2 pole pairs) turning at
+//! angular velocity Ω about an axis along y at (x_a, z_a) has outside its
+//! surface the two-dimensional multipole field (harmonic: curl- and
+//! divergence-free; the pole pattern's fundamental)
+//!
+//! B_r = B₀ (R/r)^{n+1} cos n(θ − Ωt),   B_θ = B₀ (R/r)^{n+1} sin n(θ − Ωt),
+//!
+//! in polar coordinates about the axis, B₀ the field at radius R (the shell
+//! surface). In complex form, w = (x − x_a) + i(z − z_a):
+//! B_x − iB_z = B₀ R^{n+1} e^{inΩt} w^{−(n+1)}, so that the field turns in
+//! the track plane at every point, with frequency nΩ/2π, and its magnitude
+//! B₀(R/r)^{n+1} decays away from the shell; ∂_x(B_x − iB_z) = F′(w),
+//! ∂_z(B_x − iB_z) = iF′(w), F′ = −(n + 1)F/w.
+//!
+//! **Induced moments.** A sphere of volume V and relative permeability μ_r
+//! in a field B takes the moment m = 3Vβ B/μ₀, β = (μ_r − 1)/(μ_r + 2)
+//! (Jackson §5.11), at most M_s V (saturation). With `iterations` > 0 the
+//! moments see each other's dipole fields too (mutual induction by fixed
+//! point, m_i = α(B(x_i) + Σ_j B_j(x_i))). Each moment feels
+//! F = (m·∇)B of the roller and the dipole–dipole forces of the others
+//! (minimum image along the periodic axes); the moments are taken as
+//! isotropic, along the local field, so they exert no torque.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use mote_geom::DE;
+use rayon::prelude::*;
+
+use super::interaction::{BodyInteraction, BodyView};
+
+/// μ₀ in SI.
+pub const MU0: f64 = 4.0e-7 * PI;
+
+/// The roller's field as a function of place and time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagneticRoller {
+    /// B₀: the field's magnitude at radius R.
+    pub field: f64,
+    /// N, the number of poles (even).
+    pub poles: u32,
+    /// R: the radius at which B₀ is given (the shell's outer surface).
+    pub radius: f64,
+    /// Ω: the roller's angular velocity (rad/s).
+    pub angular_velocity: f64,
+    /// The axis (x_a, z_a).
+    pub axis: [f64; 2],
+}
+
+impl MagneticRoller {
+    /// F(w) = B_x − iB_z and F′(w) as ((re, im), (re, im)).
+    #[inline]
+    fn complex_field(&self, x: f64, z: f64, t: f64) -> ((f64, f64), (f64, f64)) {
+        let n = (self.poles / 2) as f64;
+        let (wx, wz) = (x - self.axis[0], z - self.axis[1]);
+        let r = wx.hypot(wz);
+        let theta = wz.atan2(wx);
+        // B₀ R^{n+1} e^{inΩt} r^{−(n+1)} e^{−i(n+1)θ}.
+        let mag = self.field * (self.radius / r).powf(n + 1.0);
+        let (s, c) = (n * self.angular_velocity * t - (n + 1.0) * theta).sin_cos();
+        let f = (mag * c, mag * s);
+        // F′ = −(n + 1) F/w, 1/w = (wx − i wz)/r².
+        let (ix, iz) = (wx / (r * r), -wz / (r * r));
+        let d = (
+            -(n + 1.0) * (f.0 * ix - f.1 * iz),
+            -(n + 1.0) * (f.0 * iz + f.1 * ix),
+        );
+        (f, d)
+    }
+
+    /// B at (x, ·, z), time t.
+    pub fn at(&self, p: DVec3, t: f64) -> DVec3 {
+        let ((bx, mbz), _) = self.complex_field(p.x, p.z, t);
+        DVec3::new(bx, 0.0, -mbz)
+    }
+
+    /// B and (m·∇)B at `p`.
+    pub fn with_gradient(&self, p: DVec3, m: DVec3, t: f64) -> (DVec3, DVec3) {
+        let ((bx, mbz), (dr, di)) = self.complex_field(p.x, p.z, t);
+        // ∂_x B_x = Re F′, ∂_x B_z = −Im F′, ∂_z B_x = −Im F′, ∂_z B_z = −Re F′.
+        let grad = DVec3::new(m.x * dr - m.z * di, 0.0, -m.x * di - m.z * dr);
+        (DVec3::new(bx, 0.0, -mbz), grad)
+    }
+}
+
+/// The moments induced by the roller in bodies of given permeability.
+#[derive(Clone, Debug)]
+pub struct InducedDipoles {
+    pub roller: MagneticRoller,
+    /// α per template: m = α B (A·m²/T), 0 for non-magnetic bodies.
+    pub polarisability: Vec<f64>,
+    /// The largest moment per template (M_s V; infinite: no saturation).
+    pub saturation: Vec<f64>,
+    /// μ₀/4π for the forces between the moments (0: none).
+    pub dipole_dipole: f64,
+    /// Passes of mutual induction.
+    pub iterations: u32,
+    /// Periods along x and y (0: open).
+    pub period: [f64; 2],
+}
+
+impl InducedDipoles {
+    /// α = 3Vβ/μ₀ of a body of volume V and relative permeability μ_r.
+    pub fn polarisability(volume: f64, permeability: f64) -> f64 {
+        3.0 * volume * (permeability - 1.0) / (permeability + 2.0) / MU0
+    }
+
+    fn separation(&self, d: DVec3) -> DVec3 {
+        let mut d = d;
+        for a in 0..2 {
+            let l = self.period[a];
+            if l > 0.0 {
+                d[a] -= (d[a] / l).round() * l;
+            }
+        }
+        d
+    }
+
+    /// The magnetic bodies, their positions and moments at time t.
+    pub fn moments(&self, view: &BodyView<'_>, t: f64) -> (Vec<usize>, Vec<DVec3>, Vec<DVec3>) {
+        let b = view.bodies;
+        let index: Vec<usize> = (0..b.len())
+            .filter(|&i| self.polarisability[b.kind[i] as usize] > 0.0)
+            .collect();
+        let x: Vec<DVec3> = index.iter().map(|&i| b.position[i]).collect();
+        let alpha: Vec<f64> = index
+            .iter()
+            .map(|&i| self.polarisability[b.kind[i] as usize])
+            .collect();
+        let cap: Vec<f64> = index
+            .iter()
+            .map(|&i| self.saturation[b.kind[i] as usize])
+            .collect();
+        let external: Vec<DVec3> = x.iter().map(|p| self.roller.at(*p, t)).collect();
+        let induce = |local: DVec3, k: usize| {
+            let m = alpha[k] * local;
+            let len = m.length();
+            if len > cap[k] {
+                m * (cap[k] / len)
+            } else {
+                m
+            }
+        };
+        let mut m: Vec<DVec3> = external
+            .iter()
+            .enumerate()
+            .map(|(k, b)| induce(*b, k))
+            .collect();
+        if self.dipole_dipole > 0.0 {
+            for _ in 0..self.iterations {
+                let next: Vec<DVec3> = (0..x.len())
+                    .into_par_iter()
+                    .map(|i| {
+                        let mut local = external[i];
+                        for j in 0..x.len() {
+                            if j != i {
+                                local += self.dipole_field(x[i] - x[j], m[j]);
+                            }
+                        }
+                        induce(local, i)
+                    })
+                    .collect();
+                m = next;
+            }
+        }
+        (index, x, m)
+    }
+
+    /// The field at separation d = x − x_j of the moment m_j:
+    /// k [3 d(m·d)/d⁵ − m/d³].
+    #[inline]
+    fn dipole_field(&self, d: DVec3, m: DVec3) -> DVec3 {
+        let d = self.separation(d);
+        let r2 = d.length_squared();
+        let inv3 = 1.0 / (r2 * r2.sqrt());
+        self.dipole_dipole * (3.0 * m.dot(d) / r2 * d - m) * inv3
+    }
+}
+
+impl BodyInteraction for InducedDipoles {
+    fn name(&self) -> &str {
+        "magnetic roller"
+    }
+
+    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+        let (index, x, m) = self.moments(view, t);
+        let k = self.dipole_dipole;
+        let force: Vec<DVec3> = (0..x.len())
+            .into_par_iter()
+            .map(|i| {
+                let mi = m[i];
+                let (_, mut f) = self.roller.with_gradient(x[i], mi, t);
+                if k > 0.0 {
+                    for j in 0..x.len() {
+                        if j == i {
+                            continue;
+                        }
+                        // F_i = 3k/r⁵ [(m_i·m_j) r + m_i(m_j·r) + m_j(m_i·r) − 5(m_i·r)(m_j·r) r/r²].
+                        let r = self.separation(x[i] - x[j]);
+                        let mj = m[j];
+                        let r2 = r.length_squared();
+                        let inv5 = 1.0 / (r2 * r2 * r2.sqrt());
+                        let (a, b) = (mi.dot(r), mj.dot(r));
+                        f += 3.0
+                            * k
+                            * inv5
+                            * (mi.dot(mj) * r + b * mi + a * mj - 5.0 * a * b / r2 * r);
+                    }
+                }
+                f
+            })
+            .collect();
+        for (&i, f) in index.iter().zip(&force) {
+            wrench[i].v += *f;
+        }
+    }
+}
