@@ -37,6 +37,7 @@ const RIGID: &[(&str, &str)] = &[
     scene!("magnet-in-field", "rigid/magnet-in-field.toml"),
     scene!("clumps-settling", "rigid/clumps-settling.toml"),
     scene!("chains-rotating-field", "rigid/chains-rotating-field.toml"),
+    scene!("toning-nip", "rigid/toning-nip.toml"),
 ];
 
 const PACKING: &[(&str, &str)] = &[scene!("rcp", "packing/rcp.toml")];

@@ -20,6 +20,7 @@ fn examples_build() {
         "magnet-in-field.toml",
         "clumps-settling.toml",
         "chains-rotating-field.toml",
+        "toning-nip.toml",
     ] {
         let text = example(name);
         assert!(is_rigid_scene(&text));

@@ -213,30 +213,36 @@ fn a_bias_alone_gives_the_uniform_field() {
 
 #[test]
 fn linked_cells_give_the_all_pairs_real_space_sum() {
-    // 300 charges, r_c = L/3.5: the real-space sum runs on linked cells;
-    // at r_c = L/2 it runs over all pairs. Both meet the requested accuracy.
-    let cell = DVec3::new(1.0, 1.3, 0.9);
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
-    let pos: Vec<DVec3> = (0..300)
-        .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()) * cell)
-        .collect();
-    let mut q: Vec<f64> = (0..300).map(|_| rng.gen_range(-1.0..1.0)).collect();
-    let mean = q.iter().sum::<f64>() / q.len() as f64;
-    q.iter_mut().for_each(|x| *x -= mean);
-    let cells = Ewald::for_charges_in(cell, 0.9 / 3.5, 1e-9, &q);
-    let pairs = Ewald::for_charges_in(cell, 0.45, 1e-9, &q);
-    let (mut fa, mut fb) = (vec![DVec3::ZERO; 300], vec![DVec3::ZERO; 300]);
-    let ua = cells.charges(&pos, &q, Some(&mut fa));
-    let ub = pairs.charges(&pos, &q, Some(&mut fb));
-    assert!((ua - ub).abs() < 1e-7 * ub.abs(), "{ua} against {ub}");
-    let rms = (fa
-        .iter()
-        .zip(&fb)
-        .map(|(a, b)| (*a - *b).length_squared())
-        .sum::<f64>()
-        / 300.0)
-        .sqrt();
-    assert!(rms < 1e-8, "RMS force difference {rms}");
+    // 300 charges: at the smaller cut-off the real-space sum runs on
+    // linked cells (three or more cells per axis; in the second box two
+    // along y, all visited); at the larger one, beyond half a side, over
+    // all pairs and images. Both meet the requested accuracy.
+    for (cell, small, large) in [
+        (DVec3::new(1.0, 1.3, 0.9), 0.9 / 3.5, 0.45),
+        (DVec3::new(1.0, 0.45, 0.9), 0.22, 0.46),
+    ] {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(9);
+        let pos: Vec<DVec3> = (0..300)
+            .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()) * cell)
+            .collect();
+        let mut q: Vec<f64> = (0..300).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let mean = q.iter().sum::<f64>() / q.len() as f64;
+        q.iter_mut().for_each(|x| *x -= mean);
+        let cells = Ewald::for_charges_in(cell, small, 1e-9, &q);
+        let pairs = Ewald::for_charges_in(cell, large, 1e-9, &q);
+        let (mut fa, mut fb) = (vec![DVec3::ZERO; 300], vec![DVec3::ZERO; 300]);
+        let ua = cells.charges(&pos, &q, Some(&mut fa));
+        let ub = pairs.charges(&pos, &q, Some(&mut fb));
+        assert!((ua - ub).abs() < 1e-7 * ub.abs(), "{ua} against {ub}");
+        let rms = (fa
+            .iter()
+            .zip(&fb)
+            .map(|(a, b)| (*a - *b).length_squared())
+            .sum::<f64>()
+            / 300.0)
+            .sqrt();
+        assert!(rms < 1e-8, "RMS force difference {rms}");
+    }
 }
 
 #[test]

@@ -436,9 +436,10 @@ impl Ewald {
     }
 }
 
-/// The real-space pairs: linked cells when r_c ≤ L_a/3 on every axis (then
-/// only a pair's minimum image can lie within r_c, in one of the 27 cells
-/// around a particle's), otherwise every pair with every image in reach.
+/// The real-space pairs: linked cells when r_c ≤ L_a/2 on every axis (then
+/// only a pair's minimum image can lie within r_c: in one of the three
+/// cells around a particle's along an axis of three cells or more, in any
+/// along the others), otherwise every pair with every image in reach.
 struct RealSpace {
     images: Vec<DVec3>,
     /// Cells per axis (0: no cells).
@@ -452,8 +453,9 @@ struct RealSpace {
 impl RealSpace {
     fn new(ewald: &Ewald, position: &[DVec3]) -> Self {
         let l = ewald.cell;
-        let dims = [0, 1, 2].map(|a| (l[a] / ewald.r_cut).floor() as usize);
-        if dims.iter().any(|&d| d < 3) || position.len() < 64 {
+        let dims = [0, 1, 2].map(|a| ((l[a] / ewald.r_cut).floor() as usize).max(1));
+        let minimum_image_suffices = (0..3).all(|a| ewald.r_cut <= 0.5 * l[a]);
+        if !minimum_image_suffices || position.len() < 64 {
             return Self {
                 images: ewald.images(),
                 dims: [0; 3],
@@ -520,11 +522,23 @@ impl RealSpace {
         }
         let d = self.dims;
         let c = self.cell_of[i];
-        for dx in [d[0] - 1, 0, 1] {
-            for dy in [d[1] - 1, 0, 1] {
-                for dz in [d[2] - 1, 0, 1] {
-                    let cell = ((c[0] + dx) % d[0] * d[1] + (c[1] + dy) % d[1]) * d[2]
-                        + (c[2] + dz) % d[2];
+        // Along an axis of three or more cells the neighbours lie in the
+        // cell and the two beside it; along one of fewer, in any cell.
+        let offsets = |a: usize| -> &'static [usize] {
+            match d[a] {
+                1 => &[0],
+                2 => &[0, 1],
+                _ => &[usize::MAX, 0, 1],
+            }
+        };
+        let wrap = |a: usize, o: usize| (c[a] + if o == usize::MAX { d[a] - 1 } else { o }) % d[a];
+        for &ox in offsets(0) {
+            let cx = wrap(0, ox);
+            for &oy in offsets(1) {
+                let cy = wrap(1, oy);
+                for &oz in offsets(2) {
+                    let cz = wrap(2, oz);
+                    let cell = (cx * d[1] + cy) * d[2] + cz;
                     for &j in &self.order[self.start[cell] as usize..self.start[cell + 1] as usize]
                     {
                         let j = j as usize;

@@ -13,6 +13,7 @@
 //! - [`sources`]: fields, gravity, drag, Coulomb (in open space or between
 //!   conducting planes), dipole–dipole, the latent image;
 //! - [`magnet`]: the magnetic roller and the moments it induces;
+//! - [`nip`]: a toning nip's observables (developed toner, brush, free volume);
 //! - [`contacts`]: Hertz–Mindlin contacts between spheres of different
 //!   bodies and with walls;
 //! - [`scene`]: the `[rigid]` scene format and its runner;
@@ -27,6 +28,7 @@ mod free8;
 pub mod from_file;
 pub mod interaction;
 pub mod magnet;
+pub mod nip;
 pub mod run;
 pub mod scene;
 pub mod shapes;

@@ -440,6 +440,15 @@ pub fn run_rigid_scene(
             every: scene.output.trajectory_every,
         }));
     }
+    if let Some((probe, every)) = built.nip.take() {
+        driver.observers.push(Box::new(super::nip::NipCsv::create(
+            &dir.join("nip.csv"),
+            &provenance,
+            probe,
+            every,
+            append,
+        )?));
+    }
     driver.checkpoints = options.checkpoints.clone();
     driver.sample_at_start = !append;
     let (seed, dt, last_step) = (built.seed, built.dt, built.steps);

@@ -304,11 +304,36 @@ impl BodyInteraction for DipoleDipole {
 /// between two conducting planes z = z₀ and z = z₀ + h, periodic along
 /// them: every image and the bias field ([`ConductingPlanes`], Ewald on the
 /// doubled cell). Replaces [`Coulomb`], which knows no planes.
-#[derive(Clone, Debug)]
+///
+/// With `every` = n > 1 the charges' forces on one another (with their
+/// images) are summed at every n-th evaluation and held in between (a
+/// zero-order hold: the slow long-range part on a coarser clock than the
+/// contacts); the bias field acts at every step.
+#[derive(Debug)]
 pub struct PlaneCoulomb {
     pub planes: ConductingPlanes,
     /// The height z₀ of the first plane.
     pub z0: f64,
+    pub every: u64,
+    held: std::sync::Mutex<HeldForces>,
+}
+
+/// The last sum of the charges' forces on one another, per body.
+#[derive(Debug, Default)]
+struct HeldForces {
+    calls: u64,
+    force: Vec<(usize, DVec3)>,
+}
+
+impl PlaneCoulomb {
+    pub fn new(planes: ConductingPlanes, z0: f64, every: u64) -> Self {
+        PlaneCoulomb {
+            planes,
+            z0,
+            every: every.max(1),
+            held: Default::default(),
+        }
+    }
 }
 
 impl PlaneCoulomb {
@@ -339,17 +364,63 @@ impl BodyInteraction for PlaneCoulomb {
     }
 
     fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+        let mut held = self.held.lock().unwrap_or_else(|e| e.into_inner());
         let (index, position, charge) = self.charged(view);
-        let mut force = vec![DVec3::ZERO; index.len()];
-        self.planes.evaluate(&position, &charge, Some(&mut force));
-        for (&i, f) in index.iter().zip(&force) {
-            wrench[i].v += *f;
+        if held.calls.is_multiple_of(self.every) || held.force.len() != index.len() {
+            let mut force = vec![DVec3::ZERO; index.len()];
+            self.planes.evaluate(&position, &charge, Some(&mut force));
+            let bias = self.planes.bias_field();
+            held.force = index
+                .iter()
+                .zip(&force)
+                .zip(&charge)
+                .map(|((&i, f), q)| (i, *f - *q * bias))
+                .collect();
+        }
+        held.calls += 1;
+        let bias = self.planes.bias_field();
+        for ((i, f), q) in held.force.iter().zip(&charge) {
+            wrench[*i].v += *f + *q * bias;
         }
     }
 
     fn potential_energy(&self, view: &BodyView<'_>, _t: f64) -> f64 {
         let (_, position, charge) = self.charged(view);
         self.planes.evaluate(&position, &charge, None).total()
+    }
+
+    /// The held forces and the evaluation count (so that a resumed run
+    /// refreshes them at the same steps): [calls, (body, fx, fy, fz)…].
+    fn carried_state(&self) -> Vec<f64> {
+        if self.every == 1 {
+            return Vec::new();
+        }
+        let held = self.held.lock().unwrap_or_else(|e| e.into_inner());
+        let mut out = vec![held.calls as f64];
+        for (i, f) in &held.force {
+            out.extend([*i as f64, f.x, f.y, f.z]);
+        }
+        out
+    }
+
+    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
+        if state.is_empty() {
+            return Ok(());
+        }
+        if self.every == 1 || state.len() % 4 != 1 {
+            return Err(format!(
+                "{}: a held state of {} numbers does not fit",
+                self.name(),
+                state.len()
+            ));
+        }
+        let mut held = self.held.lock().unwrap_or_else(|e| e.into_inner());
+        held.calls = state[0] as u64;
+        held.force = state[1..]
+            .chunks(4)
+            .map(|c| (c[0] as usize, DVec3::new(c[1], c[2], c[3])))
+            .collect();
+        Ok(())
     }
 }
 

@@ -1,0 +1,263 @@
+//! What a printer engineer reads off a toning nip (seed 000): the toner
+//! developed onto the belt, on the image and on the background, the
+//! carrier brush and the free volume, written to nip.csv.
+//!
+//! - **Developed toner**: toner bodies whose centre is within 10 % of
+//!   their radius of the belt's surface z_b (touching it). Each is on the
+//!   image when its x in the belt's frame, x − vt (mod L), lies in a patch.
+//!   Mass per area M/A = Σ m/A_region (kg/m²; 1 kg/m² = 100 mg/cm²) and
+//!   charge per area q/A on the image and the background; `neutralised` is
+//!   −(q/A on the image)/(σ_patch − σ_background), the fraction of the
+//!   image's contrast the toner has cancelled (the space-charge limit of
+//!   development is 1).
+//! - **Brush**: carriers touching (sphere gaps below 2 % of the radii sum,
+//!   minimum image along x and y) form clusters; `chains` counts them,
+//!   `bridges` those touching both the shell and the belt (within one
+//!   carrier sphere radius), `brush_height` is the mean reach of the
+//!   clusters that touch the shell, z_s − (lowest sphere bottom).
+//! - **Free volume**: 1 − (volume of all bodies)/(L_x L_y (z_s − z_b)).
+
+use std::path::Path;
+
+use glam::DVec3;
+use mote_io::csv::CsvWriter;
+use mote_io::Provenance;
+use mote_run::Observer;
+
+use super::bodies::RigidBodies;
+use super::interaction::WorldFrame;
+use super::run::{RigidDynamics, RigidSample};
+use crate::error::MdError;
+
+/// The nip's geometry and the templates it tells apart.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NipProbe {
+    pub toner: u32,
+    pub carrier: u32,
+    /// The belt's surface z_b and the shell's z_s.
+    pub belt: f64,
+    pub shell: f64,
+    /// The box's x and y extent.
+    pub lo: DVec3,
+    pub hi: DVec3,
+    /// Image patches [start, end) at t = 0, moving at `speed` along x.
+    pub patches: Vec<[f64; 2]>,
+    pub speed: f64,
+    /// The latent image's contrast σ_patch − σ_background (0: none).
+    pub contrast: f64,
+}
+
+/// One measurement.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct NipSample {
+    pub developed: usize,
+    pub mass_image: f64,
+    pub mass_background: f64,
+    pub charge_image: f64,
+    pub charge_background: f64,
+    pub neutralised: f64,
+    pub chains: usize,
+    pub bridges: usize,
+    pub brush_height: f64,
+    pub free_volume: f64,
+}
+
+impl NipSample {
+    pub const COLUMNS: [&'static str; 11] = [
+        "time",
+        "developed",
+        "mass_per_area_image",
+        "mass_per_area_background",
+        "charge_per_area_image",
+        "charge_per_area_background",
+        "neutralised",
+        "chains",
+        "bridges",
+        "brush_height",
+        "free_volume",
+    ];
+}
+
+impl NipProbe {
+    fn period(&self) -> [f64; 2] {
+        [self.hi.x - self.lo.x, self.hi.y - self.lo.y]
+    }
+
+    /// The image's share of the belt, by length along x.
+    fn image_fraction(&self) -> f64 {
+        let l = self.period()[0];
+        self.patches.iter().map(|p| p[1] - p[0]).sum::<f64>() / l
+    }
+
+    fn on_image(&self, x: f64, t: f64) -> bool {
+        let l = self.period()[0];
+        self.patches.iter().any(|p| {
+            let u = (x - self.speed * t - p[0]).rem_euclid(l);
+            u < p[1] - p[0]
+        })
+    }
+
+    pub fn measure(&self, b: &RigidBodies) -> NipSample {
+        let mut s = NipSample::default();
+        let [lx, ly] = self.period();
+        let area = lx * ly;
+        let f_image = self.image_fraction();
+        let (a_image, a_background) = (area * f_image, area * (1.0 - f_image));
+        let mut solids = 0.0;
+        for i in 0..b.len() {
+            let t = b.template(i);
+            solids += t.props.volume;
+            if b.kind[i] != self.toner {
+                continue;
+            }
+            let r = t.radii[0];
+            if b.position[i].z - self.belt < 1.1 * r {
+                s.developed += 1;
+                if self.on_image(b.position[i].x, b.time) {
+                    s.mass_image += t.props.mass;
+                    s.charge_image += t.charge;
+                } else {
+                    s.mass_background += t.props.mass;
+                    s.charge_background += t.charge;
+                }
+            }
+        }
+        let per = |x: f64, a: f64| if a > 0.0 { x / a } else { 0.0 };
+        s.mass_image = per(s.mass_image, a_image);
+        s.mass_background = per(s.mass_background, a_background);
+        s.charge_image = per(s.charge_image, a_image);
+        s.charge_background = per(s.charge_background, a_background);
+        if self.contrast != 0.0 {
+            s.neutralised = -s.charge_image / self.contrast;
+        }
+        s.free_volume = 1.0 - solids / (area * (self.shell - self.belt));
+        self.brush(b, &mut s);
+        s
+    }
+
+    /// Clusters of touching carriers (union–find over their spheres).
+    fn brush(&self, b: &RigidBodies, s: &mut NipSample) {
+        let mut world = WorldFrame::default();
+        world.update(b);
+        let carriers: Vec<usize> = (0..b.len())
+            .filter(|&i| b.kind[i] == self.carrier)
+            .collect();
+        let spheres: Vec<(usize, DVec3, f64)> = carriers
+            .iter()
+            .enumerate()
+            .flat_map(|(k, &i)| {
+                let range = world.sphere_start[i] as usize..world.sphere_start[i + 1] as usize;
+                range.map(move |j| (k, j))
+            })
+            .map(|(k, j)| (k, world.sphere_centre[j], world.sphere_radius[j]))
+            .collect();
+        let mut parent: Vec<usize> = (0..carriers.len()).collect();
+        fn root(p: &mut [usize], mut i: usize) -> usize {
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        let [lx, ly] = self.period();
+        for (a, &(ka, ca, ra)) in spheres.iter().enumerate() {
+            for &(kb, cb, rb) in &spheres[a + 1..] {
+                if ka == kb {
+                    continue;
+                }
+                let mut d = ca - cb;
+                d.x -= (d.x / lx).round() * lx;
+                d.y -= (d.y / ly).round() * ly;
+                if d.length() < 1.02 * (ra + rb) {
+                    let (x, y) = (root(&mut parent, ka), root(&mut parent, kb));
+                    parent[x] = y;
+                }
+            }
+        }
+        // Per cluster: lowest bottom, highest top.
+        let mut extent = vec![(f64::INFINITY, f64::NEG_INFINITY); carriers.len()];
+        let mut r_max: f64 = 0.0;
+        for &(k, c, r) in &spheres {
+            let g = root(&mut parent, k);
+            extent[g].0 = extent[g].0.min(c.z - r);
+            extent[g].1 = extent[g].1.max(c.z + r);
+            r_max = r_max.max(r);
+        }
+        let (mut reach, mut rooted) = (0.0, 0);
+        for k in 0..carriers.len() {
+            if root(&mut parent, k) != k {
+                continue;
+            }
+            s.chains += 1;
+            let (bottom, top) = extent[k];
+            let at_shell = top > self.shell - r_max;
+            if at_shell {
+                rooted += 1;
+                reach += self.shell - bottom;
+                if bottom < self.belt + r_max {
+                    s.bridges += 1;
+                }
+            }
+        }
+        s.brush_height = if rooted > 0 {
+            reach / rooted as f64
+        } else {
+            0.0
+        };
+    }
+}
+
+/// nip.csv: [`NipSample::COLUMNS`] every `every` steps.
+pub struct NipCsv {
+    pub probe: NipProbe,
+    writer: CsvWriter,
+    every: u64,
+}
+
+impl NipCsv {
+    pub fn create(
+        path: &Path,
+        provenance: &Provenance,
+        probe: NipProbe,
+        every: u64,
+        append: bool,
+    ) -> Result<Self, MdError> {
+        let writer = if append {
+            CsvWriter::append(path, NipSample::COLUMNS.len())?
+        } else {
+            CsvWriter::create(path, provenance, &NipSample::COLUMNS.map(String::from), &[])?
+        };
+        Ok(NipCsv {
+            probe,
+            writer,
+            every,
+        })
+    }
+}
+
+impl Observer<RigidDynamics> for NipCsv {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, d: &RigidDynamics, _: &RigidSample) -> Result<(), MdError> {
+        let s = self.probe.measure(&d.bodies);
+        Ok(self.writer.row(&[
+            d.bodies.time,
+            s.developed as f64,
+            s.mass_image,
+            s.mass_background,
+            s.charge_image,
+            s.charge_background,
+            s.neutralised,
+            s.chains as f64,
+            s.bridges as f64,
+            s.brush_height,
+            s.free_volume,
+        ])?)
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.writer.path().display().to_string()]
+    }
+}
