@@ -105,6 +105,11 @@ fn toning_nip_example_runs_and_writes_nip_csv() {
     )
     .unwrap();
     assert_eq!(r.bodies, 800);
+    // The frames are in the periodic box: whole bodies moved into it.
+    let f = &r.final_frame;
+    assert_eq!(f.pbc, [true, true, false]);
+    assert!((f.cell[0][0] - 3.0e-4).abs() < 1e-15 && (f.cell[2][2] - 2.58e-4).abs() < 1e-15);
+    assert!(f.positions.iter().all(|p| (-2e-5..3.2e-4).contains(&p[0])));
     let table = mote_io::csv::read_table(&dir.path().join("nip.csv")).unwrap();
     let free = table.column("free_volume").unwrap();
     assert!((0.45..0.55).contains(&free[0]), "free volume {}", free[0]);
@@ -143,5 +148,87 @@ fn toning_nip_develops_the_image_not_the_background() {
     assert!(
         back < 0.1 * image,
         "background {back} against image {image}"
+    );
+}
+
+/// One toner particle resting on the shell, held by DMT adhesion
+/// (2πwR = 12.6 nN) and its image (kq²/(2R)² = 5.9 nN); the bias pulls it
+/// towards the belt with qV/h. It stays at 500 V (12.8 nN) and leaves for
+/// the belt at 1000 V (25.6 nN): transfer when the field wins.
+fn toner_on_shell(volts: f64) -> f64 {
+    let text = format!(
+        r#"
+[rigid]
+[[rigid.template]]
+name = "toner"
+generator = "sphere"
+radius = 4.0e-6
+density = 1200.0
+charge = -6.4e-15
+
+[[rigid.body]]
+template = "toner"
+position = [5.0e-5, 5.0e-5, 2.46008e-4]   # pressed 8 nm into the shell
+
+[rigid.fields]
+drag = {{ viscosity = 1.8e-5 }}
+
+[rigid.planes]
+coulomb = 8.9875517923e9
+potential = [0.0, {volts}]
+accuracy = 1.0e-13
+r_cut = 4.0e-5
+
+[rigid.contacts]
+young = 5.0e6
+restitution = 0.3
+friction = 0.3
+adhesion = 5.0e-4
+periodic = [true, true, false]
+box_lo = [0.0, 0.0, 0.0]
+box_hi = [1.0e-4, 1.0e-4, 2.5e-4]
+
+[[rigid.wall]]
+kind = "plane"
+name = "shell"
+point = [0.0, 0.0, 2.5e-4]
+normal = [0.0, 0.0, -1.0]
+
+[[rigid.wall]]
+kind = "plane"
+name = "belt"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+
+[run]
+dt = 5.0e-8
+steps = 3000
+"#
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let r = run_rigid_scene(
+        &text,
+        "toner.toml",
+        &RigidRun {
+            out_dir: Some(dir.path().to_path_buf()),
+            ..RigidRun::default()
+        },
+        |_, _, _| {},
+    )
+    .unwrap();
+    r.final_frame.positions[0][2]
+}
+
+#[test]
+fn toner_leaves_the_shell_when_the_field_beats_adhesion() {
+    let held = toner_on_shell(-500.0);
+    assert!(
+        held > 2.45e-4,
+        "at 500 V the toner left the shell: z = {held}"
+    );
+    let moved = toner_on_shell(-1000.0);
+    assert!(
+        moved < 5.0e-6,
+        "at 1000 V the toner did not reach the belt: z = {moved}"
     );
 }

@@ -275,7 +275,7 @@ impl Observer<RigidDynamics> for SphereTrajectory {
     }
 
     fn observe(&mut self, d: &RigidDynamics, _: &RigidSample) -> Result<(), MdError> {
-        Ok(self.writer.write(d.step, &sphere_frame(&d.bodies))?)
+        Ok(self.writer.write(d.step, &d.sphere_frame())?)
     }
 
     fn files(&self) -> Vec<String> {
@@ -301,6 +301,43 @@ fn sphere_masses(b: &RigidBodies, world: &super::interaction::WorldFrame) -> Vec
         .collect()
 }
 
+impl RigidDynamics {
+    /// The spheres as a frame: in the periodic box of the contacts, if
+    /// any, each body moved whole into it ([`sphere_frame_in`]).
+    pub fn sphere_frame(&self) -> Frame {
+        match &self.contacts {
+            Some(c) if c.boundary.is_periodic() => sphere_frame_in(&self.bodies, &c.boundary),
+            _ => sphere_frame(&self.bodies),
+        }
+    }
+}
+
+/// [`sphere_frame`] in a periodic box: each body is shifted by whole
+/// periods so that its centre of mass lies in the box (its spheres may
+/// stick out), and the frame's cell and `pbc` are the box's.
+pub fn sphere_frame_in(b: &RigidBodies, boundary: &crate::boundary::Boundary) -> Frame {
+    let mut frame = sphere_frame(b);
+    let mut world = super::interaction::WorldFrame::default();
+    world.update(b);
+    let shift: Vec<DVec3> = b.position.iter().map(|x| boundary.wrap(*x) - *x).collect();
+    for (p, &k) in frame.positions.iter_mut().zip(&world.sphere_body) {
+        let s = shift[k as usize];
+        for d in 0..3 {
+            p[d] += s[d];
+        }
+    }
+    // Along open axes nothing moved: the bounding cell stays.
+    let l = boundary.lengths();
+    for d in 0..3 {
+        if l[d].is_finite() {
+            frame.cell[d][d] = l[d];
+            frame.origin[d] = boundary.lo[d];
+        }
+    }
+    frame.pbc = boundary.periodic;
+    frame
+}
+
 pub fn sphere_frame(b: &RigidBodies) -> Frame {
     let mut world = super::interaction::WorldFrame::default();
     world.update(b);
@@ -314,7 +351,10 @@ pub fn sphere_frame(b: &RigidBodies) -> Frame {
             (b.velocity[k] + b.omega[k].cross(*c - b.position[k])).to_array()
         })
         .collect();
-    let (cell, origin) = Frame::bounding_cell(&positions, &world.sphere_radius, 1.0);
+    // A margin of the largest sphere's radius: the scene's own scale (a
+    // fixed 1 made a box of metres around micrometre beads).
+    let pad = world.sphere_radius.iter().copied().fold(0.0, f64::max);
+    let (cell, origin) = Frame::bounding_cell(&positions, &world.sphere_radius, pad);
     Frame {
         time: b.time,
         cell,
@@ -477,6 +517,6 @@ pub fn run_rigid_scene(
         files: report.files.iter().map(PathBuf::from).collect(),
         seed,
         dt,
-        final_frame: sphere_frame(b),
+        final_frame: dynamics.sphere_frame(),
     })
 }
