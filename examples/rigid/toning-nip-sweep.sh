@@ -5,12 +5,14 @@
 # the free volume of the nip, averaged over the last 0.3 ms of each run.
 #
 #   examples/rigid/toning-nip-sweep.sh [OUT] [N ...]
-#   MOTE=target/release/mote examples/rigid/toning-nip-sweep.sh out/sweep 40 80 120 160
+#   MOTE=target/release/mote SEED=12 examples/rigid/toning-nip-sweep.sh out/sweep 40 80 120 160
 #
+# SEED (default: the scene's, 11) places the toner and orients the beads.
 # Writes OUT/N/ (each run's files), OUT/sweep.csv and OUT/sweep.png
 # (mass per area on the image and on the background against free volume).
 set -euo pipefail
 MOTE=${MOTE:-mote}
+SEED=${SEED:-11}
 OUT=${1:-out/toning-nip-sweep}
 shift || true
 LOADS=${*:-40 60 80 100 120 140 160}
@@ -18,18 +20,18 @@ mkdir -p "$OUT"
 "$MOTE" examples --write "$OUT/scenes" >/dev/null
 SCENE="$OUT/scenes/toning-nip.toml"
 CSV="$OUT/sweep.csv"
-echo "carriers,toner,free_volume,mass_per_area_image,mass_per_area_background,neutralised,bridges,brush_height" > "$CSV"
+echo "seed,carriers,toner,free_volume,mass_per_area_image,mass_per_area_background,neutralised,bridges,brush_height" > "$CSV"
 for n in $LOADS; do
   t=$((4 * n))
   # The first `n =` line is the carriers', the second the toner's.
   awk -v n="$n" -v t="$t" '/^n = / { k++; if (k == 1) $0 = "n = " n; else if (k == 2) $0 = "n = " t } { print }' \
     "$SCENE" > "$OUT/toning-nip-$n.toml"
-  "$MOTE" -q run "$OUT/toning-nip-$n.toml" -o "$OUT/$n"
+  "$MOTE" -q --seed "$SEED" run "$OUT/toning-nip-$n.toml" -o "$OUT/$n"
   # Means over t ≥ 0.7 ms of nip.csv's columns.
-  awk -F, -v n="$n" -v t="$t" '
+  awk -F, -v n="$n" -v t="$t" -v seed="$SEED" '
     /^#/ || /^time/ { next }
     $1 >= 7e-4 { k++; fv += $11; mi += $3; mb += $4; ne += $7; br += $9; bh += $10 }
-    END { printf "%d,%d,%.6f,%.6e,%.6e,%.6f,%.3f,%.6e\n", n, t, fv/k, mi/k, mb/k, ne/k, br/k, bh/k }' \
+    END { printf "%d,%d,%d,%.6f,%.6e,%.6e,%.6f,%.3f,%.6e\n", seed, n, t, fv/k, mi/k, mb/k, ne/k, br/k, bh/k }' \
     "$OUT/$n/nip.csv" >> "$CSV"
   tail -n 1 "$CSV"
 done
