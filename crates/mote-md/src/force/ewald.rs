@@ -265,20 +265,34 @@ impl Ewald {
         let w = (2 * m + 1) as usize;
         let tau = self.tau();
         let n = position.len();
-        let structure: Vec<(f64, f64)> = kv
-            .par_iter()
-            .map(|nk| {
-                let k = DVec3::new(nk[0] as f64, nk[1] as f64, nk[2] as f64) * tau;
-                let (mut re, mut im) = (0.0, 0.0);
-                for j in 0..n {
-                    let (c, s) = phase(&ph, j, w, m, nk);
-                    let q = weight(j, k);
-                    re += q * c;
-                    im += q * s;
+        let kvec: Vec<DVec3> = kv
+            .iter()
+            .map(|nk| DVec3::new(nk[0] as f64, nk[1] as f64, nk[2] as f64) * tau)
+            .collect();
+        // Particle by particle into per-block sums (each particle's phases
+        // and the block's S(k) stay in cache), blocks added in order: the
+        // same bits for every thread count.
+        let partial: Vec<Vec<(f64, f64)>> = (0..n.div_ceil(STRUCTURE_BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let mut s = vec![(0.0, 0.0); kv.len()];
+                for j in b * STRUCTURE_BLOCK..n.min((b + 1) * STRUCTURE_BLOCK) {
+                    each_phase(&ph, j, w, m, kv, |idx, c, sn| {
+                        let q = weight(j, kvec[idx]);
+                        s[idx].0 += q * c;
+                        s[idx].1 += q * sn;
+                    });
                 }
-                (re, im)
+                s
             })
             .collect();
+        let mut structure = vec![(0.0, 0.0); kv.len()];
+        for p in &partial {
+            for (t, x) in structure.iter_mut().zip(p) {
+                t.0 += x.0;
+                t.1 += x.1;
+            }
+        }
         KSpace {
             phases: ph,
             structure,
@@ -356,10 +370,10 @@ impl Ewald {
             let damp: Vec<(f64, DVec3)> = kv.iter().map(|nk| self.damping(nk)).collect();
             force.par_iter_mut().enumerate().for_each(|(i, fi)| {
                 let mut f = DVec3::ZERO;
-                for ((nk, s), (a, k)) in kv.iter().zip(&ks.structure).zip(&damp) {
-                    let (c, sn) = phase(&ks.phases, i, w, m, nk);
-                    f += *k * (a * (sn * s.0 - c * s.1));
-                }
+                each_phase(&ks.phases, i, w, m, &kv, |idx, c, sn| {
+                    let (s, (a, k)) = (ks.structure[idx], damp[idx]);
+                    f += k * (a * (sn * s.0 - c * s.1));
+                });
                 *fi += real[i].1 + f * (8.0 * std::f64::consts::PI * charge[i] / v);
             });
         }
@@ -424,11 +438,11 @@ impl Ewald {
             .enumerate()
             .for_each(|(i, (fi, hi))| {
                 let (mut f, mut h) = (DVec3::ZERO, DVec3::ZERO);
-                for ((nk, s), (a, k)) in kv.iter().zip(&ks.structure).zip(&damp) {
-                    let (c, sn) = phase(&ks.phases, i, w, m, nk);
-                    f += *k * (a * dipole[i].dot(*k) * (sn * s.0 - c * s.1));
-                    h -= *k * (a * (c * s.0 + sn * s.1));
-                }
+                each_phase(&ks.phases, i, w, m, &kv, |idx, c, sn| {
+                    let (s, (a, k)) = (ks.structure[idx], damp[idx]);
+                    f += k * (a * dipole[i].dot(k) * (sn * s.0 - c * s.1));
+                    h -= k * (a * (c * s.0 + sn * s.1));
+                });
                 *fi += real[i].1 + f * (8.0 * pi / v);
                 *hi += real[i].2 + h * (8.0 * pi / v) + dipole[i] * (2.0 * self_coeff);
             });
@@ -558,13 +572,34 @@ struct KSpace {
     structure: Vec<(f64, f64)>,
 }
 
-/// e^{ik·r_j} = Π_a e^{i 2π n_a x_a/L_a} from the per-axis phases.
+/// Particles per block of the structure-factor sums.
+const STRUCTURE_BLOCK: usize = 128;
+
+/// Calls `f(index, cos, sin)` with e^{ik·r_j} = Π_a e^{i 2π n_a x_a/L_a}
+/// for each k-vector of `kv` in order, from the per-axis phases; the
+/// product of the x and y phases is kept while (n_x, n_y) repeats (the
+/// half-space list runs n_z innermost), so each k costs one complex product.
 #[inline]
-fn phase(ph: &[(f64, f64)], j: usize, w: usize, m: i32, nk: &[i32; 3]) -> (f64, f64) {
-    let at = |a: usize| ph[(j * 3 + a) * w + (nk[a] + m) as usize];
-    let (x, y, z) = (at(0), at(1), at(2));
-    let xy = (x.0 * y.0 - x.1 * y.1, x.0 * y.1 + x.1 * y.0);
-    (xy.0 * z.0 - xy.1 * z.1, xy.0 * z.1 + xy.1 * z.0)
+fn each_phase(
+    ph: &[(f64, f64)],
+    j: usize,
+    w: usize,
+    m: i32,
+    kv: &[[i32; 3]],
+    mut f: impl FnMut(usize, f64, f64),
+) {
+    let row = &ph[j * 3 * w..(j + 1) * 3 * w];
+    let at = |a: usize, n: i32| row[a * w + (n + m) as usize];
+    let (mut last, mut xy) = ((i32::MIN, i32::MIN), (1.0, 0.0));
+    for (idx, nk) in kv.iter().enumerate() {
+        if (nk[0], nk[1]) != last {
+            let (x, y) = (at(0, nk[0]), at(1, nk[1]));
+            xy = (x.0 * y.0 - x.1 * y.1, x.0 * y.1 + x.1 * y.0);
+            last = (nk[0], nk[1]);
+        }
+        let z = at(2, nk[2]);
+        f(idx, xy.0 * z.0 - xy.1 * z.1, xy.0 * z.1 + xy.1 * z.0);
+    }
 }
 
 /// Coulomb interaction of point charges in a cubic periodic box by Ewald
