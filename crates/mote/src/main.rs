@@ -33,6 +33,8 @@ enum Command {
     Render(cmd::render::RenderArgs),
     /// Plot columns of an observables CSV (PNG or SVG).
     Plot(cmd::plot::PlotArgs),
+    /// Show a trajectory on a local web page (WebGL2; 127.0.0.1 unless --bind).
+    View(cmd::view::ViewArgs),
     /// Random close packings by growing spheres (Lubachevsky–Stillinger); `mote pack analyse FILE` analyses one.
     ///
     /// Grows hard spheres (3-D) or disks (2-D) with spheropack's growth rate
@@ -107,6 +109,7 @@ fn main() -> ExitCode {
         Command::Pack(args) => cmd::pack::run(&global, args),
         Command::Render(args) => cmd::render::run(&global, args),
         Command::Plot(args) => cmd::plot::run(&global, args),
+        Command::View(args) => cmd::view::run(&global, args),
     };
     let result = pool.and_then(|pool| pool.install(command));
     match result {

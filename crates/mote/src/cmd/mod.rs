@@ -9,6 +9,7 @@ pub mod plot;
 pub mod rcp;
 pub mod render;
 pub mod run;
+pub mod view;
 
 /// Parses a subcommand's own words with clap (`name` heads its usage). On
 /// `--help`, `--version` or a usage error it prints clap's message and

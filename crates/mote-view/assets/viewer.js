@@ -1,0 +1,357 @@
+// mote view: instanced sphere impostors in plain WebGL2.
+// Each particle is one quad facing the camera; the fragment shader cuts the
+// disc, shades it as a sphere and writes the sphere's depth, so that
+// intersecting spheres (clumps) look right. window.moteScene holds what the
+// page shows, for tests and the console.
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const scene = { meta: null, frame: 0, n: 0, time: 0, playing: false, speed: 1,
+                color: "species", range: [0, 1], loaded: 0, errors: [] };
+window.moteScene = scene;
+
+function fail(message) {
+  scene.errors.push(message);
+  const e = $("error");
+  e.textContent = message;
+  e.style.display = "block";
+}
+
+const canvas = $("view");
+const gl = canvas.getContext("webgl2", { antialias: true });
+
+const SPHERE_VS = `#version 300 es
+layout(location = 0) in vec4 sphere;
+layout(location = 1) in float value;
+uniform mat4 view, proj;
+uniform vec2 range;
+uniform int categorical;
+out vec2 corner;
+out vec3 color;
+out vec3 centre;
+out float radius;
+const vec2 C[4] = vec2[4](vec2(-1, -1), vec2(1, -1), vec2(-1, 1), vec2(1, 1));
+vec3 viridis(float t) {
+  const vec3 c0 = vec3(0.2777, 0.0054, 0.3341), c1 = vec3(0.1050, 1.4046, 1.3846);
+  const vec3 c2 = vec3(-0.3309, 0.2148, 0.0950), c3 = vec3(-4.6342, -5.7991, -19.3324);
+  const vec3 c4 = vec3(6.2283, 14.1799, 56.6906), c5 = vec3(4.7764, -13.7451, -65.3530);
+  const vec3 c6 = vec3(-5.4355, 4.6459, 26.3124);
+  return c0 + t * (c1 + t * (c2 + t * (c3 + t * (c4 + t * (c5 + t * c6)))));
+}
+vec3 palette(float i) {
+  const vec3 P[8] = vec3[8](vec3(0.84, 0.15, 0.16), vec3(0.12, 0.47, 0.71), vec3(0.17, 0.63, 0.17),
+    vec3(1.0, 0.5, 0.05), vec3(0.58, 0.4, 0.74), vec3(0.55, 0.34, 0.29), vec3(0.89, 0.47, 0.76),
+    vec3(0.5, 0.5, 0.5));
+  return P[int(mod(i, 8.0))];
+}
+void main() {
+  corner = C[gl_VertexID];
+  radius = sphere.w;
+  vec4 c = view * vec4(sphere.xyz, 1.0);
+  centre = c.xyz;
+  gl_Position = proj * (c + vec4(corner * radius * 1.1, 0.0, 0.0));
+  float t = clamp((value - range.x) / max(range.y - range.x, 1e-30), 0.0, 1.0);
+  color = categorical == 1 ? palette(value) : viridis(t);
+}`;
+
+const SPHERE_FS = `#version 300 es
+precision highp float;
+in vec2 corner;
+in vec3 color;
+in vec3 centre;
+in float radius;
+uniform mat4 proj;
+out vec4 fragment;
+void main() {
+  vec2 q = corner * 1.1;
+  float d2 = dot(q, q);
+  if (d2 > 1.0) discard;
+  vec3 n = vec3(q, sqrt(1.0 - d2));
+  vec3 l = normalize(vec3(0.4, 0.6, 1.0));
+  float diffuse = max(dot(n, l), 0.0);
+  float specular = pow(max(dot(reflect(-l, n), vec3(0.0, 0.0, 1.0)), 0.0), 24.0);
+  fragment = vec4(color * (0.3 + 0.7 * diffuse) + 0.2 * specular, 1.0);
+  vec4 p = proj * vec4(centre + n * radius, 1.0);
+  gl_FragDepth = 0.5 * p.z / p.w + 0.5;
+}`;
+
+const LINE_VS = `#version 300 es
+layout(location = 0) in vec3 p;
+uniform mat4 view, proj;
+void main() { gl_Position = proj * view * vec4(p, 1.0); }`;
+const LINE_FS = `#version 300 es
+precision highp float;
+out vec4 fragment;
+void main() { fragment = vec4(0.3, 0.3, 0.3, 1.0); }`;
+
+function program(vs, fs) {
+  const make = (type, source) => {
+    const s = gl.createShader(type);
+    gl.shaderSource(s, source);
+    gl.compileShader(s);
+    if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
+    return s;
+  };
+  const p = gl.createProgram();
+  gl.attachShader(p, make(gl.VERTEX_SHADER, vs));
+  gl.attachShader(p, make(gl.FRAGMENT_SHADER, fs));
+  gl.linkProgram(p);
+  if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
+  return p;
+}
+
+// Column-major 4×4 matrices.
+function perspective(fovy, aspect, near, far) {
+  const f = 1 / Math.tan(fovy / 2), d = near - far;
+  return [f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) / d, -1, 0, 0, 2 * far * near / d, 0];
+}
+function lookAt(eye, target, up) {
+  const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+  const norm = (a) => { const l = Math.hypot(...a) || 1; return a.map((x) => x / l); };
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const z = norm(sub(eye, target)), x = norm(cross(up, z)), y = cross(z, x);
+  return [x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0, -dot(x, eye), -dot(y, eye), -dot(z, eye), 1];
+}
+
+const camera = { target: [0, 0, 0], distance: 1, theta: 0.8, phi: 1.1, home: null };
+function resetCamera() {
+  Object.assign(camera, JSON.parse(camera.home));
+  draw();
+}
+function eye() {
+  const c = camera, s = Math.sin(c.phi);
+  return [c.target[0] + c.distance * s * Math.cos(c.theta), c.target[1] + c.distance * s * Math.sin(c.theta),
+          c.target[2] + c.distance * Math.cos(c.phi)];
+}
+
+let spheres, lines, sphereVao, lineVao, sphereBuf, valueBuf, boxCount = 0;
+
+function setup() {
+  if (!gl) throw new Error("WebGL2 is not available in this browser");
+  spheres = program(SPHERE_VS, SPHERE_FS);
+  lines = program(LINE_VS, LINE_FS);
+  sphereVao = gl.createVertexArray();
+  gl.bindVertexArray(sphereVao);
+  sphereBuf = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
+  gl.enableVertexAttribArray(0);
+  gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 0, 0);
+  gl.vertexAttribDivisor(0, 1);
+  valueBuf = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
+  gl.enableVertexAttribArray(1);
+  gl.vertexAttribPointer(1, 1, gl.FLOAT, false, 0, 0);
+  gl.vertexAttribDivisor(1, 1);
+  lineVao = gl.createVertexArray();
+  gl.bindVertexArray(lineVao);
+  const lineBuf = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, lineBuf);
+  gl.enableVertexAttribArray(0);
+  gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+  const cell = scene.meta.cell, o = scene.meta.origin;
+  if (cell && Math.abs(cell[0][0] * cell[1][1] * cell[2][2]) > 0) {
+    const corner = (i, j, k) => [0, 1, 2].map((a) => o[a] + i * cell[0][a] + j * cell[1][a] + k * cell[2][a]);
+    const edges = [];
+    for (const [a, b] of [[[0,0,0],[1,0,0]],[[0,1,0],[1,1,0]],[[0,0,1],[1,0,1]],[[0,1,1],[1,1,1]],
+                          [[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]],[[0,0,1],[0,1,1]],[[1,0,1],[1,1,1]],
+                          [[0,0,0],[0,0,1]],[[1,0,0],[1,0,1]],[[0,1,0],[0,1,1]],[[1,1,0],[1,1,1]]]) {
+      edges.push(...corner(...a), ...corner(...b));
+    }
+    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(edges), gl.STATIC_DRAW);
+    boxCount = 24;
+  }
+  gl.bindVertexArray(null);
+  gl.enable(gl.DEPTH_TEST);
+  gl.clearColor(1, 1, 1, 1);
+}
+
+function frameCamera(data) {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < data.n; i++) {
+    for (let a = 0; a < 3; a++) {
+      const x = data.spheres[4 * i + a];
+      lo[a] = Math.min(lo[a], x);
+      hi[a] = Math.max(hi[a], x);
+    }
+  }
+  if (!(lo[0] <= hi[0])) { lo.fill(0); hi.fill(1); }
+  camera.target = lo.map((l, a) => 0.5 * (l + hi[a]));
+  camera.distance = 1.6 * Math.max(Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]), 1e-30);
+  camera.home = JSON.stringify(camera);
+}
+
+function draw() {
+  if (!scene.meta || !gl) return;
+  const w = canvas.clientWidth, h = canvas.clientHeight, dpr = window.devicePixelRatio || 1;
+  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+    canvas.width = Math.round(w * dpr);
+    canvas.height = Math.round(h * dpr);
+  }
+  gl.viewport(0, 0, canvas.width, canvas.height);
+  gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+  const view = lookAt(eye(), camera.target, [0, 0, 1]);
+  const proj = perspective(0.7, canvas.width / Math.max(canvas.height, 1), camera.distance * 0.01, camera.distance * 10);
+  gl.useProgram(spheres);
+  gl.uniformMatrix4fv(gl.getUniformLocation(spheres, "view"), false, view);
+  gl.uniformMatrix4fv(gl.getUniformLocation(spheres, "proj"), false, proj);
+  gl.uniform2f(gl.getUniformLocation(spheres, "range"), scene.range[0], scene.range[1]);
+  gl.uniform1i(gl.getUniformLocation(spheres, "categorical"), scene.color === "species" ? 1 : 0);
+  gl.bindVertexArray(sphereVao);
+  gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, scene.n);
+  if (boxCount) {
+    gl.useProgram(lines);
+    gl.uniformMatrix4fv(gl.getUniformLocation(lines, "view"), false, view);
+    gl.uniformMatrix4fv(gl.getUniformLocation(lines, "proj"), false, proj);
+    gl.bindVertexArray(lineVao);
+    gl.drawArrays(gl.LINES, 0, boxCount);
+  }
+  gl.bindVertexArray(null);
+  scene.drawn = (scene.drawn || 0) + 1;
+}
+
+function legend() {
+  const c = $("legend"), g = c.getContext("2d");
+  g.clearRect(0, 0, c.width, c.height);
+  g.fillStyle = "#222";
+  g.font = "12px system-ui, sans-serif";
+  if (scene.color === "species") {
+    const colors = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f"];
+    scene.meta.species.slice(0, 4).forEach((s, i) => {
+      g.fillStyle = colors[i % 8];
+      g.fillRect(8, 8 + 12 * i, 10, 10);
+      g.fillStyle = "#222";
+      g.fillText(s, 24, 17 + 12 * i);
+    });
+    return;
+  }
+  const grad = g.createLinearGradient(8, 0, c.width - 8, 0);
+  [[0, "#440154"], [0.25, "#3b528b"], [0.5, "#21918c"], [0.75, "#5ec962"], [1, "#fde725"]]
+    .forEach(([t, col]) => grad.addColorStop(t, col));
+  g.fillStyle = grad;
+  g.fillRect(8, 22, c.width - 16, 14);
+  g.fillStyle = "#222";
+  g.fillText(scene.color, 8, 16);
+  g.fillText(scene.range[0].toPrecision(3), 8, 52);
+  const hiText = scene.range[1].toPrecision(3);
+  g.fillText(hiText, c.width - 8 - g.measureText(hiText).width, 52);
+}
+
+async function fetchFrame(k) {
+  const r = await fetch(`/api/frame/${k}?color=${encodeURIComponent(scene.color)}`);
+  if (!r.ok) throw new Error(`frame ${k}: ${await r.text()}`);
+  const buf = await r.arrayBuffer();
+  const n = new DataView(buf).getUint32(0, true);
+  return { n, spheres: new Float32Array(buf, 4, 4 * n), values: new Float32Array(buf, 4 + 16 * n, n) };
+}
+
+let pending = false;
+async function show(k) {
+  if (pending) return;
+  pending = true;
+  try {
+    const data = await fetchFrame(k);
+    if (!camera.home) frameCamera(data);
+    gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
+    gl.bufferData(gl.ARRAY_BUFFER, data.spheres, gl.DYNAMIC_DRAW);
+    gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
+    gl.bufferData(gl.ARRAY_BUFFER, data.values, gl.DYNAMIC_DRAW);
+    let lo = Infinity, hi = -Infinity;
+    for (const v of data.values) { if (v < lo) lo = v; if (v > hi) hi = v; }
+    scene.range = lo <= hi ? [lo, hi > lo ? hi : lo + 1] : [0, 1];
+    scene.frame = k;
+    scene.n = data.n;
+    scene.time = scene.meta.time[k];
+    scene.loaded += 1;
+    $("scrub").value = k;
+    $("status").textContent = `frame ${k + 1}/${scene.meta.frames}   t = ${scene.time.toPrecision(6)}   N = ${data.n}`;
+    legend();
+    draw();
+  } catch (e) {
+    fail(String(e.message || e));
+  } finally {
+    pending = false;
+  }
+}
+
+function setPlaying(on) {
+  scene.playing = on;
+  $("play").textContent = on ? "❚❚" : "▶︎";
+}
+
+let last = 0;
+function tick(now) {
+  const interval = 100 / scene.speed;
+  if (scene.playing && !pending && now - last >= interval) {
+    last = now;
+    if (scene.frame + 1 < scene.meta.frames) show(scene.frame + 1);
+    else setPlaying(false);
+  }
+  requestAnimationFrame(tick);
+}
+
+function controls() {
+  $("play").onclick = () => setPlaying(!scene.playing);
+  $("step").onclick = () => { setPlaying(false); show(Math.min(scene.frame + 1, scene.meta.frames - 1)); };
+  $("back").onclick = () => { setPlaying(false); show(Math.max(scene.frame - 1, 0)); };
+  $("scrub").oninput = (e) => show(Number(e.target.value));
+  $("speed").onchange = (e) => { scene.speed = Number(e.target.value); };
+  $("color").onchange = (e) => { scene.color = e.target.value; show(scene.frame); };
+  $("reset").onclick = resetCamera;
+  let drag = null;
+  canvas.addEventListener("pointerdown", (e) => { drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey || e.button === 2 }; });
+  window.addEventListener("pointerup", () => { drag = null; });
+  window.addEventListener("pointermove", (e) => {
+    if (!drag) return;
+    const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+    drag.x = e.clientX;
+    drag.y = e.clientY;
+    if (drag.pan) {
+      const s = camera.distance / canvas.clientHeight, t = camera.theta;
+      camera.target[0] += s * (dx * Math.sin(t));
+      camera.target[1] -= s * (dx * Math.cos(t));
+      camera.target[2] += s * dy;
+    } else {
+      camera.theta -= dx * 0.01;
+      camera.phi = Math.min(Math.max(camera.phi - dy * 0.01, 0.01), Math.PI - 0.01);
+    }
+    draw();
+  });
+  canvas.addEventListener("contextmenu", (e) => e.preventDefault());
+  canvas.addEventListener("wheel", (e) => {
+    e.preventDefault();
+    camera.distance *= Math.exp(e.deltaY * 0.001);
+    draw();
+  }, { passive: false });
+  window.addEventListener("keydown", (e) => {
+    if (e.key === " ") { setPlaying(!scene.playing); e.preventDefault(); }
+    else if (e.key === "ArrowRight") $("step").onclick();
+    else if (e.key === "ArrowLeft") $("back").onclick();
+    else if (e.key === "r") resetCamera();
+  });
+  window.addEventListener("resize", draw);
+}
+
+async function main() {
+  try {
+    const r = await fetch("/api/meta");
+    if (!r.ok) throw new Error(await r.text());
+    scene.meta = await r.json();
+    $("label").textContent = scene.meta.label;
+    document.title = `mote view: ${scene.meta.label}`;
+    $("scrub").max = Math.max(scene.meta.frames - 1, 0);
+    for (const q of scene.meta.quantities) {
+      const o = document.createElement("option");
+      o.textContent = q;
+      $("color").appendChild(o);
+    }
+    setup();
+    controls();
+    await show(0);
+    requestAnimationFrame(tick);
+  } catch (e) {
+    fail(String(e.message || e));
+  }
+}
+
+main();

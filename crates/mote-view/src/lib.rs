@@ -1,0 +1,199 @@
+//! `mote view`: a local web page that shows a trajectory.
+//!
+//! The server holds the frames of a trajectory file (any format
+//! [`mote_io::trajectory::read_frames`] reads) and answers four requests:
+//!
+//! - `GET /` and `GET /viewer.js`: the page, compiled into the binary
+//!   (plain WebGL2, no libraries: instanced sphere impostors need one
+//!   shader pair and a few hundred lines, and nothing is fetched at run
+//!   time);
+//! - `GET /api/meta`: JSON with the file's name, the frame count, each
+//!   frame's time and particle count, the box, the species and the
+//!   quantities one can colour by;
+//! - `GET /api/frame/K?color=Q`: frame K as little-endian binary: u32 N,
+//!   then N × (x, y, z, r) as f32, then N values of Q as f32 (species: the
+//!   index in the meta's list).
+//!
+//! Nothing is read from disk after the start, so no request can reach a
+//! file: every other path is 404. The server listens on 127.0.0.1 unless
+//! told otherwise ([`bind`] says whether an address is loopback).
+
+use std::net::{IpAddr, SocketAddr};
+use std::sync::Arc;
+
+use axum::body::Body;
+use axum::extract::{Path, Query, State};
+use axum::http::{header, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::routing::get;
+use axum::Router;
+use mote_io::xyz::Frame;
+use serde::Deserialize;
+
+const INDEX: &str = include_str!("../assets/index.html");
+const SCRIPT: &str = include_str!("../assets/viewer.js");
+
+/// The quantities a frame can be coloured by, besides `species`.
+pub use mote_render::frame::QUANTITIES;
+
+/// A trajectory as the page sees it.
+pub struct Trajectory {
+    /// The name shown on the page (the file's).
+    pub label: String,
+    pub frames: Vec<Frame>,
+    /// The species of all frames, sorted: colour index = position here.
+    pub species: Vec<String>,
+}
+
+impl Trajectory {
+    pub fn new(label: String, frames: Vec<Frame>) -> Self {
+        let mut species: Vec<String> = frames
+            .iter()
+            .flat_map(|f| f.species.iter().cloned())
+            .collect();
+        species.sort();
+        species.dedup();
+        Trajectory {
+            label,
+            frames,
+            species,
+        }
+    }
+
+    /// The JSON of `/api/meta`.
+    pub fn meta(&self) -> serde_json::Value {
+        let first = self.frames.first();
+        serde_json::json!({
+            "label": self.label,
+            "frames": self.frames.len(),
+            "time": self.frames.iter().map(|f| f.time).collect::<Vec<_>>(),
+            "count": self.frames.iter().map(|f| f.positions.len()).collect::<Vec<_>>(),
+            "cell": first.map(|f| f.cell),
+            "origin": first.map(|f| f.origin),
+            "species": self.species,
+            "quantities": std::iter::once("species").chain(QUANTITIES.iter().copied()).collect::<Vec<_>>(),
+        })
+    }
+
+    /// Frame `k` as the binary of `/api/frame/K`, coloured by `color`.
+    pub fn frame_bytes(&self, k: usize, color: &str) -> Result<Vec<u8>, String> {
+        let f = self
+            .frames
+            .get(k)
+            .ok_or_else(|| format!("no frame {k}: the file has {}", self.frames.len()))?;
+        let n = f.positions.len();
+        let fallback = mote_render::frame::default_radius(f);
+        let values: Vec<f64> = if color == "species" {
+            f.species
+                .iter()
+                .map(|s| self.species.binary_search(s).map_or(0.0, |i| i as f64))
+                .chain(std::iter::repeat(0.0))
+                .take(n)
+                .collect()
+        } else {
+            mote_render::frame::quantity(f, color).map_err(|e| e.to_string())?
+        };
+        let mut out = Vec::with_capacity(4 + 20 * n);
+        out.extend((n as u32).to_le_bytes());
+        for (i, p) in f.positions.iter().enumerate() {
+            let r = f
+                .radii
+                .get(i)
+                .copied()
+                .filter(|r| *r > 0.0)
+                .unwrap_or(fallback);
+            for x in [p[0], p[1], p[2], r] {
+                out.extend((x as f32).to_le_bytes());
+            }
+        }
+        for v in values {
+            out.extend((v as f32).to_le_bytes());
+        }
+        Ok(out)
+    }
+}
+
+#[derive(Deserialize)]
+struct FrameQuery {
+    color: Option<String>,
+}
+
+fn text(status: StatusCode, body: String) -> Response {
+    (
+        status,
+        [(header::CONTENT_TYPE, "text/plain; charset=utf-8")],
+        body,
+    )
+        .into_response()
+}
+
+async fn frame(
+    State(t): State<Arc<Trajectory>>,
+    Path(k): Path<String>,
+    Query(q): Query<FrameQuery>,
+) -> Response {
+    let Ok(k) = k.parse::<usize>() else {
+        return text(StatusCode::NOT_FOUND, format!("not a frame number: {k}"));
+    };
+    let color = q.color.unwrap_or_else(|| "species".into());
+    match t.frame_bytes(k, &color) {
+        Ok(bytes) => (
+            [(header::CONTENT_TYPE, "application/octet-stream")],
+            Body::from(bytes),
+        )
+            .into_response(),
+        Err(m) => text(StatusCode::NOT_FOUND, m),
+    }
+}
+
+/// The page's routes; anything else is 404.
+pub fn router(trajectory: Arc<Trajectory>) -> Router {
+    Router::new()
+        .route(
+            "/",
+            get(|| async { ([(header::CONTENT_TYPE, "text/html; charset=utf-8")], INDEX) }),
+        )
+        .route(
+            "/viewer.js",
+            get(|| async {
+                (
+                    [(header::CONTENT_TYPE, "text/javascript; charset=utf-8")],
+                    SCRIPT,
+                )
+            }),
+        )
+        .route(
+            "/api/meta",
+            get(|State(t): State<Arc<Trajectory>>| async move { axum::Json(t.meta()) }),
+        )
+        .route("/api/frame/{k}", get(frame))
+        .fallback(|| async { text(StatusCode::NOT_FOUND, "not found".into()) })
+        .with_state(trajectory)
+}
+
+/// A listener on `host` (an IP address) and `port` (0: any free one), and
+/// whether the address is loopback (the only kind `mote view` binds to
+/// without a warning).
+pub fn bind(host: &str, port: u16) -> Result<(std::net::TcpListener, bool), String> {
+    let ip: IpAddr = host
+        .parse()
+        .map_err(|_| format!("--bind {host}: not an IP address (127.0.0.1, ::1, 0.0.0.0, ...)"))?;
+    let listener = std::net::TcpListener::bind(SocketAddr::new(ip, port))
+        .map_err(|e| format!("cannot listen on {host}:{port}: {e}"))?;
+    listener
+        .set_nonblocking(true)
+        .map_err(|e| format!("cannot listen on {host}:{port}: {e}"))?;
+    Ok((listener, ip.is_loopback()))
+}
+
+/// Serves `trajectory` on `listener` until `shutdown` completes.
+pub async fn serve(
+    listener: std::net::TcpListener,
+    trajectory: Arc<Trajectory>,
+    shutdown: impl std::future::Future<Output = ()> + Send + 'static,
+) -> std::io::Result<()> {
+    let listener = tokio::net::TcpListener::from_std(listener)?;
+    axum::serve(listener, router(trajectory))
+        .with_graceful_shutdown(shutdown)
+        .await
+}

@@ -1,0 +1,137 @@
+//! The viewer's server: loopback by default, the page and its script are
+//! served, meta and frames carry the file's numbers, and no request reaches
+//! a file (path traversal, unknown paths, bad frame numbers are 404).
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::sync::Arc;
+
+use mote_io::xyz::Frame;
+use mote_view::{bind, serve, Trajectory};
+
+fn frames() -> Vec<Frame> {
+    (0..3)
+        .map(|k| Frame {
+            time: 0.5 * k as f64,
+            cell: [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]],
+            species: vec!["Ar".into(), "He".into()],
+            positions: vec![[1.0, 1.0, 1.0 + k as f64], [2.0, 3.0, 1.5]],
+            velocities: vec![[3.0, 4.0, 0.0], [0.0, 0.0, -1.0]],
+            radii: vec![0.5, 0.25],
+            ..Frame::default()
+        })
+        .collect()
+}
+
+/// Starts a server on 127.0.0.1 and a free port; returns the port.
+fn start() -> u16 {
+    let (listener, loopback) = bind("127.0.0.1", 0).unwrap();
+    assert!(loopback);
+    let port = listener.local_addr().unwrap().port();
+    let t = Arc::new(Trajectory::new("t.xyz".into(), frames()));
+    std::thread::spawn(move || {
+        tokio::runtime::Runtime::new()
+            .unwrap()
+            .block_on(serve(listener, t, std::future::pending()))
+            .unwrap();
+    });
+    port
+}
+
+/// A raw HTTP/1.1 GET (the path is sent as given, `..` included):
+/// status code and body.
+fn get(port: u16, path: &str) -> (u16, Vec<u8>) {
+    let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut raw = Vec::new();
+    s.read_to_end(&mut raw).unwrap();
+    let split = raw.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
+    let head = String::from_utf8_lossy(&raw[..split]).to_string();
+    let status = head.split(' ').nth(1).unwrap().parse().unwrap();
+    let mut body = raw[split + 4..].to_vec();
+    if head
+        .to_ascii_lowercase()
+        .contains("transfer-encoding: chunked")
+    {
+        body = dechunk(&body);
+    }
+    (status, body)
+}
+
+fn dechunk(mut b: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    loop {
+        let line = b.windows(2).position(|w| w == b"\r\n").unwrap();
+        let n = usize::from_str_radix(std::str::from_utf8(&b[..line]).unwrap().trim(), 16).unwrap();
+        if n == 0 {
+            return out;
+        }
+        out.extend_from_slice(&b[line + 2..line + 2 + n]);
+        b = &b[line + 2 + n + 2..];
+    }
+}
+
+#[test]
+fn binds_to_loopback_unless_told_otherwise() {
+    let (l, loopback) = bind("127.0.0.1", 0).unwrap();
+    assert!(loopback && l.local_addr().unwrap().ip().is_loopback());
+    let (_, any) = bind("0.0.0.0", 0).unwrap();
+    assert!(!any, "0.0.0.0 is not loopback: the CLI warns");
+    assert!(bind("localhost.example", 0).is_err());
+}
+
+#[test]
+fn page_meta_and_frames() {
+    let port = start();
+    let (s, page) = get(port, "/");
+    assert_eq!(s, 200);
+    assert!(String::from_utf8_lossy(&page).contains("viewer.js"));
+    let (s, js) = get(port, "/viewer.js");
+    assert_eq!(s, 200);
+    assert!(String::from_utf8_lossy(&js).contains("webgl2"));
+    let (s, meta) = get(port, "/api/meta");
+    assert_eq!(s, 200);
+    let meta: serde_json::Value = serde_json::from_slice(&meta).unwrap();
+    assert_eq!(meta["frames"], 3);
+    assert_eq!(meta["time"][2], 1.0);
+    assert_eq!(meta["species"], serde_json::json!(["Ar", "He"]));
+    // Frame 2 coloured by speed: N, then (x, y, z, r) per particle, then speeds.
+    let (s, bytes) = get(port, "/api/frame/2?color=speed");
+    assert_eq!(s, 200);
+    let f = |k: usize| f32::from_le_bytes(bytes[4 + 4 * k..8 + 4 * k].try_into().unwrap());
+    assert_eq!(u32::from_le_bytes(bytes[..4].try_into().unwrap()), 2);
+    assert_eq!(bytes.len(), 4 + 2 * 16 + 2 * 4);
+    assert_eq!([f(0), f(1), f(2), f(3)], [1.0, 1.0, 3.0, 0.5]);
+    assert_eq!([f(8), f(9)], [5.0, 1.0]);
+    let (_, species) = get(port, "/api/frame/0");
+    let g = |k: usize| f32::from_le_bytes(species[4 + 4 * k..8 + 4 * k].try_into().unwrap());
+    assert_eq!([g(8), g(9)], [0.0, 1.0]);
+}
+
+#[test]
+fn no_request_reaches_a_file() {
+    let port = start();
+    for path in [
+        "/../Cargo.toml",
+        "/../../../../etc/passwd",
+        "/%2e%2e/%2e%2e/etc/passwd",
+        "/api/frame/../../Cargo.toml",
+        "/assets/index.html",
+        "/src/lib.rs",
+        "/api/frame/7",
+        "/api/frame/-1",
+        "/api/frame/0?color=mass",
+    ] {
+        let (s, body) = get(port, path);
+        assert_eq!(s, 404, "{path}: {}", String::from_utf8_lossy(&body));
+        let text = String::from_utf8_lossy(&body);
+        assert!(
+            !text.contains("[package]") && !text.contains("root:"),
+            "{path}"
+        );
+    }
+}
