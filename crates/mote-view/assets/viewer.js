@@ -15,7 +15,21 @@ function fail(message) {
   const e = $("error");
   e.textContent = message;
   e.style.display = "block";
+  publish();
 }
+window.addEventListener("error", (e) => fail(`${e.message} (${e.filename}:${e.lineno})`));
+window.addEventListener("unhandledrejection", (e) => fail(String(e.reason)));
+const consoleError = console.error;
+console.error = (...args) => { scene.errors.push(args.join(" ")); consoleError(...args); };
+
+// The page's state as JSON in a hidden element, for tests that read the DOM
+// (headless Chromium's --dump-dom) and for anyone curious.
+function publish() {
+  const { meta, ...rest } = scene;
+  $("state").textContent = JSON.stringify({ ...rest, frames: meta ? meta.frames : 0 });
+}
+const params = new URLSearchParams(location.search);
+if (params.get("color")) scene.color = params.get("color");
 
 const canvas = $("view");
 const gl = canvas.getContext("webgl2", { antialias: true });
@@ -267,6 +281,7 @@ async function show(k) {
     $("status").textContent = `frame ${k + 1}/${scene.meta.frames}   t = ${scene.time.toPrecision(6)}   N = ${data.n}`;
     legend();
     draw();
+    publish();
   } catch (e) {
     fail(String(e.message || e));
   } finally {
@@ -343,11 +358,13 @@ async function main() {
     for (const q of scene.meta.quantities) {
       const o = document.createElement("option");
       o.textContent = q;
+      o.selected = q === scene.color;
       $("color").appendChild(o);
     }
     setup();
     controls();
     await show(0);
+    if (params.get("play") === "1") setPlaying(true);
     requestAnimationFrame(tick);
   } catch (e) {
     fail(String(e.message || e));

@@ -1,0 +1,157 @@
+//! The page in a real browser: Debian's Chromium, headless, with WebGL2 on
+//! SwiftShader (software). It loads a trajectory of 1000 spheres of two
+//! species; the page's state (read from the DOM) holds all of them with no
+//! console errors, playing advances the frame and the time,
+//! and a screenshot shows the two species' colours. Skipped, with a
+//! message, where no Chromium is installed (`.ci/run` installs Debian's
+//! `chromium`; MOTE_CHROMIUM names another binary). MOTE_VIEW_SCREENSHOT=FILE
+//! keeps the screenshot (docs/img/view.png is one).
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::Arc;
+
+use mote_io::xyz::Frame;
+use mote_view::{bind, serve, Trajectory};
+
+fn chromium() -> Option<PathBuf> {
+    if let Ok(p) = std::env::var("MOTE_CHROMIUM") {
+        return Some(PathBuf::from(p));
+    }
+    ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
+        .into_iter()
+        .map(PathBuf::from)
+        .find(|p| p.exists())
+}
+
+/// 1000 spheres on a 10³ grid, species A in the lower half (z < 5) and B
+/// above, drifting along x over five frames.
+fn frames() -> Vec<Frame> {
+    (0..5)
+        .map(|k| {
+            let mut f = Frame {
+                time: 0.25 * k as f64,
+                cell: [[10.0, 0.0, 0.0], [0.0, 10.0, 0.0], [0.0, 0.0, 10.0]],
+                ..Frame::default()
+            };
+            for i in 0..1000 {
+                let (x, y, z) = (i % 10, (i / 10) % 10, i / 100);
+                f.positions.push([
+                    x as f64 + 0.5 + 0.1 * k as f64,
+                    y as f64 + 0.5,
+                    z as f64 + 0.5,
+                ]);
+                f.species.push(if z < 5 { "A" } else { "B" }.into());
+                f.radii.push(0.45);
+                f.velocities.push([0.4, 0.0, 0.0]);
+            }
+            f
+        })
+        .collect()
+}
+
+fn start() -> u16 {
+    let (listener, _) = bind("127.0.0.1", 0).unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let t = Arc::new(Trajectory::new("grid.xyz".into(), frames()));
+    std::thread::spawn(move || {
+        tokio::runtime::Runtime::new()
+            .unwrap()
+            .block_on(serve(listener, t, std::future::pending()))
+            .unwrap();
+    });
+    port
+}
+
+/// Headless Chromium as the machine's notes say it runs here: as root
+/// without the sandbox, off the network's background services, with a
+/// fresh profile; WebGL2 by SwiftShader.
+fn headless(browser: &PathBuf, extra: &[String], url: &str) -> std::process::Output {
+    let profile = tempfile::tempdir().unwrap();
+    let mut cmd = Command::new(browser);
+    cmd.args([
+        "--headless",
+        "--no-sandbox",
+        "--use-angle=swiftshader",
+        "--enable-unsafe-swiftshader",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--window-size=1000,700",
+        "--virtual-time-budget=10000",
+    ])
+    .arg(format!("--user-data-dir={}", profile.path().display()))
+    .args(extra)
+    .arg(url);
+    cmd.output().expect("chromium starts")
+}
+
+#[test]
+fn page_shows_and_plays_a_trajectory_in_chromium() {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: no Chromium (install Debian's chromium, or set MOTE_CHROMIUM)");
+        return;
+    };
+    let port = start();
+    // Play from the first frame to the last, then read the page's state.
+    let out = headless(
+        &browser,
+        &["--dump-dom".into()],
+        &format!("http://127.0.0.1:{port}/?play=1"),
+    );
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let start = dom
+        .find("<pre id=\"state\" hidden=\"\">")
+        .expect("state element")
+        + 26;
+    let end = start + dom[start..].find("</pre>").unwrap();
+    let state: serde_json::Value =
+        serde_json::from_str(&dom[start..end].replace("&quot;", "\"")).unwrap();
+    assert_eq!(state["errors"], serde_json::json!([]), "{state}");
+    assert_eq!(state["n"], 1000, "{state}");
+    assert_eq!(state["frames"], 5);
+    // Virtual time runs the animation only part of the way (the frames'
+    // fetches are real time): playing must have moved it on from frame 0.
+    let frame = state["frame"].as_u64().unwrap();
+    assert!(frame >= 1, "playing did not advance: {state}");
+    assert_eq!(state["time"], 0.25 * frame as f64);
+    assert!(state["drawn"].as_u64().unwrap() > frame);
+
+    // A screenshot of the first frame: the two species' colours.
+    let dir = tempfile::tempdir().unwrap();
+    let shot = dir.path().join("page.png");
+    headless(
+        &browser,
+        &[format!("--screenshot={}", shot.display())],
+        &format!("http://127.0.0.1:{port}/"),
+    );
+    if let Ok(keep) = std::env::var("MOTE_VIEW_SCREENSHOT") {
+        std::fs::copy(&shot, keep).unwrap();
+    }
+    let decoder = png::Decoder::new(std::fs::File::open(&shot).expect("a screenshot"));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.color_type.samples();
+    let pixels = buf[..info.buffer_size()].chunks(channels);
+    let (mut red, mut blue, mut total) = (0usize, 0usize, 0usize);
+    for p in pixels {
+        let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
+        total += 1;
+        if r > 120 && g < 80 && b < 80 {
+            red += 1;
+        }
+        if b > 100 && r < 70 && b > g {
+            blue += 1;
+        }
+    }
+    let (fr, fb) = (red as f64 / total as f64, blue as f64 / total as f64);
+    println!(
+        "screenshot: {:.1} % red (A), {:.1} % blue (B)",
+        100.0 * fr,
+        100.0 * fb
+    );
+    assert!(fr > 0.02 && fb > 0.02, "red {fr}, blue {fb}");
+}
