@@ -347,6 +347,19 @@ function controls() {
   window.addEventListener("resize", draw);
 }
 
+// ?bench=K: K redraws of the first frame with the camera turning, each
+// waited for (gl.finish): frames per second in moteScene.fps.
+function bench(count) {
+  const t0 = performance.now();
+  for (let i = 0; i < count; i++) {
+    camera.theta += 0.02;
+    draw();
+    gl.finish();
+  }
+  scene.fps = count / ((performance.now() - t0) / 1000);
+  publish();
+}
+
 async function main() {
   try {
     const r = await fetch("/api/meta");
@@ -364,7 +377,10 @@ async function main() {
     setup();
     controls();
     await show(0);
+    scene.loadMs = performance.now();
+    publish();
     if (params.get("play") === "1") setPlaying(true);
+    if (params.get("bench")) bench(Number(params.get("bench")));
     requestAnimationFrame(tick);
   } catch (e) {
     fail(String(e.message || e));
