@@ -693,3 +693,37 @@ fn killed_packing_resumes_bit_for_bit() {
         "{summary}"
     );
 }
+
+/// The toning nip killed mid-way resumes bit for bit: the checkpoint holds
+/// the Coulomb forces held between Ewald sums (`every = 5`), and the resume
+/// trims nip.csv as well as observables.csv and the trajectory.
+#[test]
+fn killed_toning_nip_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "run",
+        "example:toning-nip",
+        "--steps",
+        "600",
+        "--checkpoint-every",
+        "100",
+        "--threads",
+        "1",
+    ];
+    let (whole, at_kill, resumed) = whole_killed_resumed(dir.path(), &args, 200);
+    assert_eq!(resumed.step, whole.step);
+    assert!(
+        at_kill
+            .carried
+            .iter()
+            .any(|(_, v)| v.len() > 1 && v.len() % 4 == 1),
+        "no held Coulomb forces in the checkpoint"
+    );
+    for file in ["observables.csv", "nip.csv", "trajectory.xyz"] {
+        assert!(
+            same_file(dir.path(), file),
+            "{file} differs (killed at {})",
+            at_kill.step
+        );
+    }
+}
