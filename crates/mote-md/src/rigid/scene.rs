@@ -30,6 +30,7 @@
 //! lo = [0.0, 0.0, 0.0]
 //! hi = [10.0, 10.0, 10.0]
 //! spacing = 2.5
+//! arrangement = "cubic"        # or "fcc" (spacing: nearest-neighbour distance)
 //! random_orientation = true
 //!
 //! [[rigid.random]]             # n bodies at random, bounding spheres not overlapping
