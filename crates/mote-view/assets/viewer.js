@@ -7,7 +7,7 @@
 
 const $ = (id) => document.getElementById(id);
 const scene = { meta: null, frame: 0, n: 0, time: 0, playing: false, speed: 1,
-                color: "species", range: [0, 1], loaded: 0, errors: [] };
+                color: "species", range: [0, 1], loaded: 0, errors: [], picked: null };
 window.moteScene = scene;
 
 function fail(message) {
@@ -260,6 +260,49 @@ async function fetchFrame(k) {
 }
 
 let pending = false;
+let current = null;
+
+// The inspector: the sphere under a pixel, by casting the camera's ray
+// through it (exact ray–sphere tests on the CPU), and its columns.
+function pickAt(px, py) {
+  if (!current) return null;
+  const e = eye(), t = camera.target;
+  const norm = (a) => { const l = Math.hypot(...a) || 1; return a.map((x) => x / l); };
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const f = norm([t[0] - e[0], t[1] - e[1], t[2] - e[2]]);
+  const r = norm(cross(f, [0, 0, 1])), u = cross(r, f);
+  const w = canvas.clientWidth, h = canvas.clientHeight, tan = Math.tan(0.35);
+  const x = (2 * px / w - 1) * tan * (w / h), y = (1 - 2 * py / h) * tan;
+  const d = norm([0, 1, 2].map((a) => f[a] + x * r[a] + y * u[a]));
+  let best = Infinity, hit = null;
+  const s = current.spheres;
+  for (let i = 0; i < current.n; i++) {
+    const oc = [e[0] - s[4 * i], e[1] - s[4 * i + 1], e[2] - s[4 * i + 2]];
+    const b = oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2];
+    const c = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - s[4 * i + 3] * s[4 * i + 3];
+    const disc = b * b - c;
+    if (disc >= 0) {
+      const tt = -b - Math.sqrt(disc);
+      if (tt > 0 && tt < best) { best = tt; hit = i; }
+    }
+  }
+  return hit;
+}
+
+async function inspect(i) {
+  scene.picked = i;
+  const panel = $("inspector");
+  if (i === null) { panel.style.display = "none"; publish(); return; }
+  const r = await fetch(`/api/particle/${scene.frame}/${i}`);
+  if (!r.ok) { fail(await r.text()); return; }
+  const p = await r.json();
+  scene.inspected = p;
+  panel.textContent = Object.entries(p)
+    .map(([k, v]) => `${k}: ${Array.isArray(v) ? v.map((x) => Number(x).toPrecision(6)).join(", ") : v}`)
+    .join("\n");
+  panel.style.display = "block";
+  publish();
+}
 async function show(k) {
   if (pending) return;
   pending = true;
@@ -275,6 +318,8 @@ async function show(k) {
     scene.range = lo <= hi ? [lo, hi > lo ? hi : lo + 1] : [0, 1];
     scene.frame = k;
     scene.n = data.n;
+    current = data;
+    if (scene.picked !== null && scene.picked !== undefined) inspect(scene.picked);
     scene.time = scene.meta.time[k];
     scene.loaded += 1;
     $("scrub").value = k;
@@ -314,8 +359,16 @@ function controls() {
   $("color").onchange = (e) => { scene.color = e.target.value; show(scene.frame); };
   $("reset").onclick = resetCamera;
   let drag = null;
-  canvas.addEventListener("pointerdown", (e) => { drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey || e.button === 2 }; });
-  window.addEventListener("pointerup", () => { drag = null; });
+  canvas.addEventListener("pointerdown", (e) => {
+    drag = { x: e.clientX, y: e.clientY, x0: e.clientX, y0: e.clientY, pan: e.shiftKey || e.button === 2 };
+  });
+  window.addEventListener("pointerup", (e) => {
+    if (drag && !drag.pan && Math.hypot(e.clientX - drag.x0, e.clientY - drag.y0) < 4) {
+      const box = canvas.getBoundingClientRect();
+      inspect(pickAt(e.clientX - box.left, e.clientY - box.top));
+    }
+    drag = null;
+  });
   window.addEventListener("pointermove", (e) => {
     if (!drag) return;
     const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
@@ -381,6 +434,10 @@ async function main() {
     publish();
     if (params.get("play") === "1") setPlaying(true);
     if (params.get("bench")) bench(Number(params.get("bench")));
+    if (params.get("pick")) {
+      const [fx, fy] = params.get("pick").split(",").map(Number);
+      await inspect(pickAt(fx * canvas.clientWidth, fy * canvas.clientHeight));
+    }
     requestAnimationFrame(tick);
   } catch (e) {
     fail(String(e.message || e));

@@ -12,7 +12,9 @@
 //!   quantities one can colour by;
 //! - `GET /api/frame/K?color=Q`: frame K as little-endian binary: u32 N,
 //!   then N × (x, y, z, r) as f32, then N values of Q as f32 (species: the
-//!   index in the meta's list).
+//!   index in the meta's list);
+//! - `GET /api/particle/K/I`: particle I of frame K as JSON, every column
+//!   the file has for it (the inspector).
 //!
 //! Nothing is read from disk after the start, so no request can reach a
 //! file: every other path is 404. The server listens on 127.0.0.1 unless
@@ -73,6 +75,50 @@ impl Trajectory {
             "species": self.species,
             "quantities": std::iter::once("species").chain(QUANTITIES.iter().copied()).collect::<Vec<_>>(),
         })
+    }
+
+    /// Particle `i` of frame `k` as the JSON of `/api/particle/K/I`.
+    pub fn particle(&self, k: usize, i: usize) -> Result<serde_json::Value, String> {
+        let f = self
+            .frames
+            .get(k)
+            .ok_or_else(|| format!("no frame {k}: the file has {}", self.frames.len()))?;
+        if i >= f.positions.len() {
+            return Err(format!(
+                "no particle {i}: frame {k} has {}",
+                f.positions.len()
+            ));
+        }
+        let mut out = serde_json::Map::new();
+        out.insert("index".into(), i.into());
+        out.insert("time".into(), f.time.into());
+        out.insert("position".into(), serde_json::json!(f.positions[i]));
+        let v3 = |name: &str,
+                  c: &Vec<[f64; 3]>,
+                  out: &mut serde_json::Map<String, serde_json::Value>| {
+            if let Some(v) = c.get(i) {
+                out.insert(name.into(), serde_json::json!(v));
+            }
+        };
+        v3("velocity", &f.velocities, &mut out);
+        v3("omega", &f.angular_velocities, &mut out);
+        v3("dipole", &f.dipoles, &mut out);
+        if let Some(s) = f.species.get(i) {
+            out.insert("species".into(), s.clone().into());
+        }
+        if let Some(r) = f.radii.get(i) {
+            out.insert("radius".into(), (*r).into());
+        }
+        if let Some(m) = f.masses.get(i) {
+            out.insert("mass".into(), (*m).into());
+        }
+        if let Some(id) = f.ids.get(i) {
+            out.insert("id".into(), (*id).into());
+        }
+        if let Some(b) = f.bodies.get(i) {
+            out.insert("body".into(), (*b).into());
+        }
+        Ok(serde_json::Value::Object(out))
     }
 
     /// Frame `k` as the binary of `/api/frame/K`, coloured by `color`.
@@ -146,6 +192,22 @@ async fn frame(
     }
 }
 
+async fn particle(
+    State(t): State<Arc<Trajectory>>,
+    Path((k, i)): Path<(String, String)>,
+) -> Response {
+    match (k.parse::<usize>(), i.parse::<usize>()) {
+        (Ok(k), Ok(i)) => match t.particle(k, i) {
+            Ok(v) => axum::Json(v).into_response(),
+            Err(m) => text(StatusCode::NOT_FOUND, m),
+        },
+        _ => text(
+            StatusCode::NOT_FOUND,
+            format!("not a frame and particle: {k}/{i}"),
+        ),
+    }
+}
+
 /// The page's routes; anything else is 404.
 pub fn router(trajectory: Arc<Trajectory>) -> Router {
     Router::new()
@@ -167,6 +229,7 @@ pub fn router(trajectory: Arc<Trajectory>) -> Router {
             get(|State(t): State<Arc<Trajectory>>| async move { axum::Json(t.meta()) }),
         )
         .route("/api/frame/{k}", get(frame))
+        .route("/api/particle/{k}/{i}", get(particle))
         .fallback(|| async { text(StatusCode::NOT_FOUND, "not found".into()) })
         .with_state(trajectory)
 }

@@ -88,6 +88,21 @@ fn headless(browser: &PathBuf, extra: &[String], url: &str) -> std::process::Out
     cmd.output().expect("chromium starts")
 }
 
+/// The JSON of the page's `#state` element in a dumped DOM.
+fn page_state(dom: &str) -> serde_json::Value {
+    let start = dom
+        .find("<pre id=\"state\" hidden=\"\">")
+        .expect("state element")
+        + 26;
+    let end = start + dom[start..].find("</pre>").unwrap();
+    serde_json::from_str(
+        &dom[start..end]
+            .replace("&quot;", "\"")
+            .replace("&amp;", "&"),
+    )
+    .unwrap()
+}
+
 #[test]
 fn page_shows_and_plays_a_trajectory_in_chromium() {
     let Some(browser) = chromium() else {
@@ -101,14 +116,7 @@ fn page_shows_and_plays_a_trajectory_in_chromium() {
         &["--dump-dom".into()],
         &format!("http://127.0.0.1:{port}/?play=1"),
     );
-    let dom = String::from_utf8_lossy(&out.stdout);
-    let start = dom
-        .find("<pre id=\"state\" hidden=\"\">")
-        .expect("state element")
-        + 26;
-    let end = start + dom[start..].find("</pre>").unwrap();
-    let state: serde_json::Value =
-        serde_json::from_str(&dom[start..end].replace("&quot;", "\"")).unwrap();
+    let state = page_state(&String::from_utf8_lossy(&out.stdout));
     assert_eq!(state["errors"], serde_json::json!([]), "{state}");
     assert_eq!(state["n"], 1000, "{state}");
     assert_eq!(state["frames"], 5);
@@ -118,6 +126,18 @@ fn page_shows_and_plays_a_trajectory_in_chromium() {
     assert!(frame >= 1, "playing did not advance: {state}");
     assert_eq!(state["time"], 0.25 * frame as f64);
     assert!(state["drawn"].as_u64().unwrap() > frame);
+
+    // Clicking the middle of the view inspects the sphere under it.
+    let out = headless(
+        &browser,
+        &["--dump-dom".into()],
+        &format!("http://127.0.0.1:{port}/?pick=0.5,0.55"),
+    );
+    let state = page_state(&String::from_utf8_lossy(&out.stdout));
+    assert!(state["picked"].is_u64(), "nothing picked: {state}");
+    let species = state["inspected"]["species"].as_str().unwrap_or_default();
+    assert!(species == "A" || species == "B", "{state}");
+    assert_eq!(state["inspected"]["radius"], 0.45);
 
     // A screenshot of the first frame: the two species' colours.
     let dir = tempfile::tempdir().unwrap();

@@ -107,6 +107,15 @@ fn page_meta_and_frames() {
     assert_eq!(bytes.len(), 4 + 2 * 16 + 2 * 4);
     assert_eq!([f(0), f(1), f(2), f(3)], [1.0, 1.0, 3.0, 0.5]);
     assert_eq!([f(8), f(9)], [5.0, 1.0]);
+    // The inspector's view of one particle.
+    let (s, p) = get(port, "/api/particle/1/0");
+    assert_eq!(s, 200);
+    let p: serde_json::Value = serde_json::from_slice(&p).unwrap();
+    assert_eq!(p["species"], "Ar");
+    assert_eq!(p["position"], serde_json::json!([1.0, 1.0, 2.0]));
+    assert_eq!(p["velocity"], serde_json::json!([3.0, 4.0, 0.0]));
+    assert_eq!(p["radius"], 0.5);
+    assert_eq!(get(port, "/api/particle/1/2").0, 404);
     let (_, species) = get(port, "/api/frame/0");
     let g = |k: usize| f32::from_le_bytes(species[4 + 4 * k..8 + 4 * k].try_into().unwrap());
     assert_eq!([g(8), g(9)], [0.0, 1.0]);
@@ -125,6 +134,8 @@ fn no_request_reaches_a_file() {
         "/api/frame/7",
         "/api/frame/-1",
         "/api/frame/0?color=mass",
+        "/api/particle/0/../../../etc/passwd",
+        "/api/particle/9/0",
     ] {
         let (s, body) = get(port, path);
         assert_eq!(s, 404, "{path}: {}", String::from_utf8_lossy(&body));
