@@ -9,9 +9,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use mote_geom::{DE, E};
 use mote_md::rigid::magnet::{InducedDipoles, MagneticRoller, MU0};
-use mote_md::rigid::{
-    BodyInteraction, BodyTemplate, BodyView, ClumpSpec, Integration, RigidBodies, WorldFrame,
-};
+use mote_md::rigid::{BodyInteraction, BodyTemplate, BodyView, RigidBodies, WorldFrame};
 
 fn roller() -> MagneticRoller {
     MagneticRoller {
@@ -90,18 +88,9 @@ fn field_is_curl_and_divergence_free_and_turns() {
     assert!((a.length() - b.length()).abs() < 1e-12 * a.length());
 }
 
-/// A bead template: one sphere of radius `a` (40 µm carriers, 8 µm toner).
+/// A bead template: one sphere of radius `a` (40 µm carriers).
 fn bead(a: f64) -> Arc<BodyTemplate> {
-    let spec = ClumpSpec {
-        centres: vec![DVec3::ZERO],
-        radii: vec![a],
-        density: 5000.0,
-        youngs_modulus: 0.0,
-        poisson_ratio: 0.0,
-        charge: 0.0,
-        dipole: DVec3::ZERO,
-    };
-    BodyTemplate::new(&spec, Integration::default()).unwrap()
+    BodyTemplate::sphere(a, 5000.0).unwrap()
 }
 
 fn bodies_at(points: &[DVec3]) -> RigidBodies {

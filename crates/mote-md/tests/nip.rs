@@ -9,19 +9,13 @@ use glam::DVec3;
 use mote_geom::{DE, E};
 use mote_md::rigid::nip::NipProbe;
 use mote_md::rigid::scene::{run_rigid_scene, RigidRun};
-use mote_md::rigid::{BodyTemplate, ClumpSpec, Integration, RigidBodies};
+use mote_md::rigid::{BodyTemplate, RigidBodies};
 
+/// A one-sphere template ([`BodyTemplate::sphere`]) with a charge.
 fn sphere(radius: f64, density: f64, charge: f64) -> std::sync::Arc<BodyTemplate> {
-    let spec = ClumpSpec {
-        centres: vec![DVec3::ZERO],
-        radii: vec![radius],
-        density,
-        youngs_modulus: 0.0,
-        poisson_ratio: 0.0,
-        charge,
-        dipole: DVec3::ZERO,
-    };
-    BodyTemplate::new(&spec, Integration::default()).unwrap()
+    let mut t = BodyTemplate::sphere(radius, density).unwrap();
+    std::sync::Arc::get_mut(&mut t).unwrap().charge = charge;
+    t
 }
 
 #[test]

@@ -9,10 +9,10 @@
 
 use std::path::PathBuf;
 use std::process::Command;
-use std::sync::Arc;
 
 use mote_io::xyz::Frame;
-use mote_view::{bind, serve, Trajectory};
+
+mod common;
 
 fn chromium() -> Option<PathBuf> {
     if let Ok(p) = std::env::var("MOTE_CHROMIUM") {
@@ -51,16 +51,7 @@ fn frames() -> Vec<Frame> {
 }
 
 fn start() -> u16 {
-    let (listener, _) = bind("127.0.0.1", 0).unwrap();
-    let port = listener.local_addr().unwrap().port();
-    let t = Arc::new(Trajectory::new("grid.xyz".into(), frames()));
-    std::thread::spawn(move || {
-        tokio::runtime::Runtime::new()
-            .unwrap()
-            .block_on(serve(listener, t, std::future::pending()))
-            .unwrap();
-    });
-    port
+    common::start("grid.xyz", frames())
 }
 
 /// Headless Chromium as the machine's notes say it runs here: as root

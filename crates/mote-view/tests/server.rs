@@ -4,10 +4,11 @@
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::sync::Arc;
 
 use mote_io::xyz::Frame;
-use mote_view::{bind, serve, Trajectory};
+use mote_view::bind;
+
+mod common;
 
 fn frames() -> Vec<Frame> {
     (0..3)
@@ -23,19 +24,8 @@ fn frames() -> Vec<Frame> {
         .collect()
 }
 
-/// Starts a server on 127.0.0.1 and a free port; returns the port.
 fn start() -> u16 {
-    let (listener, loopback) = bind("127.0.0.1", 0).unwrap();
-    assert!(loopback);
-    let port = listener.local_addr().unwrap().port();
-    let t = Arc::new(Trajectory::new("t.xyz".into(), frames()));
-    std::thread::spawn(move || {
-        tokio::runtime::Runtime::new()
-            .unwrap()
-            .block_on(serve(listener, t, std::future::pending()))
-            .unwrap();
-    });
-    port
+    common::start("t.xyz", frames())
 }
 
 /// A raw HTTP/1.1 GET (the path is sent as given, `..` included):

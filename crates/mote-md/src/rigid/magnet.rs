@@ -21,6 +21,7 @@
 //! moments see each other's dipole fields too (mutual induction by fixed
 //! point, m_i = α(B(x_i) + Σ_j B_j(x_i))). Each moment feels
 //! F = (m·∇)B of the roller and the dipole–dipole forces of the others
+//! ([`super::sources::dipole_pair`], as between permanent dipoles)
 //! (minimum image along the periodic axes); the moments are taken as
 //! isotropic, along the local field, so they exert no torque.
 
@@ -31,6 +32,7 @@ use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
+use super::sources::dipole_pair;
 
 /// μ₀ in SI.
 pub const MU0: f64 = 4.0e-7 * PI;
@@ -173,10 +175,7 @@ impl InducedDipoles {
     /// k [3 d(m·d)/d⁵ − m/d³].
     #[inline]
     fn dipole_field(&self, d: DVec3, m: DVec3) -> DVec3 {
-        let d = self.separation(d);
-        let r2 = d.length_squared();
-        let inv3 = 1.0 / (r2 * r2.sqrt());
-        self.dipole_dipole * (3.0 * m.dot(d) / r2 * d - m) * inv3
+        self.dipole_dipole * dipole_pair(DVec3::ZERO, m, self.separation(d)).1
     }
 }
 
@@ -198,16 +197,7 @@ impl BodyInteraction for InducedDipoles {
                         if j == i {
                             continue;
                         }
-                        // F_i = 3k/r⁵ [(m_i·m_j) r + m_i(m_j·r) + m_j(m_i·r) − 5(m_i·r)(m_j·r) r/r²].
-                        let r = self.separation(x[i] - x[j]);
-                        let mj = m[j];
-                        let r2 = r.length_squared();
-                        let inv5 = 1.0 / (r2 * r2 * r2.sqrt());
-                        let (a, b) = (mi.dot(r), mj.dot(r));
-                        f += 3.0
-                            * k
-                            * inv5
-                            * (mi.dot(mj) * r + b * mi + a * mj - 5.0 * a * b / r2 * r);
+                        f += k * dipole_pair(mi, m[j], self.separation(x[i] - x[j])).0;
                     }
                 }
                 f

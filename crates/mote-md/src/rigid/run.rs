@@ -317,10 +317,8 @@ impl RigidDynamics {
 /// stick out), and the frame's cell and `pbc` are the box's.
 pub fn sphere_frame_in(b: &RigidBodies, boundary: &crate::boundary::Boundary) -> Frame {
     let mut frame = sphere_frame(b);
-    let mut world = super::interaction::WorldFrame::default();
-    world.update(b);
     let shift: Vec<DVec3> = b.position.iter().map(|x| boundary.wrap(*x) - *x).collect();
-    for (p, &k) in frame.positions.iter_mut().zip(&world.sphere_body) {
+    for (p, &k) in frame.positions.iter_mut().zip(&frame.bodies) {
         let s = shift[k as usize];
         for d in 0..3 {
             p[d] += s[d];

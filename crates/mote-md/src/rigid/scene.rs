@@ -842,10 +842,7 @@ impl RigidScene {
                         )
                     })
             };
-            let Some((lo, hi)) = rigid.contacts.as_ref().and_then(|c| {
-                let c = c.get_ref();
-                Some((DVec3::from(c.box_lo?), DVec3::from(c.box_hi?)))
-            }) else {
+            let Some((lo, hi, _)) = contact_box(&rigid.contacts) else {
                 return Err(err(
                     n.span(),
                     "[rigid.nip] needs the box of [rigid.contacts] (box_lo, box_hi)".into(),
@@ -905,6 +902,17 @@ impl RigidScene {
     }
 }
 
+/// The box of `[rigid.contacts]` (box_lo, box_hi) and its periodic axes,
+/// if it names one.
+fn contact_box(contacts: &Option<Spanned<ContactSettings>>) -> Option<(DVec3, DVec3, [bool; 3])> {
+    let c = contacts.as_ref()?.get_ref();
+    Some((
+        DVec3::from(c.box_lo?),
+        DVec3::from(c.box_hi?),
+        c.periodic.unwrap_or([false; 3]),
+    ))
+}
+
 /// `[rigid.roller]` above the box of `[rigid.contacts]`.
 fn induced_dipoles(
     rs: &RollerSettings,
@@ -912,16 +920,7 @@ fn induced_dipoles(
     names: &[(String, u32)],
     bodies: &RigidBodies,
 ) -> Result<InducedDipoles, String> {
-    let boxed = contacts.as_ref().and_then(|c| {
-        let c = c.get_ref();
-        match (c.periodic, c.box_lo, c.box_hi) {
-            (Some(p), Some(lo), Some(hi)) if p[0] && p[1] => {
-                Some((DVec3::from(lo), DVec3::from(hi)))
-            }
-            _ => None,
-        }
-    });
-    let Some((lo, hi)) = boxed else {
+    let Some((lo, hi, [true, true, _])) = contact_box(contacts) else {
         return Err("[rigid.roller] needs [rigid.contacts] periodic along x and y with box_lo and box_hi (the shell is z = box_hi.z)".into());
     };
     if !positive(rs.field) || !positive(rs.radius) || rs.poles < 2 || !rs.poles.is_multiple_of(2) {
@@ -984,16 +983,7 @@ fn plane_coulomb(
     {
         return Err("[rigid.planes] sums the Coulomb forces with their images: remove coulomb from [rigid.fields]".into());
     }
-    let boxed = contacts.as_ref().and_then(|c| {
-        let c = c.get_ref();
-        match (c.periodic, c.box_lo, c.box_hi) {
-            (Some([true, true, false]), Some(lo), Some(hi)) => {
-                Some((DVec3::from(lo), DVec3::from(hi)))
-            }
-            _ => None,
-        }
-    });
-    let Some((lo, hi)) = boxed else {
+    let Some((lo, hi, [true, true, false])) = contact_box(contacts) else {
         return Err("[rigid.planes] needs [rigid.contacts] with periodic = [true, true, false], box_lo and box_hi (the planes are z = box_lo.z and z = box_hi.z)".into());
     };
     if !positive(ps.coulomb) || !positive(ps.accuracy) {

@@ -192,6 +192,20 @@ pub struct DipoleDipole {
     pub k: f64,
 }
 
+/// One pair of point dipoles at separation r = xᵢ − xⱼ (k = 1): the force
+/// on i, 3/r⁵ [(mᵢ·mⱼ) r + mᵢ(mⱼ·r) + mⱼ(mᵢ·r) − 5(mᵢ·r)(mⱼ·r) r/r²], and
+/// the field of j at i, 3 r(mⱼ·r)/r⁵ − mⱼ/r³.
+#[inline]
+pub(crate) fn dipole_pair(mi: DVec3, mj: DVec3, r: DVec3) -> (DVec3, DVec3) {
+    let r2 = r.length_squared();
+    let inv_r2 = 1.0 / r2;
+    let inv_r3 = inv_r2 * inv_r2.sqrt();
+    let inv_r5 = inv_r3 * inv_r2;
+    let (mir, mjr) = (mi.dot(r), mj.dot(r));
+    let f = (3.0 * inv_r5) * (mi.dot(mj) * r + mjr * mi + mir * mj - 5.0 * mir * mjr * inv_r2 * r);
+    (f, (3.0 * mjr * inv_r5) * r - inv_r3 * mj)
+}
+
 /// Bodies at or above this count use rayon for the all-pairs sums.
 const PARALLEL_PAIRS: usize = 256;
 
@@ -269,16 +283,9 @@ impl BodyInteraction for DipoleDipole {
                 if j == i {
                     continue;
                 }
-                let mj = m[j];
-                let r = xi - b.position[j];
-                let r2 = r.length_squared();
-                let inv_r2 = 1.0 / r2;
-                let inv_r3 = inv_r2 * inv_r2.sqrt();
-                let inv_r5 = inv_r3 * inv_r2;
-                let (mir, mjr) = (mi.dot(r), mj.dot(r));
-                f += (3.0 * inv_r5)
-                    * (mi.dot(mj) * r + mjr * mi + mir * mj - 5.0 * mir * mjr * inv_r2 * r);
-                field += (3.0 * mjr * inv_r5) * r - inv_r3 * mj;
+                let (fij, bj) = dipole_pair(mi, m[j], xi - b.position[j]);
+                f += fij;
+                field += bj;
             }
             DE::new(self.k * mi.cross(field), self.k * f)
         });
