@@ -68,6 +68,8 @@ pub struct Outputs {
     pub checkpoints: Option<Checkpoints>,
     /// Continue this checkpoint's run, appending to the files.
     pub resume: Option<Checkpoint>,
+    /// The live viewer's tap, if the run is watched.
+    pub live: mote_run::LiveSlot,
 }
 
 /// What a checkpoint of an event-driven run carries beside positions and
@@ -271,6 +273,19 @@ impl<const D: usize> Propagator for EventDriven<D> {
         Ok(())
     }
 
+    fn frame(&self) -> Option<mote_io::xyz::Frame> {
+        let mut f = frame(&self.sys);
+        f.time = self.now();
+        Some(f)
+    }
+
+    fn change(&mut self, change: &mote_run::Change) -> Result<String, String> {
+        Err(format!(
+            "{}: the event-driven engine predicts collisions exactly and has no time step, field, damping or thermostat to change",
+            change.what()
+        ))
+    }
+
     fn unstable(&self) -> Option<(usize, String)> {
         // Collisions are solved exactly; overlaps are checked in `advance`.
         None
@@ -435,6 +450,7 @@ pub fn run_scene<const D: usize>(
     };
     let mut driver = Driver::new();
     driver.sample_at_start = !resuming;
+    driver.live = out.live.take();
     if let Some(f) = &scene.trajectory {
         let path = out.base.join(f);
         let format = Format::of_path(&path).unwrap_or_default();

@@ -108,6 +108,7 @@ pub(crate) fn restore(
         trajectory_format: get("trajectory-format"),
         seed: Some(cp.seed),
         threads: given.threads,
+        live: given.live.clone(),
     };
     Ok((input, options))
 }

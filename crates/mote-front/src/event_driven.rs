@@ -174,6 +174,7 @@ fn run_events(
         provenance,
         checkpoints,
         resume: resumed.cloned(),
+        live: options.live.clone(),
     };
     let cpu0 = crate::cpu::cpu_seconds();
     let progress = |f: f64| monitor.progress((f * 1000.0) as u64, 1000, "");

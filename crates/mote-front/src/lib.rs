@@ -60,6 +60,9 @@ pub struct RunOptions {
     /// Worker threads the caller asked for. The caller sets up the rayon
     /// pool; the opening line reports the pool's actual size.
     pub threads: Option<usize>,
+    /// The live viewer's tap (`mote view SCENE`): sees every step, hands
+    /// back changes, may pause the run.
+    pub live: mote_run::LiveSlot,
 }
 
 impl RunOptions {

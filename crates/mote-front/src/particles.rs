@@ -142,6 +142,7 @@ pub(crate) fn run(
     let sim = &mut built.simulation;
     let mut driver = Driver::<Simulation>::new();
     driver.sample_at_start = !append;
+    driver.live = args.live.take();
     if out.observables_every > 0 {
         driver.observers.push(Box::new(ObservablesCsv::create(
             &dir.join("observables.csv"),

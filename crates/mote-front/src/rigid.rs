@@ -89,6 +89,7 @@ fn run_with(
         checkpoints,
         resume: resumed.cloned(),
         trajectory_format: Some(format),
+        live: options.live.clone(),
     };
     monitor.start(&format!(
         "mote run {}: rigid clumps (FRBI) with dt = {}, {}, {}",

@@ -73,6 +73,16 @@ impl CsvWriter {
             .map_err(|e| IoError::os(&self.path, e))
     }
 
+    /// Writes `# text` between the rows (an event of the run, such as a
+    /// change made from the live viewer); CSV readers skip it as a comment.
+    pub fn comment(&mut self, text: &str) -> Result<(), IoError> {
+        let line = format!("# {}\n", text.replace('\n', " "));
+        self.out
+            .write_all(line.as_bytes())
+            .and_then(|_| self.out.flush())
+            .map_err(|e| IoError::os(&self.path, e))
+    }
+
     pub fn path(&self) -> &Path {
         &self.path
     }

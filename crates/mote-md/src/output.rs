@@ -131,6 +131,18 @@ impl Observer<Simulation> for ObservablesCsv {
     fn files(&self) -> Vec<String> {
         vec![self.writer.path().display().to_string()]
     }
+
+    fn event(&mut self, sim: &Simulation, text: &str) -> Result<(), MdError> {
+        Ok(self
+            .writer
+            .comment(&event_line(sim.system.step, sim.system.time, text))?)
+    }
+}
+
+/// The comment an observables table records an event of the run with:
+/// `event: step S, t = T: what changed`.
+pub fn event_line(step: u64, time: f64, text: &str) -> String {
+    format!("event: step {step}, t = {time}: {text}")
 }
 
 /// The trajectory: every particle's position, velocity, radius, mass and

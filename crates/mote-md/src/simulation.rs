@@ -165,6 +165,47 @@ impl mote_run::Propagator for Simulation {
         obs
     }
 
+    fn frame(&self) -> Option<mote_io::xyz::Frame> {
+        Some(crate::output::frame_of(&self.system))
+    }
+
+    /// Δt and the temperature are the simulation's; fields and damping go to
+    /// the interaction that owns them.
+    fn change(&mut self, change: &mote_run::Change) -> Result<String, String> {
+        use mote_run::Change;
+        match change {
+            Change::Dt(dt) => {
+                let text = format!("dt {} → {dt}", self.dt);
+                self.dt = *dt;
+                Ok(text)
+            }
+            Change::Temperature(kt) => {
+                let old = if let Some(bd) = &mut self.brownian {
+                    std::mem::replace(&mut bd.kt, *kt)
+                } else {
+                    match &mut self.thermostat {
+                        Some(
+                            Thermostat::Langevin { kt: t, .. } | Thermostat::Bussi { kt: t, .. },
+                        ) => std::mem::replace(t, *kt),
+                        None => {
+                            return Err(
+                                "the temperature: the run has no thermostat (constant energy)"
+                                    .into(),
+                            )
+                        }
+                    }
+                };
+                Ok(format!("temperature kT {old} → {kt}"))
+            }
+            other => self
+                .forces
+                .interactions
+                .iter_mut()
+                .find_map(|i| i.steer(other))
+                .unwrap_or_else(|| Err(format!("{}: the scene has none", other.what()))),
+        }
+    }
+
     /// Positions, velocities, the accelerations leap-frog carries (and the
     /// angular ones with ω when the particles turn), and what each
     /// interaction carries (contact histories) under its index.

@@ -12,13 +12,18 @@
 //! The order within a step is fixed, so that a run resumed from a
 //! checkpoint writes exactly what the uninterrupted run would:
 //! advance → check the state → sample the observers due → write the
-//! checkpoint due → progress → stop if a signal asked for it (after writing
-//! a checkpoint of this step when checkpoints are on).
+//! checkpoint due → progress → the live tap (frames out, changes in) →
+//! stop if a signal asked for it (after writing a checkpoint of this step
+//! when checkpoints are on).
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use mote_io::checkpoint::{self, Checkpoint};
+use mote_io::xyz::Frame;
+
+mod steer;
+pub use steer::{Change, FieldKind, Live, LiveSlot};
 
 /// Something that moves a state forward step by step.
 pub trait Propagator {
@@ -49,6 +54,20 @@ pub trait Propagator {
     /// Puts the state (time, step, tables, what interactions carry) into a
     /// checkpoint that already holds the run's input and options.
     fn save(&mut self, cp: &mut Checkpoint) -> Result<(), Self::Error>;
+    /// The particles (spheres) of now as a trajectory frame, for the live
+    /// viewer; `None` if the engine cannot show itself.
+    fn frame(&self) -> Option<Frame> {
+        None
+    }
+    /// Applies a change asked for from outside (the live viewer) before
+    /// the next step: what changed, in words ("dt 0.001 → 0.0005"), or why
+    /// it cannot.
+    fn change(&mut self, change: &Change) -> Result<String, String> {
+        Err(format!(
+            "{} cannot be changed in this engine",
+            change.what()
+        ))
+    }
 }
 
 /// Something that samples a run on a schedule (tables, trajectories).
@@ -61,6 +80,13 @@ pub trait Observer<P: Propagator> {
     /// Files this observer writes, for the report.
     fn files(&self) -> Vec<String> {
         Vec::new()
+    }
+    /// Records an event of the run (a change made from the live viewer)
+    /// where the samples of its time are: observables tables write it as a
+    /// `# event:` comment line.
+    fn event(&mut self, state: &P, text: &str) -> Result<(), P::Error> {
+        let _ = (state, text);
+        Ok(())
     }
 }
 
@@ -110,6 +136,9 @@ pub struct Driver<P: Propagator> {
     /// Hand the starting state to the observers (false when resuming: the
     /// interrupted run already wrote it).
     pub sample_at_start: bool,
+    /// The live viewer's tap: sees the state after priming and after every
+    /// step, hands back changes (and holds the run while paused).
+    pub live: Option<Box<dyn Live>>,
 }
 
 impl<P: Propagator> Default for Driver<P> {
@@ -118,6 +147,7 @@ impl<P: Propagator> Default for Driver<P> {
             observers: Vec::new(),
             checkpoints: None,
             sample_at_start: true,
+            live: None,
         }
     }
 }
@@ -146,6 +176,7 @@ impl<P: Propagator> Driver<P> {
                 o.observe(state, &initial)?;
             }
         }
+        self.tap(state)?;
         let mut last = None;
         while state.step() < last_step {
             state.advance()?;
@@ -178,6 +209,7 @@ impl<P: Propagator> Driver<P> {
                 _ => false,
             };
             progress(state);
+            self.tap(state)?;
             if let Some(signal) = mote_io::system::stop_requested() {
                 if !end {
                     if let Some(c) = self.checkpoints.as_ref().filter(|_| !saved) {
@@ -207,6 +239,25 @@ impl<P: Propagator> Driver<P> {
             last,
             files,
         })
+    }
+
+    /// Shows the state to the live tap and applies the changes it hands
+    /// back, each recorded by the observers as an event and answered.
+    fn tap(&mut self, state: &mut P) -> Result<(), P::Error> {
+        let Some(live) = self.live.as_mut() else {
+            return Ok(());
+        };
+        let changes = live.between(state.step(), state.time(), &mut || state.frame());
+        for change in changes {
+            let answer = change.check().and_then(|_| state.change(&change));
+            if let Ok(text) = &answer {
+                for o in &mut self.observers {
+                    o.event(state, text)?;
+                }
+            }
+            live.answer(state.step(), state.time(), &change, &answer);
+        }
+        Ok(())
     }
 
     fn save(c: &Checkpoints, state: &mut P) -> Result<(), P::Error> {
@@ -271,6 +322,91 @@ mod tests {
             cp.velocities = vec![[-self.x, 0.0, 0.0]];
             Ok(())
         }
+        fn change(&mut self, change: &Change) -> Result<String, String> {
+            match change {
+                Change::Dt(h) => {
+                    let text = format!("dt {} → {h}", self.h);
+                    self.h = *h;
+                    Ok(text)
+                }
+                other => Err(format!("{} cannot be changed", other.what())),
+            }
+        }
+    }
+
+    /// Asks for dt = 0.5 and a field at step 2; records the answers and
+    /// the steps it saw.
+    struct Steer(std::sync::Arc<std::sync::Mutex<Vec<String>>>);
+    impl Live for Steer {
+        fn between(
+            &mut self,
+            step: u64,
+            _time: f64,
+            _frame: &mut dyn FnMut() -> Option<Frame>,
+        ) -> Vec<Change> {
+            self.0.lock().unwrap().push(format!("step {step}"));
+            if step == 2 {
+                vec![
+                    Change::Dt(0.5),
+                    Change::Field {
+                        kind: FieldKind::Gravity,
+                        value: [0.0, 0.0, -1.0],
+                    },
+                    Change::Dt(-1.0),
+                ]
+            } else {
+                Vec::new()
+            }
+        }
+        fn answer(&mut self, _: u64, _: f64, _: &Change, answer: &Result<String, String>) {
+            self.0.lock().unwrap().push(match answer {
+                Ok(t) => format!("ok {t}"),
+                Err(m) => format!("no {m}"),
+            });
+        }
+    }
+
+    /// Records the events the driver hands the observers.
+    struct Events(std::rc::Rc<std::cell::RefCell<Vec<(u64, String)>>>);
+    impl Observer<Decay> for Events {
+        fn every(&self) -> u64 {
+            1
+        }
+        fn observe(&mut self, _: &Decay, _: &f64) -> Result<(), DecayError> {
+            Ok(())
+        }
+        fn event(&mut self, s: &Decay, text: &str) -> Result<(), DecayError> {
+            self.0.borrow_mut().push((s.step, text.to_string()));
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn the_live_tap_changes_the_next_step_and_the_observers_record_it() {
+        let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let events = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let mut d = Driver::new();
+        d.live = Some(Box::new(Steer(log.clone())));
+        d.observers.push(Box::new(Events(events.clone())));
+        let mut p = Decay {
+            x: 1.0,
+            h: 0.1,
+            step: 0,
+        };
+        d.run(&mut p, |_| 4, |_| {}).unwrap();
+        // Steps 1, 2 at h = 0.1, steps 3, 4 at h = 0.5.
+        assert_eq!(p.x, 0.9 * 0.9 * 0.5 * 0.5);
+        let log = log.lock().unwrap();
+        assert_eq!(log[0], "step 0");
+        assert_eq!(log[3], "ok dt 0.1 → 0.5");
+        assert!(log[4].starts_with("no the gravity cannot"), "{}", log[4]);
+        assert!(
+            log[5].starts_with("no the time step: Dt(-1.0)"),
+            "{}",
+            log[5]
+        );
+        assert_eq!(log.len(), 8);
+        assert_eq!(*events.borrow(), vec![(2, "dt 0.1 → 0.5".to_string())]);
     }
 
     /// Records the steps it saw.

@@ -21,6 +21,17 @@ impl Interaction for GlobalDamping {
         }
     }
 
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        match change {
+            mote_run::Change::Damping(gamma) => {
+                let text = format!("damping γ {} → {gamma}", self.gamma);
+                self.gamma = *gamma;
+                Some(Ok(text))
+            }
+            _ => None,
+        }
+    }
+
     fn potential_energy(&mut self, _state: &State) -> f64 {
         0.0
     }

@@ -102,6 +102,31 @@ impl Interaction for ElectricField {
         }
     }
 
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        let mote_run::Change::Field {
+            kind: mote_run::FieldKind::Electric,
+            value,
+        } = change
+        else {
+            return None;
+        };
+        if self.angular_frequency != 0.0 {
+            return Some(Err(format!(
+                "the electric field oscillates (ω = {}): only a constant one can be set",
+                self.angular_frequency
+            )));
+        }
+        let e = DVec3::from(*value);
+        let text = format!(
+            "electric field E {} → {}",
+            super::vector_text(self.at(0.0)),
+            super::vector_text(e)
+        );
+        self.amplitude = e;
+        self.phase = 0.0;
+        Some(Ok(text))
+    }
+
     /// −Σ q E·r, or 0 where the box is periodic along the field (there the
     /// potential is not defined).
     fn potential_energy(&mut self, state: &State) -> f64 {

@@ -22,6 +22,11 @@ pub use lennard_jones::LennardJones;
 pub use springs::{Spring, SpringNetwork};
 pub use uniform::UniformField;
 
+/// "(1, 0, 0)": a vector as a change's answer writes it.
+pub(crate) fn vector_text(v: DVec3) -> String {
+    format!("({}, {}, {})", v.x, v.y, v.z)
+}
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -200,6 +205,13 @@ pub trait Interaction: Send {
     /// walls.
     fn wall_forces(&self) -> Vec<(String, DVec3)> {
         Vec::new()
+    }
+    /// Applies a change asked for from the live viewer when this
+    /// interaction owns what it sets: `Some(what changed)`, or
+    /// `Some(Err(why not))`; `None` when the change is not its business.
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        let _ = change;
+        None
     }
     /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation, for
     /// the pressure P V = N k T + W/3 of periodic systems (0 if not tracked).

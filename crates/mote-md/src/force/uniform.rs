@@ -21,6 +21,25 @@ impl Interaction for UniformField {
         }
     }
 
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        match change {
+            mote_run::Change::Field {
+                kind: mote_run::FieldKind::Gravity,
+                value,
+            } => {
+                let g = DVec3::from(*value);
+                let text = format!(
+                    "gravity g {} → {}",
+                    super::vector_text(self.g),
+                    super::vector_text(g)
+                );
+                self.g = g;
+                Some(Ok(text))
+            }
+            _ => None,
+        }
+    }
+
     /// U = −Σ m_i g·x_i.
     fn potential_energy(&mut self, state: &State) -> f64 {
         -state

@@ -216,6 +216,11 @@ impl Frbi {
         &self.interactions
     }
 
+    /// The interactions, to change their settings between steps.
+    pub fn interactions_mut(&mut self) -> &mut [Box<dyn BodyInteraction>] {
+        &mut self.interactions
+    }
+
     /// Every body `freeStep(dt)`: eight bodies at a time through
     /// [`free8`](super::free8) (the same bits as [`free_step`]), the last
     /// few one by one; blocks of bodies in parallel when there are many.

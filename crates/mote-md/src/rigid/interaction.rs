@@ -29,6 +29,12 @@ pub trait BodyInteraction: Send + Sync {
     fn potential_energy(&self, _view: &BodyView<'_>, _t: f64) -> f64 {
         0.0
     }
+    /// Applies a change asked for from the live viewer when this
+    /// interaction owns what it sets (see `Interaction::steer`).
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        let _ = change;
+        None
+    }
 
     /// What this interaction carries from one evaluation to the next
     /// (contact histories), as plain numbers for checkpoints; empty if nothing.

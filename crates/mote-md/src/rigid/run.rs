@@ -42,6 +42,8 @@ pub struct RigidRun {
     pub resume: Option<Checkpoint>,
     /// Replaces `[output] trajectory_format`.
     pub trajectory_format: Option<mote_io::trajectory::Format>,
+    /// The live viewer's tap, if the run is watched.
+    pub live: mote_run::LiveSlot,
 }
 
 /// Rigid bodies moved by the FRBI with a fixed step.
@@ -142,6 +144,25 @@ impl Propagator for RigidDynamics {
                 .map(|c| c.wall_forces())
                 .unwrap_or_default(),
         }
+    }
+
+    fn frame(&self) -> Option<Frame> {
+        Some(self.sphere_frame())
+    }
+
+    /// Δt is the integrator's; fields and drag go to the interaction that
+    /// owns them. Rigid runs have no thermostat.
+    fn change(&mut self, change: &mote_run::Change) -> Result<String, String> {
+        if let mote_run::Change::Dt(dt) = change {
+            let text = format!("dt {} → {dt}", self.dt);
+            self.dt = *dt;
+            return Ok(text);
+        }
+        self.frbi
+            .interactions_mut()
+            .iter_mut()
+            .find_map(|i| i.steer(change))
+            .unwrap_or_else(|| Err(format!("{}: the scene has none", change.what())))
     }
 
     /// The bodies (the angular table holds the rotation vector r and ω),
@@ -260,6 +281,12 @@ impl Observer<RigidDynamics> for RigidCsv {
 
     fn files(&self) -> Vec<String> {
         vec![self.writer.path().display().to_string()]
+    }
+
+    fn event(&mut self, d: &RigidDynamics, text: &str) -> Result<(), MdError> {
+        Ok(self
+            .writer
+            .comment(&crate::output::event_line(d.step, d.bodies.time, text))?)
     }
 }
 
@@ -454,6 +481,7 @@ pub fn run_rigid_scene(
         .unwrap_or_default();
     let append = options.resume.is_some();
     let mut driver = Driver::new();
+    driver.live = options.live.take();
     driver.observers.push(Box::new(RigidCsv::create(
         &dir.join("observables.csv"),
         &provenance,

@@ -93,6 +93,32 @@ impl BodyInteraction for ExternalFields {
         "external fields"
     }
 
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        use mote_run::FieldKind;
+        let mote_run::Change::Field { kind, value } = change else {
+            return None;
+        };
+        let (field, symbol) = match kind {
+            FieldKind::Electric => (&mut self.electric, "E"),
+            FieldKind::Magnetic => (&mut self.magnetic, "B"),
+            FieldKind::Gravity => return None,
+        };
+        let Field::Constant(old) = *field else {
+            return Some(Err(format!(
+                "the {} varies in time: only a constant one can be set",
+                kind.name()
+            )));
+        };
+        let new = DVec3::from(*value);
+        *field = Field::Constant(new);
+        Some(Ok(format!(
+            "{} {symbol} {} → {}",
+            kind.name(),
+            crate::force::vector_text(old),
+            crate::force::vector_text(new)
+        )))
+    }
+
     fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
         let (e, b) = (self.electric.at(t), self.magnetic.at(t));
         let bodies = view.bodies;
@@ -123,6 +149,24 @@ pub struct Gravity {
 impl BodyInteraction for Gravity {
     fn name(&self) -> &str {
         "gravity"
+    }
+
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        let mote_run::Change::Field {
+            kind: mote_run::FieldKind::Gravity,
+            value,
+        } = change
+        else {
+            return None;
+        };
+        let g = DVec3::from(*value);
+        let text = format!(
+            "gravity g {} → {}",
+            crate::force::vector_text(self.g),
+            crate::force::vector_text(g)
+        );
+        self.g = g;
+        Some(Ok(text))
     }
 
     fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
@@ -158,6 +202,16 @@ pub struct AirDrag {
 impl BodyInteraction for AirDrag {
     fn name(&self) -> &str {
         "air drag"
+    }
+
+    /// Damping sets the viscosity η of the Stokes parts.
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        let mote_run::Change::Damping(eta) = change else {
+            return None;
+        };
+        let text = format!("air viscosity η {} → {eta}", self.viscosity);
+        self.viscosity = *eta;
+        Some(Ok(text))
     }
 
     fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {

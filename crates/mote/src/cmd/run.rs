@@ -63,6 +63,7 @@ impl RunArgs {
             trajectory_format: self.trajectory_format,
             seed: global.seed,
             threads: global.threads,
+            live: Default::default(),
         }
     }
 }

@@ -873,6 +873,29 @@ impl Interaction for Zeeman {
         }
     }
 
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        let mote_run::Change::Field {
+            kind: mote_run::FieldKind::Magnetic,
+            value,
+        } = change
+        else {
+            return None;
+        };
+        let AppliedField::Uniform(h) = self.field else {
+            return Some(Err(
+                "the applied magnetic field rotates or has a gradient: only a constant, uniform one can be set"
+                    .into(),
+            ));
+        };
+        let new = DVec3::from(*value);
+        self.field = AppliedField::Uniform(new);
+        Some(Ok(format!(
+            "magnetic field H {} → {}",
+            crate::force::vector_text(h),
+            crate::force::vector_text(new)
+        )))
+    }
+
     /// Σ_i −μ₀ m_i·H(r_i, t) (0 for a state without dipoles).
     fn potential_energy(&mut self, state: &State) -> f64 {
         if state.dipole.len() == state.position.len() {

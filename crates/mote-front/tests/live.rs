@@ -1,0 +1,207 @@
+//! A live tap on a run (what `mote view SCENE` uses): it sees frames, its
+//! changes reach the next step, and the observables table records each as
+//! an event.
+
+use std::sync::{Arc, Mutex};
+
+use mote_front::{Input, RunOptions, Silent};
+use mote_io::xyz::Frame;
+use mote_run::{Change, FieldKind, Live, LiveSlot};
+
+const SCENE: &str = r#"
+title = "two particles falling under damping and a thermostat"
+[run]
+integrator = "leapfrog"
+dt = 0.001
+steps = 40
+[field]
+g = [0.0, 0.0, -1.0]
+[damping]
+gamma = 0.5
+[thermostat]
+kind = "langevin"
+gamma = 1.0
+kt = 0.1
+[[particle]]
+position = [0.0, 0.0, 0.0]
+mass = 1.0
+[[particle]]
+position = [1.0, 0.0, 0.0]
+mass = 1.0
+[output]
+observables_every = 10
+trajectory_every = 0
+"#;
+
+#[derive(Default)]
+struct Seen {
+    frames: Vec<(u64, f64, usize)>,
+    answers: Vec<(u64, Result<String, String>)>,
+}
+
+struct Tap(Arc<Mutex<Seen>>);
+
+impl Live for Tap {
+    fn between(
+        &mut self,
+        step: u64,
+        time: f64,
+        frame: &mut dyn FnMut() -> Option<Frame>,
+    ) -> Vec<Change> {
+        let f = frame().expect("point particles show themselves");
+        self.0
+            .lock()
+            .unwrap()
+            .frames
+            .push((step, time, f.positions.len()));
+        if step == 20 {
+            vec![
+                Change::Dt(0.002),
+                Change::Field {
+                    kind: FieldKind::Gravity,
+                    value: [0.0, 0.0, -2.0],
+                },
+                Change::Damping(0.25),
+                Change::Temperature(0.2),
+                Change::Field {
+                    kind: FieldKind::Magnetic,
+                    value: [1.0, 0.0, 0.0],
+                },
+            ]
+        } else {
+            Vec::new()
+        }
+    }
+
+    fn answer(&mut self, step: u64, _time: f64, _change: &Change, a: &Result<String, String>) {
+        self.0.lock().unwrap().answers.push((step, a.clone()));
+    }
+}
+
+#[test]
+fn changes_reach_the_next_step_and_are_recorded_as_events() {
+    let dir = tempfile::tempdir().unwrap();
+    let seen = Arc::new(Mutex::new(Seen::default()));
+    let options = RunOptions {
+        output: Some(dir.path().to_path_buf()),
+        seed: Some(3),
+        live: LiveSlot::new(Box::new(Tap(seen.clone()))),
+        ..RunOptions::default()
+    };
+    let input = Input::scene("live", "live.toml", SCENE);
+    mote_front::run_input(&input, &options, &mut Silent).unwrap();
+    let seen = seen.lock().unwrap();
+    // Prime, then every step; 20 steps of 0.001 and 20 of 0.002.
+    assert_eq!(seen.frames.len(), 41);
+    assert_eq!(seen.frames[0], (0, 0.0, 2));
+    let (step, t, _) = seen.frames[40];
+    assert_eq!(step, 40);
+    assert!((t - 0.06).abs() < 1e-12, "t = {t}");
+    let ok: Vec<&String> = seen
+        .answers
+        .iter()
+        .filter_map(|(_, a)| a.as_ref().ok())
+        .collect();
+    assert_eq!(
+        ok,
+        [
+            "dt 0.001 → 0.002",
+            "gravity g (0, 0, -1) → (0, 0, -2)",
+            "damping γ 0.5 → 0.25",
+            "temperature kT 0.1 → 0.2",
+        ]
+    );
+    let refused = seen.answers[4].1.as_ref().unwrap_err();
+    assert!(
+        refused.contains("magnetic field: the scene has none"),
+        "{refused}"
+    );
+    let csv = std::fs::read_to_string(dir.path().join("observables.csv")).unwrap();
+    let events: Vec<&str> = csv.lines().filter(|l| l.starts_with("# event:")).collect();
+    assert_eq!(events.len(), 4, "{csv}");
+    assert!(
+        events[0].starts_with("# event: step 20, t = 0.0200"),
+        "{}",
+        events[0]
+    );
+    assert!(events[0].ends_with(": dt 0.001 → 0.002"), "{}", events[0]);
+    // The events sit after the row of step 20 and before the row of step 30.
+    let lines: Vec<&str> = csv.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with("# event:"))
+        .unwrap();
+    assert!(
+        lines[at - 1].starts_with("2.0000000000000"),
+        "{}",
+        lines[at - 1]
+    );
+    assert!(
+        lines[at + 4].starts_with("4.0000000000000"),
+        "{}",
+        lines[at + 4]
+    );
+}
+
+/// Sets B = (0, 0, 2) at step 10 of the magnet-in-field example and asks
+/// for a temperature the rigid engine does not have.
+struct RigidTap(Arc<Mutex<Seen>>);
+
+impl Live for RigidTap {
+    fn between(
+        &mut self,
+        step: u64,
+        time: f64,
+        frame: &mut dyn FnMut() -> Option<Frame>,
+    ) -> Vec<Change> {
+        let f = frame().expect("rigid bodies show their spheres");
+        self.0
+            .lock()
+            .unwrap()
+            .frames
+            .push((step, time, f.positions.len()));
+        if step == 10 {
+            vec![
+                Change::Field {
+                    kind: FieldKind::Magnetic,
+                    value: [0.0, 0.0, 2.0],
+                },
+                Change::Temperature(1.0),
+            ]
+        } else {
+            Vec::new()
+        }
+    }
+
+    fn answer(&mut self, step: u64, _time: f64, _change: &Change, a: &Result<String, String>) {
+        self.0.lock().unwrap().answers.push((step, a.clone()));
+    }
+}
+
+#[test]
+fn a_rigid_run_takes_a_new_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let seen = Arc::new(Mutex::new(Seen::default()));
+    let options = RunOptions {
+        output: Some(dir.path().to_path_buf()),
+        steps: Some(20),
+        live: LiveSlot::new(Box::new(RigidTap(seen.clone()))),
+        ..RunOptions::default()
+    };
+    let input = Input::read("example:magnet-in-field").unwrap();
+    mote_front::run_input(&input, &options, &mut Silent).unwrap();
+    let seen = seen.lock().unwrap();
+    assert_eq!(seen.frames.len(), 21);
+    assert_eq!(seen.frames[0].2, 3, "the body's three spheres");
+    assert_eq!(
+        seen.answers[0].1.as_deref(),
+        Ok("magnetic field B (0, 1, 0) → (0, 0, 2)")
+    );
+    let refused = seen.answers[1].1.as_ref().unwrap_err();
+    assert!(
+        refused.contains("temperature: the scene has none"),
+        "{refused}"
+    );
+    let csv = std::fs::read_to_string(dir.path().join("observables.csv")).unwrap();
+    assert_eq!(csv.matches("# event: step 10").count(), 1, "{csv}");
+}
