@@ -39,7 +39,7 @@ struct Seen {
     answers: Vec<(u64, Result<String, String>)>,
 }
 
-struct Tap(Arc<Mutex<Seen>>);
+struct Tap(Arc<Mutex<Seen>>, bool);
 
 impl Live for Tap {
     fn between(
@@ -54,7 +54,8 @@ impl Live for Tap {
             .unwrap()
             .frames
             .push((step, time, f.positions.len()));
-        if step == 20 {
+        if step == 20 && !self.1 {
+            self.1 = true;
             vec![
                 Change::Dt(0.002),
                 Change::Field {
@@ -85,16 +86,17 @@ fn changes_reach_the_next_step_and_are_recorded_as_events() {
     let options = RunOptions {
         output: Some(dir.path().to_path_buf()),
         seed: Some(3),
-        live: LiveSlot::new(Box::new(Tap(seen.clone()))),
+        live: LiveSlot::new(Box::new(Tap(seen.clone(), false))),
         ..RunOptions::default()
     };
     let input = Input::scene("live", "live.toml", SCENE);
     mote_front::run_input(&input, &options, &mut Silent).unwrap();
     let seen = seen.lock().unwrap();
     // Prime, then every step; 20 steps of 0.001 and 20 of 0.002.
-    assert_eq!(seen.frames.len(), 41);
+    // Prime, every step, and step 20 again after its changes.
+    assert_eq!(seen.frames.len(), 42);
     assert_eq!(seen.frames[0], (0, 0.0, 2));
-    let (step, t, _) = seen.frames[40];
+    let (step, t, _) = seen.frames[41];
     assert_eq!(step, 40);
     assert!((t - 0.06).abs() < 1e-12, "t = {t}");
     let ok: Vec<&String> = seen
@@ -145,7 +147,7 @@ fn changes_reach_the_next_step_and_are_recorded_as_events() {
 
 /// Sets B = (0, 0, 2) at step 10 of the magnet-in-field example and asks
 /// for a temperature the rigid engine does not have.
-struct RigidTap(Arc<Mutex<Seen>>);
+struct RigidTap(Arc<Mutex<Seen>>, bool);
 
 impl Live for RigidTap {
     fn between(
@@ -160,7 +162,8 @@ impl Live for RigidTap {
             .unwrap()
             .frames
             .push((step, time, f.positions.len()));
-        if step == 10 {
+        if step == 10 && !self.1 {
+            self.1 = true;
             vec![
                 Change::Field {
                     kind: FieldKind::Magnetic,
@@ -185,13 +188,13 @@ fn a_rigid_run_takes_a_new_field() {
     let options = RunOptions {
         output: Some(dir.path().to_path_buf()),
         steps: Some(20),
-        live: LiveSlot::new(Box::new(RigidTap(seen.clone()))),
+        live: LiveSlot::new(Box::new(RigidTap(seen.clone(), false))),
         ..RunOptions::default()
     };
     let input = Input::read("example:magnet-in-field").unwrap();
     mote_front::run_input(&input, &options, &mut Silent).unwrap();
     let seen = seen.lock().unwrap();
-    assert_eq!(seen.frames.len(), 21);
+    assert_eq!(seen.frames.len(), 22);
     assert_eq!(seen.frames[0].2, 3, "the body's three spheres");
     assert_eq!(
         seen.answers[0].1.as_deref(),

@@ -247,17 +247,21 @@ impl<P: Propagator> Driver<P> {
         let Some(live) = self.live.as_mut() else {
             return Ok(());
         };
-        let changes = live.between(state.step(), state.time(), &mut || state.frame());
-        for change in changes {
-            let answer = change.check().and_then(|_| state.change(&change));
-            if let Ok(text) = &answer {
-                for o in &mut self.observers {
-                    o.event(state, text)?;
-                }
+        loop {
+            let changes = live.between(state.step(), state.time(), &mut || state.frame());
+            if changes.is_empty() {
+                return Ok(());
             }
-            live.answer(state.step(), state.time(), &change, &answer);
+            for change in changes {
+                let answer = change.check().and_then(|_| state.change(&change));
+                if let Ok(text) = &answer {
+                    for o in &mut self.observers {
+                        o.event(state, text)?;
+                    }
+                }
+                live.answer(state.step(), state.time(), &change, &answer);
+            }
         }
-        Ok(())
     }
 
     fn save(c: &Checkpoints, state: &mut P) -> Result<(), P::Error> {
@@ -336,7 +340,7 @@ mod tests {
 
     /// Asks for dt = 0.5 and a field at step 2; records the answers and
     /// the steps it saw.
-    struct Steer(std::sync::Arc<std::sync::Mutex<Vec<String>>>);
+    struct Steer(std::sync::Arc<std::sync::Mutex<Vec<String>>>, bool);
     impl Live for Steer {
         fn between(
             &mut self,
@@ -345,7 +349,8 @@ mod tests {
             _frame: &mut dyn FnMut() -> Option<Frame>,
         ) -> Vec<Change> {
             self.0.lock().unwrap().push(format!("step {step}"));
-            if step == 2 {
+            if step == 2 && !self.1 {
+                self.1 = true;
                 vec![
                     Change::Dt(0.5),
                     Change::Field {
@@ -386,7 +391,7 @@ mod tests {
         let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let events = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
         let mut d = Driver::new();
-        d.live = Some(Box::new(Steer(log.clone())));
+        d.live = Some(Box::new(Steer(log.clone(), false)));
         d.observers.push(Box::new(Events(events.clone())));
         let mut p = Decay {
             x: 1.0,
@@ -405,7 +410,9 @@ mod tests {
             "{}",
             log[5]
         );
-        assert_eq!(log.len(), 8);
+        // Step 2 is shown again after its changes, before stepping on.
+        assert_eq!(log[6], "step 2");
+        assert_eq!(log.len(), 9);
         assert_eq!(*events.borrow(), vec![(2, "dt 0.1 → 0.5".to_string())]);
     }
 

@@ -81,8 +81,10 @@ impl Change {
 pub trait Live: Send {
     /// Called after priming and after every step. `frame` makes the
     /// particles of now (call it only when a frame is wanted: it copies the
-    /// state). Returns the changes to apply before the next step; may hold
-    /// the run (pause) until it returns.
+    /// state). Returns the changes to apply before the next step, and is
+    /// called again once they are applied, until it returns none: a paused
+    /// viewer holds the run inside this call and returns the changes made
+    /// meanwhile without letting it step.
     fn between(
         &mut self,
         step: u64,

@@ -24,6 +24,7 @@ use std::net::{IpAddr, SocketAddr};
 use std::sync::Arc;
 
 use axum::body::Body;
+use axum::extract::ws::WebSocketUpgrade;
 use axum::extract::{Path, Query, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -31,6 +32,9 @@ use axum::routing::get;
 use axum::Router;
 use mote_io::xyz::Frame;
 use serde::Deserialize;
+
+pub mod live;
+pub mod table;
 
 const INDEX: &str = include_str!("../assets/index.html");
 const SCRIPT: &str = include_str!("../assets/viewer.js");
@@ -83,42 +87,7 @@ impl Trajectory {
             .frames
             .get(k)
             .ok_or_else(|| format!("no frame {k}: the file has {}", self.frames.len()))?;
-        if i >= f.positions.len() {
-            return Err(format!(
-                "no particle {i}: frame {k} has {}",
-                f.positions.len()
-            ));
-        }
-        let mut out = serde_json::Map::new();
-        out.insert("index".into(), i.into());
-        out.insert("time".into(), f.time.into());
-        out.insert("position".into(), serde_json::json!(f.positions[i]));
-        let v3 = |name: &str,
-                  c: &Vec<[f64; 3]>,
-                  out: &mut serde_json::Map<String, serde_json::Value>| {
-            if let Some(v) = c.get(i) {
-                out.insert(name.into(), serde_json::json!(v));
-            }
-        };
-        v3("velocity", &f.velocities, &mut out);
-        v3("omega", &f.angular_velocities, &mut out);
-        v3("dipole", &f.dipoles, &mut out);
-        if let Some(s) = f.species.get(i) {
-            out.insert("species".into(), s.clone().into());
-        }
-        if let Some(r) = f.radii.get(i) {
-            out.insert("radius".into(), (*r).into());
-        }
-        if let Some(m) = f.masses.get(i) {
-            out.insert("mass".into(), (*m).into());
-        }
-        if let Some(id) = f.ids.get(i) {
-            out.insert("id".into(), (*id).into());
-        }
-        if let Some(b) = f.bodies.get(i) {
-            out.insert("body".into(), (*b).into());
-        }
-        Ok(serde_json::Value::Object(out))
+        particle_json(f, i).map_err(|m| format!("{m} in frame {k}"))
     }
 
     /// Frame `k` as the binary of `/api/frame/K`, coloured by `color`.
@@ -127,36 +96,78 @@ impl Trajectory {
             .frames
             .get(k)
             .ok_or_else(|| format!("no frame {k}: the file has {}", self.frames.len()))?;
-        let n = f.positions.len();
-        let fallback = mote_render::frame::default_radius(f);
-        let values: Vec<f64> = if color == "species" {
-            f.species
-                .iter()
-                .map(|s| self.species.binary_search(s).map_or(0.0, |i| i as f64))
-                .chain(std::iter::repeat(0.0))
-                .take(n)
-                .collect()
-        } else {
-            mote_render::frame::quantity(f, color).map_err(|e| e.to_string())?
-        };
-        let mut out = Vec::with_capacity(4 + 20 * n);
-        out.extend((n as u32).to_le_bytes());
-        for (i, p) in f.positions.iter().enumerate() {
-            let r = f
-                .radii
-                .get(i)
-                .copied()
-                .filter(|r| *r > 0.0)
-                .unwrap_or(fallback);
-            for x in [p[0], p[1], p[2], r] {
-                out.extend((x as f32).to_le_bytes());
-            }
-        }
-        for v in values {
-            out.extend((v as f32).to_le_bytes());
-        }
-        Ok(out)
+        encode_frame(f, &self.species, color)
     }
+}
+
+/// Particle `i` of a frame as JSON: every column the frame has for it.
+pub fn particle_json(f: &Frame, i: usize) -> Result<serde_json::Value, String> {
+    if i >= f.positions.len() {
+        return Err(format!("no particle {i}: there are {}", f.positions.len()));
+    }
+    let mut out = serde_json::Map::new();
+    out.insert("index".into(), i.into());
+    out.insert("time".into(), f.time.into());
+    out.insert("position".into(), serde_json::json!(f.positions[i]));
+    let v3 =
+        |name: &str, c: &Vec<[f64; 3]>, out: &mut serde_json::Map<String, serde_json::Value>| {
+            if let Some(v) = c.get(i) {
+                out.insert(name.into(), serde_json::json!(v));
+            }
+        };
+    v3("velocity", &f.velocities, &mut out);
+    v3("omega", &f.angular_velocities, &mut out);
+    v3("dipole", &f.dipoles, &mut out);
+    if let Some(s) = f.species.get(i) {
+        out.insert("species".into(), s.clone().into());
+    }
+    if let Some(r) = f.radii.get(i) {
+        out.insert("radius".into(), (*r).into());
+    }
+    if let Some(m) = f.masses.get(i) {
+        out.insert("mass".into(), (*m).into());
+    }
+    if let Some(id) = f.ids.get(i) {
+        out.insert("id".into(), (*id).into());
+    }
+    if let Some(b) = f.bodies.get(i) {
+        out.insert("body".into(), (*b).into());
+    }
+    Ok(serde_json::Value::Object(out))
+}
+
+/// A frame as the page's binary: little-endian u32 N, N × (x, y, z, r) as
+/// f32, N values of `color` as f32 (species: the index in `species`).
+pub fn encode_frame(f: &Frame, species: &[String], color: &str) -> Result<Vec<u8>, String> {
+    let n = f.positions.len();
+    let fallback = mote_render::frame::default_radius(f);
+    let values: Vec<f64> = if color == "species" {
+        f.species
+            .iter()
+            .map(|s| species.binary_search(s).map_or(0.0, |i| i as f64))
+            .chain(std::iter::repeat(0.0))
+            .take(n)
+            .collect()
+    } else {
+        mote_render::frame::quantity(f, color).map_err(|e| e.to_string())?
+    };
+    let mut out = Vec::with_capacity(4 + 20 * n);
+    out.extend((n as u32).to_le_bytes());
+    for (i, p) in f.positions.iter().enumerate() {
+        let r = f
+            .radii
+            .get(i)
+            .copied()
+            .filter(|r| *r > 0.0)
+            .unwrap_or(fallback);
+        for x in [p[0], p[1], p[2], r] {
+            out.extend((x as f32).to_le_bytes());
+        }
+    }
+    for v in values {
+        out.extend((v as f32).to_le_bytes());
+    }
+    Ok(out)
 }
 
 #[derive(Deserialize)]
@@ -173,11 +184,81 @@ fn text(status: StatusCode, body: String) -> Response {
         .into_response()
 }
 
+/// What the server shows.
+pub enum App {
+    /// A trajectory file, with the observables table beside it if any.
+    File {
+        trajectory: Trajectory,
+        observables: Option<table::Table>,
+    },
+    /// A run in progress.
+    Live(Arc<live::Session>),
+    /// An input that could not be read: the page shows why.
+    Failed { label: String, message: String },
+}
+
+impl App {
+    /// A trajectory file's frames, and the observables.csv of its folder.
+    pub fn file(trajectory: Trajectory, observables: Option<table::Table>) -> Arc<App> {
+        Arc::new(App::File {
+            trajectory,
+            observables,
+        })
+    }
+
+    /// The JSON of `/api/meta`.
+    pub fn meta(&self) -> serde_json::Value {
+        let quantities: Vec<&str> = std::iter::once("species")
+            .chain(QUANTITIES.iter().copied())
+            .collect();
+        match self {
+            App::File {
+                trajectory,
+                observables,
+            } => {
+                let mut m = trajectory.meta();
+                m["observables"] = observables.is_some().into();
+                m
+            }
+            App::Live(s) => serde_json::json!({
+                "label": s.label,
+                "live": true,
+                "frames": 0,
+                "species": [],
+                "quantities": quantities,
+            }),
+            App::Failed { label, message } => serde_json::json!({
+                "label": label,
+                "error": message,
+                "frames": 0,
+                "quantities": quantities,
+            }),
+        }
+    }
+}
+
+fn file_only(app: &App) -> Option<&Trajectory> {
+    match app {
+        App::File { trajectory, .. } => Some(trajectory),
+        _ => None,
+    }
+}
+
+fn no_file() -> Response {
+    text(
+        StatusCode::NOT_FOUND,
+        "no trajectory file: this is a live run".into(),
+    )
+}
+
 async fn frame(
-    State(t): State<Arc<Trajectory>>,
+    State(app): State<Arc<App>>,
     Path(k): Path<String>,
     Query(q): Query<FrameQuery>,
 ) -> Response {
+    let Some(t) = file_only(&app) else {
+        return no_file();
+    };
     let Ok(k) = k.parse::<usize>() else {
         return text(StatusCode::NOT_FOUND, format!("not a frame number: {k}"));
     };
@@ -192,10 +273,10 @@ async fn frame(
     }
 }
 
-async fn particle(
-    State(t): State<Arc<Trajectory>>,
-    Path((k, i)): Path<(String, String)>,
-) -> Response {
+async fn particle(State(app): State<Arc<App>>, Path((k, i)): Path<(String, String)>) -> Response {
+    let Some(t) = file_only(&app) else {
+        return no_file();
+    };
     match (k.parse::<usize>(), i.parse::<usize>()) {
         (Ok(k), Ok(i)) => match t.particle(k, i) {
             Ok(v) => axum::Json(v).into_response(),
@@ -208,8 +289,30 @@ async fn particle(
     }
 }
 
+/// The file's observables table (columns, rows, events) for the plots.
+async fn observables(State(app): State<Arc<App>>) -> Response {
+    match &*app {
+        App::File {
+            observables: Some(t),
+            ..
+        } => axum::Json(t).into_response(),
+        _ => text(StatusCode::NOT_FOUND, "no observables table".into()),
+    }
+}
+
+/// The live run's socket.
+async fn socket(State(app): State<Arc<App>>, ws: WebSocketUpgrade) -> Response {
+    match &*app {
+        App::Live(session) => {
+            let session = Arc::clone(session);
+            ws.on_upgrade(move |socket| live::client(socket, session))
+        }
+        _ => text(StatusCode::NOT_FOUND, "not a live run".into()),
+    }
+}
+
 /// The page's routes; anything else is 404.
-pub fn router(trajectory: Arc<Trajectory>) -> Router {
+pub fn router(app: Arc<App>) -> Router {
     Router::new()
         .route(
             "/",
@@ -226,12 +329,14 @@ pub fn router(trajectory: Arc<Trajectory>) -> Router {
         )
         .route(
             "/api/meta",
-            get(|State(t): State<Arc<Trajectory>>| async move { axum::Json(t.meta()) }),
+            get(|State(app): State<Arc<App>>| async move { axum::Json(app.meta()) }),
         )
         .route("/api/frame/{k}", get(frame))
         .route("/api/particle/{k}/{i}", get(particle))
+        .route("/api/observables", get(observables))
+        .route("/api/live", get(socket))
         .fallback(|| async { text(StatusCode::NOT_FOUND, "not found".into()) })
-        .with_state(trajectory)
+        .with_state(app)
 }
 
 /// A listener on `host` (an IP address) and `port` (0: any free one), and
@@ -249,14 +354,14 @@ pub fn bind(host: &str, port: u16) -> Result<(std::net::TcpListener, bool), Stri
     Ok((listener, ip.is_loopback()))
 }
 
-/// Serves `trajectory` on `listener` until `shutdown` completes.
+/// Serves `app` on `listener` until `shutdown` completes.
 pub async fn serve(
     listener: std::net::TcpListener,
-    trajectory: Arc<Trajectory>,
+    app: Arc<App>,
     shutdown: impl std::future::Future<Output = ()> + Send + 'static,
 ) -> std::io::Result<()> {
     let listener = tokio::net::TcpListener::from_std(listener)?;
-    axum::serve(listener, router(trajectory))
+    axum::serve(listener, router(app))
         .with_graceful_shutdown(shutdown)
         .await
 }

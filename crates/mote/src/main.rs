@@ -54,8 +54,8 @@ enum Command {
     Edmd(cmd::edmd::EdmdArgs),
 }
 
-/// SIGINT and SIGTERM during `mote run` (and its alias `mote edmd`) and
-/// `mote pack`: the first asks the run to stop after its current step or
+/// SIGINT and SIGTERM during `mote run` (and its alias `mote edmd`),
+/// `mote pack` and `mote view`: the first asks the run to stop after its current step or
 /// window (files flushed, a last checkpoint where checkpoints are on, the
 /// packing so far written; exit 128 + the signal's number); a second one
 /// ends the program at once. Other subcommands keep the default: a signal
@@ -95,7 +95,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     if matches!(
         cli.command,
-        Command::Run(_) | Command::Edmd(_) | Command::Pack(_)
+        Command::Run(_) | Command::Edmd(_) | Command::Pack(_) | Command::View(_)
     ) {
         stop_cleanly_on_signals();
     }

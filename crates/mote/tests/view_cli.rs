@@ -1,46 +1,18 @@
 //! `mote view` from the command line: a trajectory that cannot be read is
-//! refused at once with `file:line: message` and a non-zero exit; a good one
-//! is served on 127.0.0.1 and the printed address answers.
+//! reported with `file:line: message` in the terminal and on the page, and
+//! the exit is non-zero; a good one is served on 127.0.0.1 and the printed
+//! address answers; a live run goes on with no page open and Ctrl-C ends
+//! it and the server cleanly, its files kept.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::process::{Command, Stdio};
 
-#[test]
-fn unreadable_trajectory_is_refused_with_its_line() {
-    let dir = tempfile::tempdir().unwrap();
-    let bad = dir.path().join("bad.xyz");
-    std::fs::write(
-        &bad,
-        "2\nLattice=\"1 0 0 0 1 0 0 0 1\"\nH 0 0 0\nH 0 zero 0\n",
-    )
-    .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_mote"))
-        .args(["view", bad.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("bad.xyz:4"), "{err}");
-    let missing = Command::new(env!("CARGO_BIN_EXE_mote"))
-        .args(["view", "no-such-file.xyz"])
-        .output()
-        .unwrap();
-    assert!(!missing.status.success());
-    assert!(String::from_utf8_lossy(&missing.stderr).contains("no-such-file.xyz"));
-}
-
-#[test]
-fn serves_on_loopback_and_prints_the_address() {
-    let dir = tempfile::tempdir().unwrap();
-    let good = dir.path().join("good.xyz");
-    std::fs::write(
-        &good,
-        "2\nLattice=\"4 0 0 0 4 0 0 0 4\" Properties=species:S:1:pos:R:3\nH 1 1 1\nO 2 2 2\n",
-    )
-    .unwrap();
+/// Starts `mote view ARGS`; the child and the port it printed.
+fn start(args: &[&str]) -> (std::process::Child, u16) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_mote"))
-        .args(["view", good.to_str().unwrap()])
+        .arg("view")
+        .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -58,16 +30,115 @@ fn serves_on_loopback_and_prints_the_address() {
         .trim_end_matches('/')
         .parse()
         .unwrap();
+    (child, port)
+}
+
+fn get(port: u16, path: &str) -> String {
     let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
     write!(
         s,
-        "GET /api/meta HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
+        "GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
     )
     .unwrap();
     let mut reply = String::new();
     s.read_to_string(&mut reply).unwrap();
-    child.kill().ok();
-    child.wait().ok();
+    reply
+}
+
+/// Sends SIGINT (what Ctrl-C sends) and waits for the exit.
+fn interrupt(mut child: std::process::Child) -> (std::process::ExitStatus, String) {
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (status, err)
+}
+
+#[test]
+fn unreadable_trajectory_is_shown_in_the_terminal_and_on_the_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.xyz");
+    std::fs::write(
+        &bad,
+        "2\nLattice=\"1 0 0 0 1 0 0 0 1\"\nH 0 0 0\nH 0 zero 0\n",
+    )
+    .unwrap();
+    let (child, port) = start(&[bad.to_str().unwrap()]);
+    let meta = get(port, "/api/meta");
+    assert!(
+        meta.contains("\"error\":") && meta.contains("bad.xyz:4"),
+        "{meta}"
+    );
+    let (status, err) = interrupt(child);
+    assert_eq!(status.code(), Some(1));
+    assert!(err.contains("bad.xyz:4"), "{err}");
+    let (child, port) = start(&["no-such-file.xyz"]);
+    assert!(get(port, "/api/meta").contains("no-such-file.xyz"));
+    let (status, err) = interrupt(child);
+    assert_eq!(status.code(), Some(1));
+    assert!(err.contains("no-such-file.xyz"), "{err}");
+}
+
+#[test]
+fn serves_on_loopback_and_prints_the_address() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.xyz");
+    std::fs::write(
+        &good,
+        "2\nLattice=\"4 0 0 0 4 0 0 0 4\" Properties=species:S:1:pos:R:3\nH 1 1 1\nO 2 2 2\n",
+    )
+    .unwrap();
+    let (child, port) = start(&[good.to_str().unwrap()]);
+    let reply = get(port, "/api/meta");
+    let (status, _) = interrupt(child);
+    assert_eq!(status.code(), Some(0));
     assert!(reply.starts_with("HTTP/1.1 200"), "{reply}");
     assert!(reply.contains("\"frames\":1"), "{reply}");
+}
+
+#[test]
+fn ctrl_c_ends_a_live_run_and_the_server_keeping_the_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("fall.toml");
+    std::fs::write(
+        &scene,
+        "[run]\nintegrator = \"leapfrog\"\ndt = 1e-4\nsteps = 100000000\n\
+         [field]\ng = [0.0, 0.0, -1.0]\n[[particle]]\nposition = [0.0, 0.0, 0.0]\n\
+         [output]\nobservables_every = 100\ntrajectory_every = 0\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let (child, port) = start(&[scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let meta = get(port, "/api/meta");
+    assert!(meta.contains("\"live\":true"), "{meta}");
+    // No page is open: the run goes on by itself.
+    let table = out.join("observables.csv");
+    let rows = || {
+        std::fs::read_to_string(&table)
+            .map(|t| t.lines().filter(|l| !l.starts_with('#')).count())
+            .unwrap_or(0)
+    };
+    let t0 = std::time::Instant::now();
+    while rows() < 10 && t0.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert!(rows() >= 10, "the run did not go on without a page");
+    let (status, err) = interrupt(child);
+    assert_eq!(status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("stopped") || err.contains("interrupt"),
+        "{err}"
+    );
+    let kept = rows();
+    assert!(kept >= 10);
+    let last = std::fs::read_to_string(&table).unwrap();
+    assert!(last.ends_with('\n'), "the table ends in a whole row");
 }

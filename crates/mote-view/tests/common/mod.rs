@@ -1,9 +1,7 @@
 //! What the viewer's tests share: a server for a trajectory in a thread.
 
-use std::sync::Arc;
-
 use mote_io::xyz::Frame;
-use mote_view::{bind, serve, Trajectory};
+use mote_view::{bind, serve, App, Trajectory};
 
 /// Serves `frames` (named `label`) on 127.0.0.1 and a free port, in a
 /// thread that lives as long as the test; returns the port.
@@ -11,7 +9,7 @@ pub fn start(label: &str, frames: Vec<Frame>) -> u16 {
     let (listener, loopback) = bind("127.0.0.1", 0).unwrap();
     assert!(loopback);
     let port = listener.local_addr().unwrap().port();
-    let t = Arc::new(Trajectory::new(label.into(), frames));
+    let t = App::file(Trajectory::new(label.into(), frames), None);
     std::thread::spawn(move || {
         tokio::runtime::Runtime::new()
             .unwrap()

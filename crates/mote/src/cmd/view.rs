@@ -1,21 +1,28 @@
-//! `mote view`: a trajectory in the browser (crates/mote-view). Serves on
-//! 127.0.0.1 and a free port unless told otherwise, prints the address, and
-//! runs until Ctrl-C.
+//! `mote view`: a trajectory, or a run in progress, in the browser
+//! (crates/mote-view). Serves on 127.0.0.1 and a free port unless told
+//! otherwise, prints the address, and runs until Ctrl-C. Input that cannot
+//! be read is reported in the terminal and on the page (exit 1 at the end).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
+use std::time::Duration;
 
-use anyhow::{anyhow, bail};
+use anyhow::anyhow;
+use mote_front::{Engine, Input, RunOptions, Terminal};
+use mote_view::live::Session;
+use mote_view::App;
 
-/// Shows a trajectory (extended XYZ, LAMMPS dump, GSD, VTU, PVD) on a local web page.
+/// Shows a trajectory (extended XYZ, LAMMPS dump, GSD, VTU, PVD) or runs a
+/// scene live on a local web page.
 #[derive(clap::Args, Debug)]
-#[command(
-    after_help = "Examples:\n  mote view out/settling/trajectory.xyz\n  mote view traj.dump --port 8080 --open"
-)]
+#[command(after_help = "Examples:\n  mote view out/settling/trajectory.xyz\n  \
+mote view example:ferrofluid        (runs it; pause, change the field, dt, ...)\n  \
+mote view traj.dump --port 8080 --open")]
 pub struct ViewArgs {
-    /// The trajectory file.
-    file: PathBuf,
+    /// A trajectory file, or a scene file, particle file or example:NAME to
+    /// run live.
+    input: String,
     /// Address to listen on (default 127.0.0.1: this machine only; anything
     /// else lets other machines see the page, with a warning).
     #[arg(long, value_name = "IP", default_value = "127.0.0.1")]
@@ -26,19 +33,117 @@ pub struct ViewArgs {
     /// Open the page in the default browser.
     #[arg(long)]
     open: bool,
+    /// Live runs: output folder (default: the scene's, else out/NAME).
+    #[arg(short, long, value_name = "DIR")]
+    output: Option<PathBuf>,
+    /// Live runs: run until this simulated time.
+    #[arg(long, value_name = "T")]
+    until: Option<f64>,
+    /// Live runs: run this many steps.
+    #[arg(long, value_name = "N", conflicts_with = "until")]
+    steps: Option<u64>,
+    /// Live runs: time step.
+    #[arg(long, value_name = "DT")]
+    dt: Option<f64>,
+}
+
+/// A trajectory by its extension; anything else is a scene to run.
+fn is_trajectory(input: &str) -> bool {
+    !input.starts_with("example:")
+        && mote_io::trajectory::Format::of_path(Path::new(input)).is_some()
+}
+
+fn file_name(input: &str) -> String {
+    Path::new(input)
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| input.to_string())
+}
+
+/// The trajectory's frames and its folder's observables.csv.
+fn file_app(input: &str) -> Result<(Arc<App>, String), String> {
+    let path = Path::new(input);
+    let frames = mote_io::trajectory::read_frames(path).map_err(|e| e.to_string())?;
+    if frames.is_empty() {
+        return Err(format!("{input}: no frames"));
+    }
+    let table = path
+        .parent()
+        .map(|d| d.join("observables.csv"))
+        .filter(|p| p.exists())
+        .and_then(|p| mote_view::table::Table::read(&p).ok());
+    let line = format!(
+        "{} frames, {} particles in the first",
+        frames.len(),
+        frames[0].positions.len()
+    );
+    let t = mote_view::Trajectory::new(file_name(input), frames);
+    Ok((App::file(t, table), line))
+}
+
+/// Starts the run in a thread of its own; the page watches it through the
+/// session.
+fn live_app(
+    global: &super::GlobalOpts,
+    a: &ViewArgs,
+) -> Result<(Arc<App>, String, std::thread::JoinHandle<()>), String> {
+    let input = Input::read(&a.input).map_err(|e| e.to_string())?;
+    if input.engine() == Engine::Packing {
+        return Err(format!(
+            "{}: a packing runs its own loop: make it with `mote pack`, then `mote view` its trajectory",
+            a.input
+        ));
+    }
+    let scene_dir = (!input.plist)
+        .then(|| toml::from_str::<toml::Table>(&input.text).ok())
+        .flatten()
+        .and_then(|t| t.get("output")?.get("dir")?.as_str().map(str::to_string));
+    let dir = input.output_dir(a.output.as_ref(), scene_dir.as_ref());
+    let session = Session::new(input.label.clone(), dir.clone());
+    let options = RunOptions {
+        input: Some(a.input.clone()),
+        until: a.until,
+        steps: a.steps,
+        dt: a.dt,
+        output: Some(dir.clone()),
+        seed: global.seed,
+        threads: global.threads,
+        live: mote_run::LiveSlot::new(session.tap()),
+        ..RunOptions::default()
+    };
+    let run_session = Arc::clone(&session);
+    let quiet = global.quiet;
+    // The run uses the pool the command was started in.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(rayon::current_num_threads())
+        .build()
+        .map_err(|e| e.to_string())?;
+    let run = std::thread::spawn(move || {
+        let mut terminal = Terminal::new(true);
+        let result = pool.install(|| mote_front::run(&options, &mut terminal));
+        let (text, failed) = match result {
+            Ok(outcome) => {
+                let code = super::run::report(&outcome, quiet);
+                let failed = code != ExitCode::SUCCESS;
+                let text = match &outcome.ending {
+                    mote_front::Ending::Finished => outcome.summary.join(" "),
+                    mote_front::Ending::Unstable(m) => m.clone(),
+                    mote_front::Ending::Interrupted { message, .. } => message.clone(),
+                };
+                (text, failed)
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                (e.to_string(), true)
+            }
+        };
+        run_session.end(text, failed);
+    });
+    let line = format!("running live, files in {}", dir.display());
+    Ok((Arc::new(App::Live(session)), line, run))
 }
 
 pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> {
-    let frames = mote_io::trajectory::read_frames(&a.file).map_err(|e| anyhow!("{e}"))?;
-    if frames.is_empty() {
-        bail!("{}: no frames", a.file.display());
-    }
-    let label = a
-        .file
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| a.file.display().to_string());
-    let trajectory = Arc::new(mote_view::Trajectory::new(label, frames));
     let (listener, loopback) = mote_view::bind(&a.bind, a.port).map_err(|m| anyhow!(m))?;
     if !loopback {
         eprintln!(
@@ -46,6 +151,21 @@ pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> 
             a.bind
         );
     }
+    let made = if is_trajectory(&a.input) {
+        file_app(&a.input).map(|(app, line)| (app, line, None))
+    } else {
+        live_app(global, &a).map(|(app, line, run)| (app, line, Some(run)))
+    };
+    let mut failed = false;
+    let (app, line, run) = made.unwrap_or_else(|message| {
+        eprintln!("error: {message}");
+        failed = true;
+        let app = Arc::new(App::Failed {
+            label: file_name(&a.input),
+            message,
+        });
+        (app, "could not be read (the page says why)".into(), None)
+    });
     let addr = listener.local_addr()?;
     let host = if addr.ip().is_unspecified() {
         "127.0.0.1".to_string()
@@ -57,15 +177,10 @@ pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> 
     } else {
         format!("http://{host}:{}/", addr.port())
     };
-    if !global.quiet {
-        println!(
-            "mote view {}: {} frames, {} particles in the first; open {url} (Ctrl-C ends)",
-            a.file.display(),
-            trajectory.frames.len(),
-            trajectory.frames[0].positions.len()
-        );
+    if !global.quiet || failed {
+        println!("mote view {}: {line}; open {url} (Ctrl-C ends)", a.input);
     }
-    // The page is flushed before anything waits.
+    // The address is flushed before anything waits.
     use std::io::Write;
     std::io::stdout().flush().ok();
     if a.open {
@@ -77,8 +192,19 @@ pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> 
         .worker_threads(2)
         .enable_all()
         .build()?;
-    runtime.block_on(mote_view::serve(listener, trajectory, async {
-        tokio::signal::ctrl_c().await.ok();
+    // Ctrl-C (SIGINT) or SIGTERM sets the stop flag: the run ends after its
+    // step (files flushed), then the server.
+    runtime.block_on(mote_view::serve(listener, app, async {
+        while mote_io::system::stop_requested().is_none() {
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
     }))?;
-    Ok(ExitCode::SUCCESS)
+    if let Some(run) = run {
+        run.join().ok();
+    }
+    Ok(if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
 }
