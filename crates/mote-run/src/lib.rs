@@ -224,6 +224,9 @@ impl<P: Propagator> Driver<P> {
                 }
             }
         }
+        if let Some(live) = self.live.as_mut() {
+            live.last(state.step(), state.time(), &mut || state.frame());
+        }
         let last = match last {
             Some(s) => s,
             None => initial.clone(),

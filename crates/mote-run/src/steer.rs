@@ -91,6 +91,11 @@ pub trait Live: Send {
         time: f64,
         frame: &mut dyn FnMut() -> Option<Frame>,
     ) -> Vec<Change>;
+    /// The run reached its last step: show it (called once, not after an
+    /// unstable step or a signal).
+    fn last(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Frame>) {
+        let _ = (step, time, frame);
+    }
     /// The answer to a change: what changed, or why it could not.
     fn answer(&mut self, step: u64, time: f64, change: &Change, answer: &Result<String, String>);
 }

@@ -2,12 +2,15 @@
 // Each particle is one quad facing the camera; the fragment shader cuts the
 // disc, shades it as a sphere and writes the sphere's depth, so that
 // intersecting spheres (clumps) look right. window.moteScene holds what the
-// page shows, for tests and the console.
+// page shows, for tests and the console. A trajectory file comes frame by
+// frame over HTTP; a live run over a WebSocket (/api/live), one frame at a
+// time: the page says "ready" after drawing one and gets the latest then.
 "use strict";
 
 const $ = (id) => document.getElementById(id);
 const scene = { meta: null, frame: 0, n: 0, time: 0, playing: false, speed: 1,
-                color: "species", range: [0, 1], loaded: 0, errors: [], picked: null };
+                color: "species", range: [0, 1], loaded: 0, errors: [], picked: null,
+                live: false, step: 0, paused: false, log: [], ended: null, rows: 0, tracked: 0 };
 window.moteScene = scene;
 
 function fail(message) {
@@ -139,7 +142,22 @@ function eye() {
           c.target[2] + c.distance * Math.cos(c.phi)];
 }
 
-let spheres, lines, sphereVao, lineVao, sphereBuf, valueBuf, boxCount = 0;
+let spheres, lines, sphereVao, lineVao, sphereBuf, valueBuf, lineBuf, boxCount = 0;
+
+// The box's twelve edges, if the frame has a cell.
+function setBox(cell, o) {
+  if (!cell || !(Math.abs(cell[0][0] * cell[1][1] * cell[2][2]) > 0)) return;
+  const corner = (i, j, k) => [0, 1, 2].map((a) => o[a] + i * cell[0][a] + j * cell[1][a] + k * cell[2][a]);
+  const edges = [];
+  for (const [a, b] of [[[0,0,0],[1,0,0]],[[0,1,0],[1,1,0]],[[0,0,1],[1,0,1]],[[0,1,1],[1,1,1]],
+                        [[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]],[[0,0,1],[0,1,1]],[[1,0,1],[1,1,1]],
+                        [[0,0,0],[0,0,1]],[[1,0,0],[1,0,1]],[[0,1,0],[0,1,1]],[[1,1,0],[1,1,1]]]) {
+    edges.push(...corner(...a), ...corner(...b));
+  }
+  gl.bindBuffer(gl.ARRAY_BUFFER, lineBuf);
+  gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(edges), gl.STATIC_DRAW);
+  boxCount = 24;
+}
 
 function setup() {
   if (!gl) throw new Error("WebGL2 is not available in this browser");
@@ -159,22 +177,10 @@ function setup() {
   gl.vertexAttribDivisor(1, 1);
   lineVao = gl.createVertexArray();
   gl.bindVertexArray(lineVao);
-  const lineBuf = gl.createBuffer();
+  lineBuf = gl.createBuffer();
   gl.bindBuffer(gl.ARRAY_BUFFER, lineBuf);
   gl.enableVertexAttribArray(0);
   gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
-  const cell = scene.meta.cell, o = scene.meta.origin;
-  if (cell && Math.abs(cell[0][0] * cell[1][1] * cell[2][2]) > 0) {
-    const corner = (i, j, k) => [0, 1, 2].map((a) => o[a] + i * cell[0][a] + j * cell[1][a] + k * cell[2][a]);
-    const edges = [];
-    for (const [a, b] of [[[0,0,0],[1,0,0]],[[0,1,0],[1,1,0]],[[0,0,1],[1,0,1]],[[0,1,1],[1,1,1]],
-                          [[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]],[[0,0,1],[0,1,1]],[[1,0,1],[1,1,1]],
-                          [[0,0,0],[0,0,1]],[[1,0,0],[1,0,1]],[[0,1,0],[0,1,1]],[[1,1,0],[1,1,1]]]) {
-      edges.push(...corner(...a), ...corner(...b));
-    }
-    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(edges), gl.STATIC_DRAW);
-    boxCount = 24;
-  }
   gl.bindVertexArray(null);
   gl.enable(gl.DEPTH_TEST);
   gl.clearColor(1, 1, 1, 1);
@@ -251,12 +257,30 @@ function legend() {
   g.fillText(hiText, c.width - 8 - g.measureText(hiText).width, 52);
 }
 
+// A frame's bytes: u32 N, N × (x, y, z, r), N values, little-endian.
+function decode(buf) {
+  const n = new DataView(buf).getUint32(0, true);
+  return { n, spheres: new Float32Array(buf, 4, 4 * n), values: new Float32Array(buf, 4 + 16 * n, n) };
+}
+
 async function fetchFrame(k) {
   const r = await fetch(`/api/frame/${k}?color=${encodeURIComponent(scene.color)}`);
   if (!r.ok) throw new Error(`frame ${k}: ${await r.text()}`);
-  const buf = await r.arrayBuffer();
-  const n = new DataView(buf).getUint32(0, true);
-  return { n, spheres: new Float32Array(buf, 4, 4 * n), values: new Float32Array(buf, 4 + 16 * n, n) };
+  return decode(await r.arrayBuffer());
+}
+
+// Hands a decoded frame to the GPU and sets the colour range.
+function upload(data) {
+  if (!camera.home) frameCamera(data);
+  gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
+  gl.bufferData(gl.ARRAY_BUFFER, data.spheres, gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
+  gl.bufferData(gl.ARRAY_BUFFER, data.values, gl.DYNAMIC_DRAW);
+  let lo = Infinity, hi = -Infinity;
+  for (const v of data.values) { if (v < lo) lo = v; if (v > hi) hi = v; }
+  scene.range = lo <= hi ? [lo, hi > lo ? hi : lo + 1] : [0, 1];
+  scene.n = data.n;
+  current = data;
 }
 
 let pending = false;
@@ -289,36 +313,210 @@ function pickAt(px, py) {
   return hit;
 }
 
-async function inspect(i) {
-  scene.picked = i;
+// Shows one particle's columns in the inspector.
+function showParticle(p) {
   const panel = $("inspector");
-  if (i === null) { panel.style.display = "none"; publish(); return; }
-  const r = await fetch(`/api/particle/${scene.frame}/${i}`);
-  if (!r.ok) { fail(await r.text()); return; }
-  const p = await r.json();
   scene.inspected = p;
   panel.textContent = Object.entries(p)
     .map(([k, v]) => `${k}: ${Array.isArray(v) ? v.map((x) => Number(x).toPrecision(6)).join(", ") : v}`)
     .join("\n");
   panel.style.display = "block";
+}
+
+async function inspect(i) {
+  const changed = i !== scene.picked;
+  scene.picked = i;
+  if (i === null) {
+    $("inspector").style.display = "none";
+    $("pickplot").style.display = "none";
+    if (live) live.send(JSON.stringify({ do: "pick", index: null }));
+    publish();
+    return;
+  }
+  if (live) {
+    // The particle comes with every frame from now on; its history starts here.
+    if (changed) { track = { time: [], speed: [], x: [], y: [], z: [] }; live.send(JSON.stringify({ do: "pick", index: i })); }
+    $("pickname").textContent = `#${i}`;
+    $("pickplot").style.display = "block";
+    publish();
+    return;
+  }
+  const r = await fetch(`/api/particle/${scene.frame}/${i}`);
+  if (!r.ok) { fail(await r.text()); return; }
+  showParticle(await r.json());
+  if (changed) {
+    const t = await fetch(`/api/track/${i}`);
+    if (t.ok) { track = await t.json(); scene.tracked = track.time.length; }
+  }
+  $("pickname").textContent = `#${i}`;
+  $("pickplot").style.display = "block";
+  plots();
   publish();
+}
+
+// Line plots on a 2-D canvas: y against x, axes with their ranges, and
+// dashed marks at `marks` (the times of the run's events).
+function linePlot(canvas, x, y, marks) {
+  const g = canvas.getContext("2d"), w = canvas.width, h = canvas.height;
+  const left = 52, bottom = 18, top = 6, right = 6;
+  g.clearRect(0, 0, w, h);
+  g.font = "10px system-ui, sans-serif";
+  g.fillStyle = "#222";
+  const finite = (v) => Number.isFinite(v);
+  let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+  for (let i = 0; i < x.length; i++) {
+    if (!finite(x[i]) || !finite(y[i])) continue;
+    x0 = Math.min(x0, x[i]); x1 = Math.max(x1, x[i]);
+    y0 = Math.min(y0, y[i]); y1 = Math.max(y1, y[i]);
+  }
+  if (!(x0 <= x1)) { g.fillText("no data yet", left, h / 2); return; }
+  if (x1 === x0) x1 = x0 + 1;
+  if (y1 === y0) { y0 -= Math.abs(y0) * 0.01 + 1e-30; y1 += Math.abs(y1) * 0.01 + 1e-30; }
+  const px = (v) => left + (w - left - right) * (v - x0) / (x1 - x0);
+  const py = (v) => h - bottom - (h - bottom - top) * (v - y0) / (y1 - y0);
+  g.strokeStyle = "#999";
+  g.strokeRect(left, top, w - left - right, h - top - bottom);
+  g.fillText(y1.toPrecision(4), 2, top + 8);
+  g.fillText(y0.toPrecision(4), 2, h - bottom);
+  g.fillText(x0.toPrecision(4), left, h - 4);
+  const xe = x1.toPrecision(4);
+  g.fillText(xe, w - right - g.measureText(xe).width, h - 4);
+  g.strokeStyle = "#c60";
+  g.setLineDash([3, 3]);
+  for (const m of marks || []) {
+    if (m >= x0 && m <= x1) { g.beginPath(); g.moveTo(px(m), top); g.lineTo(px(m), h - bottom); g.stroke(); }
+  }
+  g.setLineDash([]);
+  g.strokeStyle = "#1f77b4";
+  g.lineWidth = 1.5;
+  g.beginPath();
+  let pen = false;
+  for (let i = 0; i < x.length; i++) {
+    if (!finite(x[i]) || !finite(y[i])) { pen = false; continue; }
+    if (pen) g.lineTo(px(x[i]), py(y[i])); else g.moveTo(px(x[i]), py(y[i]));
+    pen = true;
+  }
+  g.stroke();
+}
+
+// The observables table (time first) and the picked particle's history.
+let table = { columns: [], rows: [], events: [] };
+let track = { time: [], speed: [], x: [], y: [], z: [] };
+function addTable(part) {
+  if (part.columns && part.columns.length) {
+    table.columns = part.columns;
+    const select = $("obscol");
+    select.innerHTML = "";
+    part.columns.slice(1).forEach((c) => {
+      const o = document.createElement("option");
+      o.textContent = c;
+      o.selected = c === "total_energy";
+      select.appendChild(o);
+    });
+    $("obsplot").style.display = "block";
+  }
+  table.rows.push(...part.rows);
+  table.events.push(...part.events);
+  scene.rows = table.rows.length;
+  scene.events = table.events;
+}
+function plots() {
+  if (table.columns.length) {
+    const k = table.columns.indexOf($("obscol").value);
+    const marks = table.events.map((e) => Number((/t = ([^:]+):/.exec(e) || [])[1]));
+    if (k > 0) linePlot($("obscanvas"), table.rows.map((r) => r[0]), table.rows.map((r) => r[k]), marks);
+  }
+  if (scene.picked !== null && scene.picked !== undefined && track.time.length) {
+    linePlot($("pickcanvas"), track.time, track[$("pickcol").value] || []);
+  }
+}
+function trackLive(p) {
+  const v = p.velocity || [NaN, NaN, NaN];
+  track.time.push(p.time);
+  track.speed.push(Math.hypot(...v));
+  track.x.push(p.position[0]);
+  track.y.push(p.position[1]);
+  track.z.push(p.position[2]);
+  scene.tracked = track.time.length;
+}
+
+// A live run: frames, status and the table come over the socket.
+let live = null;
+function note(line) {
+  scene.log.push(line);
+  const log = $("log");
+  log.textContent = scene.log.slice(-50).join("\n");
+  log.scrollTop = log.scrollHeight;
+}
+function liveStatus() {
+  const state = scene.ended ? "ended" : scene.paused ? "paused" : "running";
+  $("status").textContent = `${state}   step ${scene.step}   t = ${Number(scene.time).toPrecision(6)}   N = ${scene.n}`;
+}
+function connectLive() {
+  return new Promise((resolve) => {
+    const ws = new WebSocket(`ws://${location.host}/api/live`);
+    ws.binaryType = "arraybuffer";
+    live = ws;
+    let head = null;
+    ws.onopen = () => ws.send(JSON.stringify({ do: "color", quantity: scene.color }));
+    ws.onclose = () => { if (!scene.ended) note("the connection to the run closed"); };
+    ws.onmessage = (e) => {
+      if (typeof e.data === "string") {
+        const m = JSON.parse(e.data);
+        if (m.type === "status") {
+          scene.step = m.step;
+          scene.paused = m.paused;
+          setPlaying(!m.paused && !m.ended);
+          m.log.forEach(note);
+          if (m.ended && !scene.ended) {
+            scene.ended = m.ended;
+            if (m.failed) fail(m.ended); else note(`run ended: ${m.ended}`);
+          }
+          liveStatus();
+          publish();
+        } else if (m.type === "frame") {
+          head = m;
+        } else if (m.type === "observables") {
+          addTable(m.table);
+          plots();
+          publish();
+        } else if (m.type === "error") {
+          note(`refused: ${m.message}`);
+          publish();
+        }
+        return;
+      }
+      const data = decode(e.data);
+      if (!boxCount) setBox(head.cell, head.origin);
+      scene.meta.species = head.species;
+      upload(data);
+      scene.time = head.time;
+      scene.step = head.step;
+      scene.loaded += 1;
+      if (head.particle) { showParticle(head.particle); trackLive(head.particle); plots(); }
+      legend();
+      draw();
+      liveStatus();
+      publish();
+      resolve();
+      requestAnimationFrame(() => { if (ws.readyState === 1) ws.send(JSON.stringify({ do: "ready" })); });
+    };
+  });
+}
+function steer(what) {
+  const number = (id) => Number($(id).value);
+  const message = what === "field"
+    ? { do: "set", what, kind: $("fieldkind").value, vector: [number("fx"), number("fy"), number("fz")] }
+    : { do: "set", what, value: number(what) };
+  live.send(JSON.stringify(message));
 }
 async function show(k) {
   if (pending) return;
   pending = true;
   try {
     const data = await fetchFrame(k);
-    if (!camera.home) frameCamera(data);
-    gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
-    gl.bufferData(gl.ARRAY_BUFFER, data.spheres, gl.DYNAMIC_DRAW);
-    gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
-    gl.bufferData(gl.ARRAY_BUFFER, data.values, gl.DYNAMIC_DRAW);
-    let lo = Infinity, hi = -Infinity;
-    for (const v of data.values) { if (v < lo) lo = v; if (v > hi) hi = v; }
-    scene.range = lo <= hi ? [lo, hi > lo ? hi : lo + 1] : [0, 1];
+    upload(data);
     scene.frame = k;
-    scene.n = data.n;
-    current = data;
     if (scene.picked !== null && scene.picked !== undefined) inspect(scene.picked);
     scene.time = scene.meta.time[k];
     scene.loaded += 1;
@@ -342,7 +540,7 @@ function setPlaying(on) {
 let last = 0;
 function tick(now) {
   const interval = 100 / scene.speed;
-  if (scene.playing && !pending && now - last >= interval) {
+  if (!live && scene.playing && !pending && now - last >= interval) {
     last = now;
     if (scene.frame + 1 < scene.meta.frames) show(scene.frame + 1);
     else setPlaying(false);
@@ -351,12 +549,24 @@ function tick(now) {
 }
 
 function controls() {
-  $("play").onclick = () => setPlaying(!scene.playing);
+  // In a live run, play and pause hold and release the simulation itself.
+  const toggle = () => {
+    if (live) live.send(JSON.stringify({ do: scene.paused ? "resume" : "pause" }));
+    else setPlaying(!scene.playing);
+  };
+  $("play").onclick = toggle;
+  document.querySelectorAll("[data-set]").forEach((b) => { b.onclick = () => steer(b.dataset.set); });
+  $("obscol").onchange = plots;
+  $("pickcol").onchange = plots;
   $("step").onclick = () => { setPlaying(false); show(Math.min(scene.frame + 1, scene.meta.frames - 1)); };
   $("back").onclick = () => { setPlaying(false); show(Math.max(scene.frame - 1, 0)); };
   $("scrub").oninput = (e) => show(Number(e.target.value));
   $("speed").onchange = (e) => { scene.speed = Number(e.target.value); };
-  $("color").onchange = (e) => { scene.color = e.target.value; show(scene.frame); };
+  $("color").onchange = (e) => {
+    scene.color = e.target.value;
+    if (live) live.send(JSON.stringify({ do: "color", quantity: scene.color }));
+    else show(scene.frame);
+  };
   $("reset").onclick = resetCamera;
   let drag = null;
   canvas.addEventListener("pointerdown", (e) => {
@@ -392,7 +602,8 @@ function controls() {
     draw();
   }, { passive: false });
   window.addEventListener("keydown", (e) => {
-    if (e.key === " ") { setPlaying(!scene.playing); e.preventDefault(); }
+    if (e.target.tagName === "INPUT") return;
+    if (e.key === " ") { toggle(); e.preventDefault(); }
     else if (e.key === "ArrowRight") $("step").onclick();
     else if (e.key === "ArrowLeft") $("back").onclick();
     else if (e.key === "r") resetCamera();
@@ -413,6 +624,21 @@ function bench(count) {
   publish();
 }
 
+// ?set=WHAT:VALUE (dt, damping, temperature) or ?set=field:KIND:X,Y,Z
+// steers a live run once its first frame is shown (for tests and links).
+function steerFromUrl() {
+  const spec = params.get("set");
+  if (!spec) return;
+  const [what, a, b] = spec.split(":");
+  if (what === "field") {
+    $("fieldkind").value = a;
+    b.split(",").forEach((v, k) => { $(["fx", "fy", "fz"][k]).value = v; });
+  } else {
+    $(what).value = a;
+  }
+  steer(what);
+}
+
 async function main() {
   try {
     const r = await fetch("/api/meta");
@@ -420,20 +646,42 @@ async function main() {
     scene.meta = await r.json();
     $("label").textContent = scene.meta.label;
     document.title = `mote view: ${scene.meta.label}`;
-    $("scrub").max = Math.max(scene.meta.frames - 1, 0);
     for (const q of scene.meta.quantities) {
       const o = document.createElement("option");
       o.textContent = q;
       o.selected = q === scene.color;
       $("color").appendChild(o);
     }
+    if (scene.meta.error) {
+      // The input could not be read: say why, here as in the terminal.
+      fail(scene.meta.error);
+      return;
+    }
     setup();
     controls();
-    await show(0);
-    scene.loadMs = performance.now();
-    publish();
-    if (params.get("play") === "1") setPlaying(true);
-    if (params.get("bench")) bench(Number(params.get("bench")));
+    if (scene.meta.live) {
+      scene.live = true;
+      for (const id of ["back", "step", "scrub", "speedbox"]) $(id).style.display = "none";
+      $("steer").style.display = "block";
+      await connectLive();
+      scene.loadMs = performance.now();
+      publish();
+      if (params.get("pause") === "1") live.send(JSON.stringify({ do: "pause" }));
+      steerFromUrl();
+      if (params.get("run") === "1") live.send(JSON.stringify({ do: "resume" }));
+    } else {
+      $("scrub").max = Math.max(scene.meta.frames - 1, 0);
+      setBox(scene.meta.cell, scene.meta.origin);
+      await show(0);
+      scene.loadMs = performance.now();
+      if (scene.meta.observables) {
+        const t = await fetch("/api/observables");
+        if (t.ok) { addTable(await t.json()); plots(); }
+      }
+      publish();
+      if (params.get("play") === "1") setPlaying(true);
+      if (params.get("bench")) bench(Number(params.get("bench")));
+    }
     if (params.get("pick")) {
       const [fx, fy] = params.get("pick").split(",").map(Number);
       await inspect(pickAt(fx * canvas.clientWidth, fy * canvas.clientHeight));

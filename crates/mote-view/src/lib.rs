@@ -90,6 +90,37 @@ impl Trajectory {
         particle_json(f, i).map_err(|m| format!("{m} in frame {k}"))
     }
 
+    /// Particle `i` through all frames, as the JSON of `/api/track/I`:
+    /// time, x, y, z and speed (NaN where a frame lacks it).
+    pub fn track(&self, i: usize) -> serde_json::Value {
+        let column = |a: usize| -> Vec<f64> {
+            self.frames
+                .iter()
+                .map(|f| f.positions.get(i).map_or(f64::NAN, |p| p[a]))
+                .collect()
+        };
+        let speed: Vec<f64> = self
+            .frames
+            .iter()
+            .map(|f| {
+                f.velocities.get(i).map_or(f64::NAN, |v| {
+                    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+                })
+            })
+            .collect();
+        // JSON has no NaN: missing values go as null.
+        let json = |v: Vec<f64>| -> Vec<Option<f64>> {
+            v.into_iter().map(|x| x.is_finite().then_some(x)).collect()
+        };
+        serde_json::json!({
+            "time": self.frames.iter().map(|f| f.time).collect::<Vec<_>>(),
+            "x": json(column(0)),
+            "y": json(column(1)),
+            "z": json(column(2)),
+            "speed": json(speed),
+        })
+    }
+
     /// Frame `k` as the binary of `/api/frame/K`, coloured by `color`.
     pub fn frame_bytes(&self, k: usize, color: &str) -> Result<Vec<u8>, String> {
         let f = self
@@ -289,6 +320,16 @@ async fn particle(State(app): State<Arc<App>>, Path((k, i)): Path<(String, Strin
     }
 }
 
+async fn track(State(app): State<Arc<App>>, Path(i): Path<String>) -> Response {
+    let Some(t) = file_only(&app) else {
+        return no_file();
+    };
+    match i.parse::<usize>() {
+        Ok(i) => axum::Json(t.track(i)).into_response(),
+        Err(_) => text(StatusCode::NOT_FOUND, format!("not a particle: {i}")),
+    }
+}
+
 /// The file's observables table (columns, rows, events) for the plots.
 async fn observables(State(app): State<Arc<App>>) -> Response {
     match &*app {
@@ -333,6 +374,7 @@ pub fn router(app: Arc<App>) -> Router {
         )
         .route("/api/frame/{k}", get(frame))
         .route("/api/particle/{k}/{i}", get(particle))
+        .route("/api/track/{i}", get(track))
         .route("/api/observables", get(observables))
         .route("/api/live", get(socket))
         .fallback(|| async { text(StatusCode::NOT_FOUND, "not found".into()) })

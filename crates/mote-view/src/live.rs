@@ -56,13 +56,14 @@ pub struct Session {
 }
 
 impl Session {
-    pub fn new(label: String, dir: PathBuf) -> Arc<Session> {
+    /// A session whose run starts `paused` or not.
+    pub fn new(label: String, dir: PathBuf, paused: bool) -> Arc<Session> {
         Arc::new(Session {
             label,
             dir,
             latest: watch::Sender::new(Snapshot::default()),
             wanted: AtomicBool::new(true),
-            paused: AtomicBool::new(false),
+            paused: AtomicBool::new(paused),
             changes: Mutex::new(Vec::new()),
         })
     }
@@ -125,6 +126,46 @@ impl Session {
                 s.species = Arc::new(species);
             }
         });
+    }
+}
+
+/// Runs `options` through mote's front in a thread of its own (with a
+/// pool of as many threads as the caller's), watched through `session`.
+/// `report` says how the run ended, as the line the pages show and whether
+/// it failed (the binary also prints it there).
+pub fn spawn_run(
+    mut options: mote_front::RunOptions,
+    session: &Arc<Session>,
+    report: impl FnOnce(&Result<mote_front::Outcome, mote_front::FrontError>) -> (String, bool)
+        + Send
+        + 'static,
+) -> std::io::Result<std::thread::JoinHandle<()>> {
+    options.live = mote_run::LiveSlot::new(session.tap());
+    let session = Arc::clone(session);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(rayon::current_num_threads())
+        .build()
+        .map_err(std::io::Error::other)?;
+    std::thread::Builder::new()
+        .name("mote run".into())
+        .spawn(move || {
+            let result = pool.install(|| mote_front::run(&options, &mut mote_front::Silent));
+            let (text, failed) = report(&result);
+            session.end(text, failed);
+        })
+}
+
+/// The usual ending line: the summary, the instability, the signal or the
+/// error.
+pub fn ending(result: &Result<mote_front::Outcome, mote_front::FrontError>) -> (String, bool) {
+    use mote_front::Ending;
+    match result {
+        Ok(o) => match &o.ending {
+            Ending::Finished => (o.summary.join(" "), false),
+            Ending::Unstable(m) => (m.clone(), true),
+            Ending::Interrupted { message, .. } => (message.clone(), false),
+        },
+        Err(e) => (e.to_string(), true),
     }
 }
 
@@ -205,6 +246,16 @@ impl Live for Tap {
         }
         s.latest.send_modify(|snap| snap.paused = false);
         Vec::new()
+    }
+
+    fn last(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Frame>) {
+        match frame() {
+            Some(f) => self.session.publish_frame(step, time, f),
+            None => self.session.latest.send_modify(|s| {
+                s.step = step;
+                s.time = time;
+            }),
+        }
     }
 
     fn answer(&mut self, step: u64, time: f64, change: &Change, answer: &Result<String, String>) {
@@ -295,6 +346,9 @@ pub async fn client(mut socket: WebSocket, session: Arc<Session>) {
                     Ok(Command::Pick { index }) => pick = index,
                     Ok(Command::Set { what, value, kind, vector }) => {
                         match change_of(&what, value, kind.as_deref(), vector) {
+                            _ if latest.borrow().ended.is_some() => {
+                                message = Some(error_message(&format!("set {what}: the run has ended")))
+                            }
                             Ok(c) => session.ask(c),
                             Err(m) => message = Some(error_message(&m)),
                         }

@@ -2,7 +2,10 @@
 //! SwiftShader (software). It loads a trajectory of 1000 spheres of two
 //! species; the page's state (read from the DOM) holds all of them with no
 //! console errors, playing advances the frame and the time,
-//! and a screenshot shows the two species' colours. Skipped, with a
+//! and a screenshot shows the two species' colours. A live run, driven
+//! through the DevTools protocol: its time advances on the page, and a
+//! change of dt made on the page reaches the run and its observables
+//! table. Skipped, with a
 //! message, where no Chromium is installed (`.ci/run` installs Debian's
 //! `chromium`; MOTE_CHROMIUM names another binary). MOTE_VIEW_SCREENSHOT=FILE
 //! keeps the screenshot (docs/img/view.png is one).
@@ -12,6 +15,7 @@ use std::process::Command;
 
 use mote_io::xyz::Frame;
 
+mod cdp;
 mod common;
 
 fn chromium() -> Option<PathBuf> {
@@ -165,4 +169,94 @@ fn page_shows_and_plays_a_trajectory_in_chromium() {
         100.0 * fb
     );
     assert!(fr > 0.02 && fb > 0.02, "red {fr}, blue {fb}");
+}
+
+/// 300 particles falling under gravity with damping, for as long as the
+/// test watches.
+const FALLING: &str = r#"
+[run]
+integrator = "leapfrog"
+dt = 0.001
+steps = 1000000000
+[field]
+g = [0.0, 0.0, -1.0]
+[damping]
+gamma = 0.1
+[[random_box]]
+n = 300
+min = [0.0, 0.0, 0.0]
+max = [10.0, 10.0, 10.0]
+[output]
+observables_every = 50
+trajectory_every = 0
+"#;
+
+#[test]
+fn a_live_run_advances_and_takes_a_change_from_the_page() {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: no Chromium (install Debian's chromium, or set MOTE_CHROMIUM)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("falling.toml");
+    std::fs::write(&scene, FALLING).unwrap();
+    let out = dir.path().join("out");
+    // The run starts paused: the page changes dt, then lets it run.
+    let session = mote_view::live::Session::new("falling.toml".into(), out.clone(), true);
+    let options = mote_front::RunOptions {
+        input: Some(scene.display().to_string()),
+        output: Some(out.clone()),
+        seed: Some(5),
+        ..Default::default()
+    };
+    mote_view::live::spawn_run(options, &session, mote_view::live::ending).unwrap();
+    let (listener, _) = mote_view::bind("127.0.0.1", 0).unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let app = std::sync::Arc::new(mote_view::App::Live(session.clone()));
+    std::thread::spawn(move || {
+        tokio::runtime::Runtime::new()
+            .unwrap()
+            .block_on(mote_view::serve(listener, app, std::future::pending()))
+            .unwrap();
+    });
+    let mut page = cdp::Browser::open(
+        &browser,
+        &format!("http://127.0.0.1:{port}/?set=dt:0.0005&run=1&color=speed"),
+    );
+    let limit = std::time::Duration::from_secs(60);
+    let state = page.state_when(limit, |s| {
+        s["loaded"].as_u64().unwrap_or(0) >= 3 && s["time"].as_f64().unwrap_or(0.0) > 0.0
+    });
+    assert_eq!(state["errors"], serde_json::json!([]), "{state}");
+    assert_eq!(state["live"], true);
+    assert_eq!(state["n"], 300, "{state}");
+    assert!(
+        state["time"].as_f64().unwrap() > 0.0,
+        "time did not advance: {state}"
+    );
+    let log = state["log"].to_string();
+    assert!(
+        log.contains("step 0") && log.contains("dt 0.001 → 0.0005"),
+        "{state}"
+    );
+    // The run really steps with the new dt: t = 0.0005 · step.
+    let later = page.state_when(limit, |s| s["step"].as_u64().unwrap_or(0) > 200);
+    let (step, snap) = (later["step"].as_u64().unwrap(), session.snapshot());
+    assert!(step > 200, "{later}");
+    assert!((snap.time - 0.0005 * snap.step as f64).abs() < 1e-9 * snap.time.max(1.0));
+    // The page's plot follows the observables table, event included.
+    let plotted = page.state_when(limit, |s| s["rows"].as_u64().unwrap_or(0) >= 3);
+    assert!(
+        plotted["events"][0]
+            .as_str()
+            .unwrap()
+            .contains("dt 0.001 → 0.0005"),
+        "{plotted}"
+    );
+    let table = std::fs::read_to_string(out.join("observables.csv")).unwrap();
+    assert!(
+        table.contains("# event: step 0, t = 0: dt 0.001 → 0.0005"),
+        "{table}"
+    );
+    mote_io::system::request_stop(15);
 }

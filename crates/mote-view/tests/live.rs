@@ -60,7 +60,7 @@ fn fake_run(session: &Arc<Session>, n: usize, taken: Arc<Mutex<Vec<Change>>>) {
 /// run took, and the port.
 fn start(n: usize) -> (Arc<Session>, Arc<Mutex<Vec<Change>>>, u16) {
     let dir = tempfile::tempdir().unwrap().keep();
-    let session = Session::new("fake".into(), dir);
+    let session = Session::new("fake".into(), dir, false);
     let taken = Arc::new(Mutex::new(Vec::new()));
     fake_run(&session, n, taken.clone());
     let (listener, _) = bind("127.0.0.1", 0).unwrap();

@@ -9,8 +9,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::anyhow;
-use mote_front::{Engine, Input, RunOptions, Terminal};
-use mote_view::live::Session;
+use mote_front::{Engine, Input, RunOptions};
+use mote_view::live::{self, Session};
 use mote_view::App;
 
 /// Shows a trajectory (extended XYZ, LAMMPS dump, GSD, VTU, PVD) or runs a
@@ -45,6 +45,9 @@ pub struct ViewArgs {
     /// Live runs: time step.
     #[arg(long, value_name = "DT")]
     dt: Option<f64>,
+    /// Live runs: start paused (the page's play button starts the run).
+    #[arg(long)]
+    paused: bool,
 }
 
 /// A trajectory by its extension; anything else is a scene to run.
@@ -99,7 +102,7 @@ fn live_app(
         .flatten()
         .and_then(|t| t.get("output")?.get("dir")?.as_str().map(str::to_string));
     let dir = input.output_dir(a.output.as_ref(), scene_dir.as_ref());
-    let session = Session::new(input.label.clone(), dir.clone());
+    let session = Session::new(input.label.clone(), dir.clone(), a.paused);
     let options = RunOptions {
         input: Some(a.input.clone()),
         until: a.until,
@@ -108,37 +111,19 @@ fn live_app(
         output: Some(dir.clone()),
         seed: global.seed,
         threads: global.threads,
-        live: mote_run::LiveSlot::new(session.tap()),
         ..RunOptions::default()
     };
-    let run_session = Arc::clone(&session);
     let quiet = global.quiet;
-    // The run uses the pool the command was started in.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(rayon::current_num_threads())
-        .build()
-        .map_err(|e| e.to_string())?;
-    let run = std::thread::spawn(move || {
-        let mut terminal = Terminal::new(true);
-        let result = pool.install(|| mote_front::run(&options, &mut terminal));
-        let (text, failed) = match result {
+    let run = live::spawn_run(options, &session, move |result| {
+        match result {
             Ok(outcome) => {
-                let code = super::run::report(&outcome, quiet);
-                let failed = code != ExitCode::SUCCESS;
-                let text = match &outcome.ending {
-                    mote_front::Ending::Finished => outcome.summary.join(" "),
-                    mote_front::Ending::Unstable(m) => m.clone(),
-                    mote_front::Ending::Interrupted { message, .. } => message.clone(),
-                };
-                (text, failed)
+                super::run::report(outcome, quiet);
             }
-            Err(e) => {
-                eprintln!("error: {e}");
-                (e.to_string(), true)
-            }
-        };
-        run_session.end(text, failed);
-    });
+            Err(e) => eprintln!("error: {e}"),
+        }
+        live::ending(result)
+    })
+    .map_err(|e| e.to_string())?;
     let line = format!("running live, files in {}", dir.display());
     Ok((Arc::new(App::Live(session)), line, run))
 }
