@@ -37,18 +37,9 @@ if (params.get("color")) scene.color = params.get("color");
 const canvas = $("view");
 const gl = canvas.getContext("webgl2", { antialias: true });
 
-const SPHERE_VS = `#version 300 es
-layout(location = 0) in vec4 sphere;
-layout(location = 1) in float value;
-uniform mat4 view, proj;
-uniform vec2 range;
-uniform int categorical;
-out vec2 corner;
-out vec3 color;
-out vec3 centre;
-out float radius;
-const vec2 C[4] = vec2[4](vec2(-1, -1), vec2(1, -1), vec2(-1, 1), vec2(1, 1));
-vec3 viridis(float t) {
+// Colour maps of both sphere programs: viridis for quantities, a palette
+// of eight for species.
+const COLORS = `vec3 viridis(float t) {
   const vec3 c0 = vec3(0.2777, 0.0054, 0.3341), c1 = vec3(0.1050, 1.4046, 1.3846);
   const vec3 c2 = vec3(-0.3309, 0.2148, 0.0950), c3 = vec3(-4.6342, -5.7991, -19.3324);
   const vec3 c4 = vec3(6.2283, 14.1799, 56.6906), c5 = vec3(4.7764, -13.7451, -65.3530);
@@ -61,7 +52,20 @@ vec3 palette(float i) {
     vec3(0.5, 0.5, 0.5));
   return P[int(mod(i, 8.0))];
 }
-void main() {
+`;
+
+const SPHERE_VS = `#version 300 es
+layout(location = 0) in vec4 sphere;
+layout(location = 1) in float value;
+uniform mat4 view, proj;
+uniform vec2 range;
+uniform int categorical;
+out vec2 corner;
+out vec3 color;
+out vec3 centre;
+out float radius;
+const vec2 C[4] = vec2[4](vec2(-1, -1), vec2(1, -1), vec2(-1, 1), vec2(1, 1));
+${COLORS}void main() {
   corner = C[gl_VertexID];
   radius = sphere.w;
   vec4 c = view * vec4(sphere.xyz, 1.0);
@@ -90,6 +94,38 @@ void main() {
   fragment = vec4(color * (0.3 + 0.7 * diffuse) + 0.2 * specular, 1.0);
   vec4 p = proj * vec4(centre + n * radius, 1.0);
   gl_FragDepth = 0.5 * p.z / p.w + 0.5;
+}`;
+
+// Level of detail: one point per sphere (a quarter of the vertices), sized
+// to the sphere's projected diameter and shaded as a disc, depth at its
+// centre.
+const POINT_VS = `#version 300 es
+layout(location = 0) in vec4 sphere;
+layout(location = 1) in float value;
+uniform mat4 view, proj;
+uniform vec2 range;
+uniform int categorical;
+uniform float pixels;
+out vec3 color;
+${COLORS}
+void main() {
+  vec4 c = view * vec4(sphere.xyz, 1.0);
+  gl_Position = proj * c;
+  gl_PointSize = max(sphere.w * proj[1][1] * pixels / max(-c.z, 1e-30), 1.0);
+  float t = clamp((value - range.x) / max(range.y - range.x, 1e-30), 0.0, 1.0);
+  color = categorical == 1 ? palette(value) : viridis(t);
+}`;
+const POINT_FS = `#version 300 es
+precision highp float;
+in vec3 color;
+out vec4 fragment;
+void main() {
+  vec2 q = vec2(2.0 * gl_PointCoord.x - 1.0, 1.0 - 2.0 * gl_PointCoord.y);
+  float d2 = dot(q, q);
+  if (d2 > 1.0) discard;
+  vec3 n = vec3(q, sqrt(1.0 - d2));
+  float diffuse = max(dot(n, normalize(vec3(0.4, 0.6, 1.0))), 0.0);
+  fragment = vec4(color * (0.3 + 0.7 * diffuse), 1.0);
 }`;
 
 const LINE_VS = `#version 300 es
@@ -142,7 +178,7 @@ function eye() {
           c.target[2] + c.distance * Math.cos(c.phi)];
 }
 
-let spheres, lines, sphereVao, lineVao, sphereBuf, valueBuf, lineBuf, boxCount = 0;
+let spheres, points, pointVao, lines, sphereVao, lineVao, sphereBuf, valueBuf, lineBuf, boxCount = 0;
 
 // The box's twelve edges, if the frame has a cell.
 function setBox(cell, o) {
@@ -163,6 +199,7 @@ function setup() {
   if (!gl) throw new Error("WebGL2 is not available in this browser");
   spheres = program(SPHERE_VS, SPHERE_FS);
   lines = program(LINE_VS, LINE_FS);
+  points = program(POINT_VS, POINT_FS);
   sphereVao = gl.createVertexArray();
   gl.bindVertexArray(sphereVao);
   sphereBuf = gl.createBuffer();
@@ -175,6 +212,15 @@ function setup() {
   gl.enableVertexAttribArray(1);
   gl.vertexAttribPointer(1, 1, gl.FLOAT, false, 0, 0);
   gl.vertexAttribDivisor(1, 1);
+  // The same buffers, one vertex per sphere.
+  pointVao = gl.createVertexArray();
+  gl.bindVertexArray(pointVao);
+  gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
+  gl.enableVertexAttribArray(0);
+  gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 0, 0);
+  gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
+  gl.enableVertexAttribArray(1);
+  gl.vertexAttribPointer(1, 1, gl.FLOAT, false, 0, 0);
   lineVao = gl.createVertexArray();
   gl.bindVertexArray(lineVao);
   lineBuf = gl.createBuffer();
@@ -201,24 +247,49 @@ function frameCamera(data) {
   camera.home = JSON.stringify(camera);
 }
 
-function draw() {
+// Waits until the GPU drew everything asked so far: reading a pixel back
+// does (Chromium's gl.finish returns before its GPU process is done).
+const onePixel = new Uint8Array(4);
+function sync() {
+  gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, onePixel);
+}
+
+// Level of detail: while the camera moves, a scene whose full draw takes
+// longer than INTERACTIVE_MS is drawn as points (one vertex per sphere
+// instead of four: SwiftShader draws them ten times faster), and in full
+// once the camera rests. A large scene's first draw is points too, so it
+// shows at once; the full draw follows.
+const INTERACTIVE_MS = 40, LARGE = 20000;
+let fullCost = 0, settle = null;
+function draw(moving) {
   if (!scene.meta || !gl) return;
+  const slow = fullCost > INTERACTIVE_MS || (!fullCost && scene.n > LARGE);
+  const lod = (!!moving || !scene.drawn) && slow;
   const w = canvas.clientWidth, h = canvas.clientHeight, dpr = window.devicePixelRatio || 1;
   if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
     canvas.width = Math.round(w * dpr);
     canvas.height = Math.round(h * dpr);
   }
+  scene.lod = lod;
+  const t0 = performance.now();
   gl.viewport(0, 0, canvas.width, canvas.height);
   gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
   const view = lookAt(eye(), camera.target, [0, 0, 1]);
   const proj = perspective(0.7, canvas.width / Math.max(canvas.height, 1), camera.distance * 0.01, camera.distance * 10);
-  gl.useProgram(spheres);
-  gl.uniformMatrix4fv(gl.getUniformLocation(spheres, "view"), false, view);
-  gl.uniformMatrix4fv(gl.getUniformLocation(spheres, "proj"), false, proj);
-  gl.uniform2f(gl.getUniformLocation(spheres, "range"), scene.range[0], scene.range[1]);
-  gl.uniform1i(gl.getUniformLocation(spheres, "categorical"), scene.color === "species" ? 1 : 0);
-  gl.bindVertexArray(sphereVao);
-  gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, scene.n);
+  const prog = lod ? points : spheres;
+  gl.useProgram(prog);
+  gl.uniformMatrix4fv(gl.getUniformLocation(prog, "view"), false, view);
+  gl.uniformMatrix4fv(gl.getUniformLocation(prog, "proj"), false, proj);
+  gl.uniform2f(gl.getUniformLocation(prog, "range"), scene.range[0], scene.range[1]);
+  gl.uniform1i(gl.getUniformLocation(prog, "categorical"), scene.color === "species" ? 1 : 0);
+  if (lod) {
+    gl.uniform1f(gl.getUniformLocation(prog, "pixels"), canvas.height);
+    gl.bindVertexArray(pointVao);
+    gl.drawArrays(gl.POINTS, 0, scene.n);
+  } else {
+    gl.bindVertexArray(sphereVao);
+    gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, scene.n);
+  }
   if (boxCount) {
     gl.useProgram(lines);
     gl.uniformMatrix4fv(gl.getUniformLocation(lines, "view"), false, view);
@@ -228,6 +299,16 @@ function draw() {
   }
   gl.bindVertexArray(null);
   scene.drawn = (scene.drawn || 0) + 1;
+  if (scene.n > LARGE) {
+    // Large scenes: time the draw (the wait costs nothing the next draw
+    // would not wait for anyway).
+    sync();
+    if (!lod) fullCost = performance.now() - t0;
+  }
+  if (lod) {
+    clearTimeout(settle);
+    settle = setTimeout(() => draw(false), 200);
+  }
 }
 
 function legend() {
@@ -593,13 +674,13 @@ function controls() {
       camera.theta -= dx * 0.01;
       camera.phi = Math.min(Math.max(camera.phi - dy * 0.01, 0.01), Math.PI - 0.01);
     }
-    draw();
+    draw(true);
   });
   canvas.addEventListener("contextmenu", (e) => e.preventDefault());
   canvas.addEventListener("wheel", (e) => {
     e.preventDefault();
     camera.distance *= Math.exp(e.deltaY * 0.001);
-    draw();
+    draw(true);
   }, { passive: false });
   window.addEventListener("keydown", (e) => {
     if (e.target.tagName === "INPUT") return;
@@ -612,15 +693,23 @@ function controls() {
 }
 
 // ?bench=K: K redraws of the first frame with the camera turning, each
-// waited for (gl.finish): frames per second in moteScene.fps.
+// waited for (a pixel read back): frames per second at full resolution in
+// moteScene.fps, and while moving (level of detail) in moteScene.movingFps.
 function bench(count) {
-  const t0 = performance.now();
+  let t0 = performance.now();
   for (let i = 0; i < count; i++) {
     camera.theta += 0.02;
-    draw();
-    gl.finish();
+    draw(false);
+    sync();
   }
   scene.fps = count / ((performance.now() - t0) / 1000);
+  t0 = performance.now();
+  for (let i = 0; i < count; i++) {
+    camera.theta += 0.02;
+    draw(true);
+    sync();
+  }
+  scene.movingFps = count / ((performance.now() - t0) / 1000);
   publish();
 }
 

@@ -9,7 +9,7 @@
 //! whatever the number or speed of the pages.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -21,8 +21,11 @@ use tokio::sync::watch;
 
 use crate::table::Follow;
 
-/// Frames are made at most this often.
+/// Frames are made at most this often,
 const FRAME_INTERVAL: Duration = Duration::from_millis(33);
+/// and at most this share of the run's time goes into making them (a
+/// frame of 10⁶ spheres takes tens of milliseconds to copy).
+const FRAME_SHARE: f64 = 0.05;
 /// The log keeps this many entries.
 const LOG_KEPT: usize = 200;
 
@@ -53,6 +56,8 @@ pub struct Session {
     wanted: AtomicBool,
     paused: AtomicBool,
     changes: Mutex<Vec<Change>>,
+    /// The share of the run's time frames may take (f64 bits).
+    frame_share: AtomicU64,
 }
 
 impl Session {
@@ -65,6 +70,7 @@ impl Session {
             wanted: AtomicBool::new(true),
             paused: AtomicBool::new(paused),
             changes: Mutex::new(Vec::new()),
+            frame_share: AtomicU64::new(FRAME_SHARE.to_bits()),
         })
     }
 
@@ -73,6 +79,7 @@ impl Session {
         Box::new(Tap {
             session: Arc::clone(self),
             last: None,
+            interval: FRAME_INTERVAL,
         })
     }
 
@@ -107,6 +114,12 @@ impl Session {
         if let Ok(mut c) = self.changes.lock() {
             c.push(change);
         }
+    }
+
+    /// Lets frames take this share of the run's time (default 5 %; 1: as
+    /// many as the pages ask for, up to 30 a second).
+    pub fn set_frame_share(&self, share: f64) {
+        self.frame_share.store(share.to_bits(), Ordering::Relaxed);
     }
 
     pub fn set_paused(&self, paused: bool) {
@@ -174,6 +187,9 @@ struct Tap {
     session: Arc<Session>,
     /// When the last snapshot went out.
     last: Option<Instant>,
+    /// The wait between frames: [`FRAME_INTERVAL`], or longer where making
+    /// a frame takes more than [`FRAME_SHARE`] of it.
+    interval: Duration,
 }
 
 impl Tap {
@@ -181,14 +197,18 @@ impl Tap {
     /// frame when a page wants one.
     fn show(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Frame>) {
         let s = &self.session;
-        let due = self.last.is_none_or(|t| t.elapsed() >= FRAME_INTERVAL);
+        let due = self.last.is_none_or(|t| t.elapsed() >= self.interval);
         if !due {
             return;
         }
-        self.last = Some(Instant::now());
+        let now = Instant::now();
+        self.last = Some(now);
         if s.wanted.swap(false, Ordering::Relaxed) {
             if let Some(f) = frame() {
                 s.publish_frame(step, time, f);
+                let cost = now.elapsed().as_secs_f64();
+                let share = f64::from_bits(s.frame_share.load(Ordering::Relaxed));
+                self.interval = FRAME_INTERVAL.max(Duration::from_secs_f64(cost / share));
                 return;
             }
         }
