@@ -452,7 +452,7 @@ function linePlot(canvas, x, y, marks) {
   }
   if (!(x0 <= x1)) { g.fillText("no data yet", left, h / 2); return; }
   if (x1 === x0) x1 = x0 + 1;
-  if (y1 === y0) { y0 -= Math.abs(y0) * 0.01 + 1e-30; y1 += Math.abs(y1) * 0.01 + 1e-30; }
+  if (y1 === y0) { const pad = Math.abs(y0) * 0.01 || 1; y0 -= pad; y1 += pad; }
   const px = (v) => left + (w - left - right) * (v - x0) / (x1 - x0);
   const py = (v) => h - bottom - (h - bottom - top) * (v - y0) / (y1 - y0);
   g.strokeStyle = "#999";
@@ -546,6 +546,7 @@ function connectLive() {
         const m = JSON.parse(e.data);
         if (m.type === "status") {
           scene.step = m.step;
+          scene.time = m.time;
           scene.paused = m.paused;
           setPlaying(!m.paused && !m.ended);
           m.log.forEach(note);

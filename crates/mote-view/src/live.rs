@@ -80,6 +80,7 @@ impl Session {
             session: Arc::clone(self),
             last: None,
             interval: FRAME_INTERVAL,
+            shown_paused: false,
         })
     }
 
@@ -190,6 +191,8 @@ struct Tap {
     /// The wait between frames: [`FRAME_INTERVAL`], or longer where making
     /// a frame takes more than [`FRAME_SHARE`] of it.
     interval: Duration,
+    /// Whether the pages were last told the run is paused.
+    shown_paused: bool,
 }
 
 impl Tap {
@@ -242,17 +245,23 @@ impl Live for Tap {
             return changes;
         }
         let s = Arc::clone(&self.session);
-        if !s.paused.load(Ordering::Relaxed) {
-            return Vec::new();
-        }
-        s.latest.send_modify(|snap| {
-            snap.paused = true;
-            snap.step = step;
-            snap.time = time;
-        });
         // Held here while paused: frames on request, changes applied at
-        // once, a signal still ends the run.
-        while s.paused.load(Ordering::Relaxed) && mote_io::system::stop_requested().is_none() {
+        // once (the driver calls again after them), a signal still ends
+        // the run.
+        loop {
+            let paused =
+                s.paused.load(Ordering::Relaxed) && mote_io::system::stop_requested().is_none();
+            if paused != self.shown_paused {
+                self.shown_paused = paused;
+                s.latest.send_modify(|snap| {
+                    snap.paused = paused;
+                    snap.step = step;
+                    snap.time = time;
+                });
+            }
+            if !paused {
+                return Vec::new();
+            }
             std::thread::sleep(Duration::from_millis(15));
             let changes = self.take_changes();
             if !changes.is_empty() {
@@ -264,8 +273,6 @@ impl Live for Tap {
                 }
             }
         }
-        s.latest.send_modify(|snap| snap.paused = false);
-        Vec::new()
     }
 
     fn last(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Frame>) {

@@ -5,7 +5,7 @@
 //! and a screenshot shows the two species' colours. A live run, driven
 //! through the DevTools protocol: its time advances on the page, and a
 //! change of dt made on the page reaches the run and its observables
-//! table. Skipped, with a
+//! table, and the page shows the run going on. Skipped, with a
 //! message, where no Chromium is installed (`.ci/run` installs Debian's
 //! `chromium`; MOTE_CHROMIUM names another binary). MOTE_VIEW_SCREENSHOT=FILE
 //! keeps the screenshot (docs/img/view.png is one).
@@ -171,21 +171,32 @@ fn page_shows_and_plays_a_trajectory_in_chromium() {
     assert!(fr > 0.02 && fb > 0.02, "red {fr}, blue {fb}");
 }
 
-/// 300 particles falling under gravity with damping, for as long as the
-/// test watches.
-const FALLING: &str = r#"
+/// 300 glass beads settling in a box (the settling example, smaller), for
+/// as long as the test watches.
+const SETTLING: &str = r#"
+units = "si"
 [run]
 integrator = "leapfrog"
-dt = 0.001
+dt = 5e-5
 steps = 1000000000
 [field]
-g = [0.0, 0.0, -1.0]
-[damping]
-gamma = 0.1
-[[random_box]]
+g = [0.0, 0.0, -9.81]
+[granular]
+young = 1e6
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+[[wall]]
+kind = "box"
+name = "box"
+lo = [0.0, 0.0, 0.0]
+hi = [0.03, 0.03, 0.06]
+[[cloud]]
 n = 300
 min = [0.0, 0.0, 0.0]
-max = [10.0, 10.0, 10.0]
+max = [0.03, 0.03, 0.05]
+radius = 0.002
+density = 2500.0
 [output]
 observables_every = 50
 trajectory_every = 0
@@ -198,11 +209,11 @@ fn a_live_run_advances_and_takes_a_change_from_the_page() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("falling.toml");
-    std::fs::write(&scene, FALLING).unwrap();
+    let scene = dir.path().join("settling.toml");
+    std::fs::write(&scene, SETTLING).unwrap();
     let out = dir.path().join("out");
     // The run starts paused: the page changes dt, then lets it run.
-    let session = mote_view::live::Session::new("falling.toml".into(), out.clone(), true);
+    let session = mote_view::live::Session::new("settling.toml".into(), out.clone(), true);
     let options = mote_front::RunOptions {
         input: Some(scene.display().to_string()),
         output: Some(out.clone()),
@@ -221,7 +232,7 @@ fn a_live_run_advances_and_takes_a_change_from_the_page() {
     });
     let mut page = cdp::Browser::open(
         &browser,
-        &format!("http://127.0.0.1:{port}/?set=dt:0.0005&run=1&color=speed"),
+        &format!("http://127.0.0.1:{port}/?set=dt:0.000025&run=1&color=speed"),
     );
     let limit = std::time::Duration::from_secs(60);
     let state = page.state_when(limit, |s| {
@@ -236,27 +247,40 @@ fn a_live_run_advances_and_takes_a_change_from_the_page() {
     );
     let log = state["log"].to_string();
     assert!(
-        log.contains("step 0") && log.contains("dt 0.001 → 0.0005"),
+        log.contains("step 0") && log.contains("dt 0.00005 → 0.000025"),
         "{state}"
     );
-    // The run really steps with the new dt: t = 0.0005 · step.
+    // The run really steps with the new dt: t = 2.5e-5 · step (summed:
+    // round-off grows with the steps).
     let later = page.state_when(limit, |s| s["step"].as_u64().unwrap_or(0) > 200);
     let (step, snap) = (later["step"].as_u64().unwrap(), session.snapshot());
     assert!(step > 200, "{later}");
-    assert!((snap.time - 0.0005 * snap.step as f64).abs() < 1e-9 * snap.time.max(1.0));
+    assert_eq!(later["paused"], false, "{later}");
+    assert!(
+        (snap.time - 2.5e-5 * snap.step as f64).abs() < 1e-9,
+        "{}",
+        snap.time
+    );
     // The page's plot follows the observables table, event included.
     let plotted = page.state_when(limit, |s| s["rows"].as_u64().unwrap_or(0) >= 3);
     assert!(
         plotted["events"][0]
             .as_str()
             .unwrap()
-            .contains("dt 0.001 → 0.0005"),
+            .contains("dt 0.00005 → 0.000025"),
         "{plotted}"
     );
     let table = std::fs::read_to_string(out.join("observables.csv")).unwrap();
     assert!(
-        table.contains("# event: step 0, t = 0: dt 0.001 → 0.0005"),
+        table.contains("# event: step 0, t = 0: dt 0.00005 → 0.000025"),
         "{table}"
     );
+    // MOTE_VIEW_LIVE_SCREENSHOT=FILE keeps a picture of the live page
+    // (docs/img/view-live.png is one): a particle picked, plots filled.
+    if let Ok(keep) = std::env::var("MOTE_VIEW_LIVE_SCREENSHOT") {
+        page.eval("inspect(pickAt(canvas.clientWidth / 2, canvas.clientHeight / 2))");
+        page.state_when(limit, |s| s["tracked"].as_u64().unwrap_or(0) >= 20);
+        std::fs::write(keep, page.screenshot()).unwrap();
+    }
     mote_io::system::request_stop(15);
 }

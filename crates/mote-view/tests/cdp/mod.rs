@@ -161,3 +161,49 @@ impl Drop for Browser {
         self.child.wait().ok();
     }
 }
+
+impl Browser {
+    /// A PNG of the page as it is now.
+    pub fn screenshot(&mut self) -> Vec<u8> {
+        let id = self.next_id;
+        self.next_id += 1;
+        let call = serde_json::json!({ "id": id, "method": "Page.captureScreenshot", "params": { "format": "png" } });
+        self.page
+            .send(Message::Text(call.to_string().into()))
+            .unwrap();
+        loop {
+            if let Message::Text(t) = self.page.read().unwrap() {
+                let v: serde_json::Value = serde_json::from_str(&t).unwrap();
+                if v["id"] == id {
+                    return base64(v["result"]["data"].as_str().unwrap());
+                }
+            }
+        }
+    }
+}
+
+/// Decodes standard base64 (what the protocol sends images in).
+fn base64(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => 0,
+    };
+    let digits: Vec<u8> = text
+        .bytes()
+        .filter(|c| *c != b'=' && !c.is_ascii_whitespace())
+        .collect();
+    let mut out = Vec::with_capacity(digits.len() * 3 / 4);
+    for chunk in digits.chunks(4) {
+        let mut n = 0u32;
+        for (k, c) in chunk.iter().enumerate() {
+            n |= (value(*c) as u32) << (18 - 6 * k);
+        }
+        let bytes = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
+        out.extend_from_slice(&bytes[..chunk.len() - 1]);
+    }
+    out
+}
