@@ -13,6 +13,7 @@ use std::time::Duration;
 use mote_io::xyz::Frame;
 use rand::{Rng, SeedableRng};
 
+#[allow(dead_code)] // the screenshot helper is the live browser test's
 mod cdp;
 mod common;
 
