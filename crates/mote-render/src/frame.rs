@@ -19,9 +19,47 @@ pub enum ColorBy {
 }
 
 /// The quantities [`ColorBy::Quantity`] knows.
-pub const QUANTITIES: &[&str] = &["speed", "radius", "vx", "vy", "vz", "x", "y", "z"];
+pub const QUANTITIES: &[&str] = &[
+    "speed", "radius", "vx", "vy", "vz", "x", "y", "z", "mass", "spin", "wx", "wy", "wz", "moment",
+    "mx", "my", "mz", "id", "body",
+];
 
-/// The values of a named per-particle quantity.
+/// The quantities of [`QUANTITIES`] a frame has columns for (positions
+/// always; velocities, radii, masses, spins, dipoles, ids, bodies where
+/// the frame carries them).
+pub fn quantities_of(frame: &Frame) -> Vec<&'static str> {
+    let n = frame.positions.len();
+    let has = |len: usize| len == n && n > 0;
+    QUANTITIES
+        .iter()
+        .copied()
+        .filter(|q| match *q {
+            "x" | "y" | "z" => true,
+            "speed" | "vx" | "vy" | "vz" => has(frame.velocities.len()),
+            "radius" => has(frame.radii.len()),
+            "mass" => has(frame.masses.len()),
+            "spin" | "wx" | "wy" | "wz" => has(frame.angular_velocities.len()),
+            "moment" | "mx" | "my" | "mz" => has(frame.dipoles.len()),
+            "id" => has(frame.ids.len()),
+            "body" => has(frame.bodies.len()),
+            _ => false,
+        })
+        .collect()
+}
+
+fn norm(v: &[f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// `f` of each entry of a per-particle column, NaN where it is missing.
+fn column<T>(values: &[T], n: usize, f: impl Fn(&T) -> f64) -> Vec<f64> {
+    (0..n).map(|i| values.get(i).map_or(f64::NAN, &f)).collect()
+}
+
+/// The values of a named per-particle quantity (NaN for a particle whose
+/// frame lacks the column): speed, radius, velocity and position
+/// components, mass, spin |ω| and its components, dipole moment |m| and its
+/// components, id, body.
 pub fn quantity(frame: &Frame, name: &str) -> Result<Vec<f64>, RenderError> {
     let n = frame.positions.len();
     let vel = |i: usize| frame.velocities.get(i).copied().unwrap_or([0.0; 3]);
@@ -43,6 +81,19 @@ pub fn quantity(frame: &Frame, name: &str) -> Result<Vec<f64>, RenderError> {
             let d = (name.as_bytes()[0] - b'x') as usize;
             frame.positions.iter().map(|p| p[d]).collect()
         }
+        "mass" => column(&frame.masses, n, |m| *m),
+        "spin" => column(&frame.angular_velocities, n, norm),
+        "wx" | "wy" | "wz" => {
+            let d = (name.as_bytes()[1] - b'x') as usize;
+            column(&frame.angular_velocities, n, |w| w[d])
+        }
+        "moment" => column(&frame.dipoles, n, norm),
+        "mx" | "my" | "mz" => {
+            let d = (name.as_bytes()[1] - b'x') as usize;
+            column(&frame.dipoles, n, |m| m[d])
+        }
+        "id" => column(&frame.ids, n, |k| *k as f64),
+        "body" => column(&frame.bodies, n, |k| *k as f64),
         other => {
             return Err(RenderError::Invalid(format!(
                 "unknown quantity '{other}' to colour by; known: species, {}",
@@ -170,4 +221,33 @@ pub fn picture_image(frame: &Frame, width: u32, height: u32) -> Result<crate::Im
         ..crate::RenderOptions::default()
     };
     Ok(crate::Renderer::new(&scene).render(&cam, &opts))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantities_follow_the_columns_a_frame_has() {
+        let mut f = Frame {
+            positions: vec![[1.0, 2.0, 3.0], [0.0; 3]],
+            angular_velocities: vec![[3.0, 4.0, 0.0], [0.0, 0.0, 1.0]],
+            bodies: vec![7, 7],
+            ..Frame::default()
+        };
+        assert_eq!(
+            quantities_of(&f),
+            ["x", "y", "z", "spin", "wx", "wy", "wz", "body"]
+        );
+        assert_eq!(quantity(&f, "spin").unwrap(), [5.0, 1.0]);
+        assert_eq!(quantity(&f, "wy").unwrap(), [4.0, 0.0]);
+        assert_eq!(quantity(&f, "body").unwrap(), [7.0, 7.0]);
+        // A column a frame lacks gives NaN, not a panic.
+        f.masses = vec![2.0];
+        let m = quantity(&f, "mass").unwrap();
+        assert_eq!(m[0], 2.0);
+        assert!(m[1].is_nan());
+        assert!(!quantities_of(&f).contains(&"mass"));
+        assert!(quantity(&f, "charge").is_err());
+    }
 }

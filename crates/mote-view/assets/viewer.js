@@ -570,6 +570,10 @@ function connectLive() {
       }
       const data = decode(e.data);
       if (!boxCount) setBox(head.cell, head.origin);
+      if (head.quantities.join() !== scene.meta.quantities.slice(1).join()) {
+        scene.meta.quantities = ["species", ...head.quantities];
+        colorOptions();
+      }
       scene.meta.species = head.species;
       upload(data);
       scene.time = head.time;
@@ -714,6 +718,18 @@ function bench(count) {
   publish();
 }
 
+// The colour menu: species and the quantities the frames carry.
+function colorOptions() {
+  const select = $("color");
+  select.innerHTML = "";
+  for (const q of scene.meta.quantities) {
+    const o = document.createElement("option");
+    o.textContent = q;
+    o.selected = q === scene.color;
+    select.appendChild(o);
+  }
+}
+
 // ?set=WHAT:VALUE (dt, damping, temperature) or ?set=field:KIND:X,Y,Z
 // steers a live run once its first frame is shown (for tests and links).
 function steerFromUrl() {
@@ -736,12 +752,7 @@ async function main() {
     scene.meta = await r.json();
     $("label").textContent = scene.meta.label;
     document.title = `mote view: ${scene.meta.label}`;
-    for (const q of scene.meta.quantities) {
-      const o = document.createElement("option");
-      o.textContent = q;
-      o.selected = q === scene.color;
-      $("color").appendChild(o);
-    }
+    colorOptions();
     if (scene.meta.error) {
       // The input could not be read: say why, here as in the terminal.
       fail(scene.meta.error);

@@ -77,7 +77,9 @@ impl Trajectory {
             "cell": first.map(|f| f.cell),
             "origin": first.map(|f| f.origin),
             "species": self.species,
-            "quantities": std::iter::once("species").chain(QUANTITIES.iter().copied()).collect::<Vec<_>>(),
+            "quantities": std::iter::once("species")
+                .chain(first.map(mote_render::frame::quantities_of).unwrap_or_default())
+                .collect::<Vec<_>>(),
         })
     }
 

@@ -456,6 +456,7 @@ pub async fn client(mut socket: WebSocket, session: Arc<Session>) {
             "cell": frame.cell,
             "origin": frame.origin,
             "species": *snap.species,
+            "quantities": mote_render::frame::quantities_of(frame),
             "color": color,
             "particle": pick.and_then(|i| crate::particle_json(frame, i).ok()),
         });

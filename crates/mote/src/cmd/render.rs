@@ -29,7 +29,8 @@ pub struct RenderArgs {
     /// Draw every frame, numbered for a movie.
     #[arg(long)]
     all: bool,
-    /// Colour by `species` or a per-particle quantity: speed, radius, vx, vy, vz, x, y, z.
+    /// Colour by `species` or a per-particle quantity: speed, radius, vx, vy, vz, x, y, z,
+    /// mass, spin, wx, wy, wz, moment, mx, my, mz, id, body.
     #[arg(long, value_name = "Q", default_value = "species")]
     color_by: String,
     /// Colour map for quantities: viridis, coolwarm, heat.
