@@ -39,7 +39,25 @@ struct Seen {
     answers: Vec<(u64, Result<String, String>)>,
 }
 
-struct Tap(Arc<Mutex<Seen>>, bool);
+/// Records every frame it is shown and asks for `changes` once, at step
+/// `at`.
+struct Tap {
+    seen: Arc<Mutex<Seen>>,
+    at: u64,
+    changes: Vec<Change>,
+}
+
+impl Tap {
+    fn slot(at: u64, changes: Vec<Change>) -> (Arc<Mutex<Seen>>, LiveSlot) {
+        let seen = Arc::new(Mutex::new(Seen::default()));
+        let tap = Tap {
+            seen: seen.clone(),
+            at,
+            changes,
+        };
+        (seen, LiveSlot::new(Box::new(tap)))
+    }
+}
 
 impl Live for Tap {
     fn between(
@@ -48,52 +66,54 @@ impl Live for Tap {
         time: f64,
         frame: &mut dyn FnMut() -> Option<Frame>,
     ) -> Vec<Change> {
-        let f = frame().expect("point particles show themselves");
-        self.0
+        let f = frame().expect("the engine shows its particles");
+        self.seen
             .lock()
             .unwrap()
             .frames
             .push((step, time, f.positions.len()));
-        if step == 20 && !self.1 {
-            self.1 = true;
-            vec![
-                Change::Dt(0.002),
-                Change::Field {
-                    kind: FieldKind::Gravity,
-                    value: [0.0, 0.0, -2.0],
-                },
-                Change::Damping(0.25),
-                Change::Temperature(0.2),
-                Change::Field {
-                    kind: FieldKind::Magnetic,
-                    value: [1.0, 0.0, 0.0],
-                },
-            ]
+        if step == self.at {
+            std::mem::take(&mut self.changes)
         } else {
             Vec::new()
         }
     }
 
     fn answer(&mut self, step: u64, _time: f64, _change: &Change, a: &Result<String, String>) {
-        self.0.lock().unwrap().answers.push((step, a.clone()));
+        self.seen.lock().unwrap().answers.push((step, a.clone()));
     }
 }
 
 #[test]
 fn changes_reach_the_next_step_and_are_recorded_as_events() {
     let dir = tempfile::tempdir().unwrap();
-    let seen = Arc::new(Mutex::new(Seen::default()));
+    let (seen, live) = Tap::slot(
+        20,
+        vec![
+            Change::Dt(0.002),
+            Change::Field {
+                kind: FieldKind::Gravity,
+                value: [0.0, 0.0, -2.0],
+            },
+            Change::Damping(0.25),
+            Change::Temperature(0.2),
+            Change::Field {
+                kind: FieldKind::Magnetic,
+                value: [1.0, 0.0, 0.0],
+            },
+        ],
+    );
     let options = RunOptions {
         output: Some(dir.path().to_path_buf()),
         seed: Some(3),
-        live: LiveSlot::new(Box::new(Tap(seen.clone(), false))),
+        live,
         ..RunOptions::default()
     };
     let input = Input::scene("live", "live.toml", SCENE);
     mote_front::run_input(&input, &options, &mut Silent).unwrap();
     let seen = seen.lock().unwrap();
-    // Prime, then every step; 20 steps of 0.001 and 20 of 0.002.
-    // Prime, every step, and step 20 again after its changes.
+    // Prime, every step (20 of 0.001 and 20 of 0.002), and step 20 again
+    // after its changes.
     assert_eq!(seen.frames.len(), 42);
     assert_eq!(seen.frames[0], (0, 0.0, 2));
     let (step, t, _) = seen.frames[41];
@@ -145,50 +165,24 @@ fn changes_reach_the_next_step_and_are_recorded_as_events() {
     );
 }
 
-/// Sets B = (0, 0, 2) at step 10 of the magnet-in-field example and asks
-/// for a temperature the rigid engine does not have.
-struct RigidTap(Arc<Mutex<Seen>>, bool);
-
-impl Live for RigidTap {
-    fn between(
-        &mut self,
-        step: u64,
-        time: f64,
-        frame: &mut dyn FnMut() -> Option<Frame>,
-    ) -> Vec<Change> {
-        let f = frame().expect("rigid bodies show their spheres");
-        self.0
-            .lock()
-            .unwrap()
-            .frames
-            .push((step, time, f.positions.len()));
-        if step == 10 && !self.1 {
-            self.1 = true;
-            vec![
-                Change::Field {
-                    kind: FieldKind::Magnetic,
-                    value: [0.0, 0.0, 2.0],
-                },
-                Change::Temperature(1.0),
-            ]
-        } else {
-            Vec::new()
-        }
-    }
-
-    fn answer(&mut self, step: u64, _time: f64, _change: &Change, a: &Result<String, String>) {
-        self.0.lock().unwrap().answers.push((step, a.clone()));
-    }
-}
-
 #[test]
 fn a_rigid_run_takes_a_new_field() {
     let dir = tempfile::tempdir().unwrap();
-    let seen = Arc::new(Mutex::new(Seen::default()));
+    // B = (0, 0, 2) at step 10, and a temperature the rigid engine lacks.
+    let (seen, live) = Tap::slot(
+        10,
+        vec![
+            Change::Field {
+                kind: FieldKind::Magnetic,
+                value: [0.0, 0.0, 2.0],
+            },
+            Change::Temperature(1.0),
+        ],
+    );
     let options = RunOptions {
         output: Some(dir.path().to_path_buf()),
         steps: Some(20),
-        live: LiveSlot::new(Box::new(RigidTap(seen.clone(), false))),
+        live,
         ..RunOptions::default()
     };
     let input = Input::read("example:magnet-in-field").unwrap();

@@ -64,22 +64,11 @@ fn start() -> u16 {
 fn headless(browser: &PathBuf, extra: &[String], url: &str) -> std::process::Output {
     let profile = tempfile::tempdir().unwrap();
     let mut cmd = Command::new(browser);
-    cmd.args([
-        "--headless",
-        "--no-sandbox",
-        "--use-angle=swiftshader",
-        "--enable-unsafe-swiftshader",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        "--window-size=1000,700",
-        "--virtual-time-budget=10000",
-    ])
-    .arg(format!("--user-data-dir={}", profile.path().display()))
-    .args(extra)
-    .arg(url);
+    cmd.args(cdp::FLAGS)
+        .arg("--virtual-time-budget=10000")
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .args(extra)
+        .arg(url);
     cmd.output().expect("chromium starts")
 }
 
@@ -221,15 +210,7 @@ fn a_live_run_advances_and_takes_a_change_from_the_page() {
         ..Default::default()
     };
     mote_view::live::spawn_run(options, &session, mote_view::live::ending).unwrap();
-    let (listener, _) = mote_view::bind("127.0.0.1", 0).unwrap();
-    let port = listener.local_addr().unwrap().port();
-    let app = std::sync::Arc::new(mote_view::App::Live(session.clone()));
-    std::thread::spawn(move || {
-        tokio::runtime::Runtime::new()
-            .unwrap()
-            .block_on(mote_view::serve(listener, app, std::future::pending()))
-            .unwrap();
-    });
+    let port = common::start_app(std::sync::Arc::new(mote_view::App::Live(session.clone())));
     let mut page = cdp::Browser::open(
         &browser,
         &format!("http://127.0.0.1:{port}/?set=dt:0.000025&run=1&color=speed"),

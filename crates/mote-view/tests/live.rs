@@ -9,8 +9,10 @@ use std::time::{Duration, Instant};
 use mote_io::xyz::Frame;
 use mote_run::Change;
 use mote_view::live::Session;
-use mote_view::{bind, serve, App};
+use mote_view::App;
 use tungstenite::{Message, WebSocket};
+
+mod common;
 
 /// A stand-in for a run: `n` particles moving along x, stepping `h`
 /// (changed by `Change::Dt`) for ever; the changes it took are recorded.
@@ -63,15 +65,7 @@ fn start(n: usize) -> (Arc<Session>, Arc<Mutex<Vec<Change>>>, u16) {
     let session = Session::new("fake".into(), dir, false);
     let taken = Arc::new(Mutex::new(Vec::new()));
     fake_run(&session, n, taken.clone());
-    let (listener, _) = bind("127.0.0.1", 0).unwrap();
-    let port = listener.local_addr().unwrap().port();
-    let app = Arc::new(App::Live(session.clone()));
-    std::thread::spawn(move || {
-        tokio::runtime::Runtime::new()
-            .unwrap()
-            .block_on(serve(listener, app, std::future::pending()))
-            .unwrap();
-    });
+    let port = common::start_app(Arc::new(App::Live(session.clone())));
     (session, taken, port)
 }
 

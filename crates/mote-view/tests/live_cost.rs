@@ -9,8 +9,10 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use mote_view::live::{self, Session};
-use mote_view::{bind, serve, App};
+use mote_view::App;
 use tungstenite::Message;
+
+mod common;
 
 fn run(watched: bool) -> (f64, u64) {
     let dir = tempfile::tempdir().unwrap();
@@ -22,15 +24,7 @@ fn run(watched: bool) -> (f64, u64) {
         seed: Some(1),
         ..Default::default()
     };
-    let (listener, _) = bind("127.0.0.1", 0).unwrap();
-    let port = listener.local_addr().unwrap().port();
-    let app = Arc::new(App::Live(session.clone()));
-    std::thread::spawn(move || {
-        tokio::runtime::Runtime::new()
-            .unwrap()
-            .block_on(serve(listener, app, std::future::pending()))
-            .unwrap();
-    });
+    let port = common::start_app(Arc::new(App::Live(session.clone())));
     let mut frames = 0;
     let mut ws = None;
     if watched {

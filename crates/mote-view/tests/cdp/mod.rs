@@ -51,25 +51,28 @@ fn http_get(port: u16, path: &str) -> Option<String> {
     }
 }
 
+/// How Chromium runs here: headless, as root without the sandbox, WebGL2
+/// on SwiftShader, off the network's background services.
+pub const FLAGS: &[&str] = &[
+    "--headless",
+    "--no-sandbox",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--window-size=1000,700",
+];
+
 impl Browser {
-    /// Chromium (headless, as root without the sandbox, WebGL2 on
-    /// SwiftShader, off the network's background services) showing `url`.
+    /// Chromium (with [`FLAGS`] and a fresh profile) showing `url`.
     pub fn open(binary: &Path, url: &str) -> Browser {
         let profile = tempfile::tempdir().unwrap();
         let child = Command::new(binary)
-            .args([
-                "--headless",
-                "--no-sandbox",
-                "--use-angle=swiftshader",
-                "--enable-unsafe-swiftshader",
-                "--disable-quic",
-                "--no-first-run",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--window-size=1000,700",
-                "--remote-debugging-port=0",
-            ])
+            .args(FLAGS)
+            .arg("--remote-debugging-port=0")
             .arg(format!("--user-data-dir={}", profile.path().display()))
             .arg(url)
             .stdout(Stdio::null())
@@ -113,15 +116,11 @@ impl Browser {
         }
     }
 
-    /// Evaluates a JavaScript expression in the page; its value as JSON.
-    pub fn eval(&mut self, expression: &str) -> serde_json::Value {
+    /// Calls a DevTools method on the page; its result.
+    fn call(&mut self, method: &str, params: serde_json::Value) -> serde_json::Value {
         let id = self.next_id;
         self.next_id += 1;
-        let call = serde_json::json!({
-            "id": id,
-            "method": "Runtime.evaluate",
-            "params": { "expression": expression, "returnByValue": true, "awaitPromise": true },
-        });
+        let call = serde_json::json!({ "id": id, "method": method, "params": params });
         self.page
             .send(Message::Text(call.to_string().into()))
             .unwrap();
@@ -129,10 +128,27 @@ impl Browser {
             if let Message::Text(t) = self.page.read().unwrap() {
                 let v: serde_json::Value = serde_json::from_str(&t).unwrap();
                 if v["id"] == id {
-                    return v["result"]["result"]["value"].clone();
+                    return v["result"].clone();
                 }
             }
         }
+    }
+
+    /// Evaluates a JavaScript expression in the page; its value as JSON.
+    pub fn eval(&mut self, expression: &str) -> serde_json::Value {
+        let params = serde_json::json!({
+            "expression": expression, "returnByValue": true, "awaitPromise": true,
+        });
+        self.call("Runtime.evaluate", params)["result"]["value"].clone()
+    }
+
+    /// A PNG of the page as it is now.
+    pub fn screenshot(&mut self) -> Vec<u8> {
+        let shot = self.call(
+            "Page.captureScreenshot",
+            serde_json::json!({ "format": "png" }),
+        );
+        base64(shot["data"].as_str().unwrap())
     }
 
     /// The page's state (its `#state` element) once `ready` holds of it,
@@ -159,26 +175,6 @@ impl Drop for Browser {
     fn drop(&mut self) {
         self.child.kill().ok();
         self.child.wait().ok();
-    }
-}
-
-impl Browser {
-    /// A PNG of the page as it is now.
-    pub fn screenshot(&mut self) -> Vec<u8> {
-        let id = self.next_id;
-        self.next_id += 1;
-        let call = serde_json::json!({ "id": id, "method": "Page.captureScreenshot", "params": { "format": "png" } });
-        self.page
-            .send(Message::Text(call.to_string().into()))
-            .unwrap();
-        loop {
-            if let Message::Text(t) = self.page.read().unwrap() {
-                let v: serde_json::Value = serde_json::from_str(&t).unwrap();
-                if v["id"] == id {
-                    return base64(v["result"]["data"].as_str().unwrap());
-                }
-            }
-        }
     }
 }
 
