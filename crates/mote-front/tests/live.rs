@@ -5,8 +5,7 @@
 use std::sync::{Arc, Mutex};
 
 use mote_front::{Input, RunOptions, Silent};
-use mote_io::xyz::Frame;
-use mote_run::{Change, FieldKind, Live, LiveSlot};
+use mote_run::{Change, FieldKind, Live, LiveSlot, Shown};
 
 const SCENE: &str = r#"
 title = "two particles falling under damping and a thermostat"
@@ -64,9 +63,9 @@ impl Live for Tap {
         &mut self,
         step: u64,
         time: f64,
-        frame: &mut dyn FnMut() -> Option<Frame>,
+        frame: &mut dyn FnMut() -> Option<Shown>,
     ) -> Vec<Change> {
-        let f = frame().expect("the engine shows its particles");
+        let f = frame().expect("the engine shows its particles").frame;
         self.seen
             .lock()
             .unwrap()

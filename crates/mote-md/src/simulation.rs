@@ -169,6 +169,15 @@ impl mote_run::Propagator for Simulation {
         Some(crate::output::frame_of(&self.system))
     }
 
+    fn walls(&self) -> Vec<mote_run::WallGeometry> {
+        let t = self.system.time;
+        self.forces
+            .interactions
+            .iter()
+            .flat_map(|i| i.walls(t))
+            .collect()
+    }
+
     /// Δt and the temperature are the simulation's; fields and damping go to
     /// the interaction that owns them.
     fn change(&mut self, change: &mote_run::Change) -> Result<String, String> {

@@ -23,7 +23,7 @@ use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::xyz::Frame;
 
 mod steer;
-pub use steer::{Change, FieldKind, Live, LiveSlot};
+pub use steer::{Change, FieldKind, Live, LiveSlot, Shown, WallGeometry};
 
 /// Something that moves a state forward step by step.
 pub trait Propagator {
@@ -58,6 +58,10 @@ pub trait Propagator {
     /// viewer; `None` if the engine cannot show itself.
     fn frame(&self) -> Option<Frame> {
         None
+    }
+    /// The walls where they are now, for the live viewer.
+    fn walls(&self) -> Vec<WallGeometry> {
+        Vec::new()
     }
     /// Applies a change asked for from outside (the live viewer) before
     /// the next step: what changed, in words ("dt 0.001 → 0.0005"), or why
@@ -225,7 +229,7 @@ impl<P: Propagator> Driver<P> {
             }
         }
         if let Some(live) = self.live.as_mut() {
-            live.last(state.step(), state.time(), &mut || state.frame());
+            live.last(state.step(), state.time(), &mut || Self::shown(state));
         }
         let last = match last {
             Some(s) => s,
@@ -251,7 +255,7 @@ impl<P: Propagator> Driver<P> {
             return Ok(());
         };
         loop {
-            let changes = live.between(state.step(), state.time(), &mut || state.frame());
+            let changes = live.between(state.step(), state.time(), &mut || Self::shown(state));
             if changes.is_empty() {
                 return Ok(());
             }
@@ -265,6 +269,13 @@ impl<P: Propagator> Driver<P> {
                 live.answer(state.step(), state.time(), &change, &answer);
             }
         }
+    }
+
+    fn shown(state: &P) -> Option<Shown> {
+        state.frame().map(|frame| Shown {
+            frame,
+            walls: state.walls(),
+        })
     }
 
     fn save(c: &Checkpoints, state: &mut P) -> Result<(), P::Error> {
@@ -349,7 +360,7 @@ mod tests {
             &mut self,
             step: u64,
             _time: f64,
-            _frame: &mut dyn FnMut() -> Option<Frame>,
+            _frame: &mut dyn FnMut() -> Option<Shown>,
         ) -> Vec<Change> {
             self.0.lock().unwrap().push(format!("step {step}"));
             if step == 2 && !self.1 {

@@ -3,6 +3,28 @@
 
 use mote_io::xyz::Frame;
 
+/// A wall as a viewer draws it, where it is now.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WallGeometry {
+    /// The plane through `point` with unit `normal`.
+    Plane { point: [f64; 3], normal: [f64; 3] },
+    /// The cylinder of `radius` about the line through `point` along unit
+    /// `axis`, turned by `angle` (radians) about it since t = 0.
+    Cylinder {
+        point: [f64; 3],
+        axis: [f64; 3],
+        radius: f64,
+        angle: f64,
+    },
+}
+
+/// What a viewer is shown of a state: its particles and its walls.
+#[derive(Debug, Clone, Default)]
+pub struct Shown {
+    pub frame: Frame,
+    pub walls: Vec<WallGeometry>,
+}
+
 /// Which uniform external field a [`Change::Field`] sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FieldKind {
@@ -80,8 +102,8 @@ impl Change {
 /// The live viewer's tap on a run ([`crate::Driver::live`]).
 pub trait Live: Send {
     /// Called after priming and after every step. `frame` makes the
-    /// particles of now (call it only when a frame is wanted: it copies the
-    /// state). Returns the changes to apply before the next step, and is
+    /// particles and walls of now (call it only when a frame is wanted: it
+    /// copies the state). Returns the changes to apply before the next step, and is
     /// called again once they are applied, until it returns none: a paused
     /// viewer holds the run inside this call and returns the changes made
     /// meanwhile without letting it step.
@@ -89,11 +111,11 @@ pub trait Live: Send {
         &mut self,
         step: u64,
         time: f64,
-        frame: &mut dyn FnMut() -> Option<Frame>,
+        frame: &mut dyn FnMut() -> Option<Shown>,
     ) -> Vec<Change>;
     /// The run reached its last step: show it (called once, not after an
     /// unstable step or a signal).
-    fn last(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Frame>) {
+    fn last(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Shown>) {
         let _ = (step, time, frame);
     }
     /// The answer to a change: what changed, or why it could not.

@@ -134,8 +134,9 @@ uniform mat4 view, proj;
 void main() { gl_Position = proj * view * vec4(p, 1.0); }`;
 const LINE_FS = `#version 300 es
 precision highp float;
+uniform vec3 tint;
 out vec4 fragment;
-void main() { fragment = vec4(0.3, 0.3, 0.3, 1.0); }`;
+void main() { fragment = vec4(tint, 1.0); }`;
 
 function program(vs, fs) {
   const make = (type, source) => {
@@ -178,6 +179,7 @@ function eye() {
           c.target[2] + c.distance * Math.cos(c.phi)];
 }
 
+let wallVao, wallBuf, wallCount = 0;
 let spheres, points, pointVao, lines, sphereVao, lineVao, sphereBuf, valueBuf, lineBuf, boxCount = 0;
 
 // The box's twelve edges, if the frame has a cell.
@@ -221,6 +223,12 @@ function setup() {
   gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
   gl.enableVertexAttribArray(1);
   gl.vertexAttribPointer(1, 1, gl.FLOAT, false, 0, 0);
+  wallVao = gl.createVertexArray();
+  gl.bindVertexArray(wallVao);
+  wallBuf = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, wallBuf);
+  gl.enableVertexAttribArray(0);
+  gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
   lineVao = gl.createVertexArray();
   gl.bindVertexArray(lineVao);
   lineBuf = gl.createBuffer();
@@ -290,12 +298,21 @@ function draw(moving) {
     gl.bindVertexArray(sphereVao);
     gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, scene.n);
   }
-  if (boxCount) {
+  if (boxCount || wallCount) {
     gl.useProgram(lines);
     gl.uniformMatrix4fv(gl.getUniformLocation(lines, "view"), false, view);
     gl.uniformMatrix4fv(gl.getUniformLocation(lines, "proj"), false, proj);
-    gl.bindVertexArray(lineVao);
-    gl.drawArrays(gl.LINES, 0, boxCount);
+    const tint = gl.getUniformLocation(lines, "tint");
+    if (boxCount) {
+      gl.uniform3f(tint, 0.3, 0.3, 0.3);
+      gl.bindVertexArray(lineVao);
+      gl.drawArrays(gl.LINES, 0, boxCount);
+    }
+    if (wallCount) {
+      gl.uniform3f(tint, 0.1, 0.45, 0.75);
+      gl.bindVertexArray(wallVao);
+      gl.drawArrays(gl.LINES, 0, wallCount);
+    }
   }
   gl.bindVertexArray(null);
   scene.drawn = (scene.drawn || 0) + 1;
@@ -570,6 +587,11 @@ function connectLive() {
       }
       const data = decode(e.data);
       if (!boxCount) setBox(head.cell, head.origin);
+      // The walls, where they are now (moving and turning ones move).
+      gl.bindBuffer(gl.ARRAY_BUFFER, wallBuf);
+      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(head.walls.flat()), gl.DYNAMIC_DRAW);
+      wallCount = 2 * head.walls.length;
+      scene.walls = head.walls.length;
       if (head.quantities.join() !== scene.meta.quantities.slice(1).join()) {
         scene.meta.quantities = ["species", ...head.quantities];
         colorOptions();

@@ -34,6 +34,7 @@ use mote_io::xyz::Frame;
 use serde::Deserialize;
 
 pub mod live;
+pub mod outline;
 pub mod table;
 
 const INDEX: &str = include_str!("../assets/index.html");

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use axum::extract::ws::{Message, WebSocket};
 use mote_io::xyz::Frame;
-use mote_run::{Change, FieldKind, Live};
+use mote_run::{Change, FieldKind, Live, Shown};
 use serde::Deserialize;
 use tokio::sync::watch;
 
@@ -40,6 +40,8 @@ pub struct Snapshot {
     pub serial: u64,
     /// The frame's species, sorted: colour index = position here.
     pub species: Arc<Vec<String>>,
+    /// The walls as segments (x0, y0, z0, x1, y1, z1) around the frame.
+    pub walls: Arc<Vec<[f64; 6]>>,
     /// How the run ended, and whether it failed.
     pub ended: Option<(String, bool)>,
     /// The last [`LOG_KEPT`] answers and notes, and how many there were.
@@ -127,7 +129,10 @@ impl Session {
         self.paused.store(paused, Ordering::Relaxed);
     }
 
-    fn publish_frame(&self, step: u64, time: f64, frame: Frame) {
+    fn publish_frame(&self, step: u64, time: f64, shown: Shown) {
+        let Shown { frame, walls } = shown;
+        let (lo, hi) = crate::outline::extent(&frame, &walls);
+        let walls = crate::outline::outlines(&walls, lo, hi);
         let mut species: Vec<String> = frame.species.clone();
         species.sort_unstable();
         species.dedup();
@@ -136,6 +141,7 @@ impl Session {
             s.time = time;
             s.serial += 1;
             s.frame = Some(Arc::new(frame));
+            s.walls = Arc::new(walls);
             if *s.species != species {
                 s.species = Arc::new(species);
             }
@@ -198,7 +204,7 @@ struct Tap {
 impl Tap {
     /// Publishes step and time at most every [`FRAME_INTERVAL`], with a
     /// frame when a page wants one.
-    fn show(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Frame>) {
+    fn show(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Shown>) {
         let s = &self.session;
         let due = self.last.is_none_or(|t| t.elapsed() >= self.interval);
         if !due {
@@ -237,7 +243,7 @@ impl Live for Tap {
         &mut self,
         step: u64,
         time: f64,
-        frame: &mut dyn FnMut() -> Option<Frame>,
+        frame: &mut dyn FnMut() -> Option<Shown>,
     ) -> Vec<Change> {
         self.show(step, time, frame);
         let changes = self.take_changes();
@@ -275,7 +281,7 @@ impl Live for Tap {
         }
     }
 
-    fn last(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Frame>) {
+    fn last(&mut self, step: u64, time: f64, frame: &mut dyn FnMut() -> Option<Shown>) {
         match frame() {
             Some(f) => self.session.publish_frame(step, time, f),
             None => self.session.latest.send_modify(|s| {
@@ -456,6 +462,7 @@ pub async fn client(mut socket: WebSocket, session: Arc<Session>) {
             "cell": frame.cell,
             "origin": frame.origin,
             "species": *snap.species,
+            "walls": *snap.walls,
             "quantities": mote_render::frame::quantities_of(frame),
             "color": color,
             "particle": pick.and_then(|i| crate::particle_json(frame, i).ok()),

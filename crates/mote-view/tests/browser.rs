@@ -222,6 +222,8 @@ fn a_live_run_advances_and_takes_a_change_from_the_page() {
     assert_eq!(state["errors"], serde_json::json!([]), "{state}");
     assert_eq!(state["live"], true);
     assert_eq!(state["n"], 300, "{state}");
+    // The box wall: six planes, each drawn as its face (four lines).
+    assert_eq!(state["walls"], 24, "{state}");
     assert!(
         state["time"].as_f64().unwrap() > 0.0,
         "time did not advance: {state}"

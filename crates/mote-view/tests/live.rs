@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use mote_io::xyz::Frame;
-use mote_run::Change;
+use mote_run::{Change, Shown};
 use mote_view::live::Session;
 use mote_view::App;
 use tungstenite::{Message, WebSocket};
@@ -24,13 +24,17 @@ fn fake_run(session: &Arc<Session>, n: usize, taken: Arc<Mutex<Vec<Change>>>) {
         loop {
             loop {
                 let changes = tap.between(step, t, &mut || {
-                    Some(Frame {
+                    let frame = Frame {
                         time: t,
                         species: vec!["A".into(); n],
                         positions: (0..n).map(|i| [i as f64 + t, 0.0, 0.0]).collect(),
                         velocities: vec![[1.0, 0.0, 0.0]; n],
                         radii: vec![0.5; n],
                         ..Frame::default()
+                    };
+                    Some(Shown {
+                        frame,
+                        walls: Vec::new(),
                     })
                 });
                 if changes.is_empty() {

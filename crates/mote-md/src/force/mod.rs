@@ -206,6 +206,12 @@ pub trait Interaction: Send {
     fn wall_forces(&self) -> Vec<(String, DVec3)> {
         Vec::new()
     }
+    /// The walls of this interaction where they are at time `t` (for the
+    /// live viewer); empty for interactions without walls.
+    fn walls(&self, t: f64) -> Vec<mote_run::WallGeometry> {
+        let _ = t;
+        Vec::new()
+    }
     /// Applies a change asked for from the live viewer when this
     /// interaction owns what it sets: `Some(what changed)`, or
     /// `Some(Err(why not))`; `None` when the change is not its business.

@@ -150,6 +150,14 @@ impl Propagator for RigidDynamics {
         Some(self.sphere_frame())
     }
 
+    fn walls(&self) -> Vec<mote_run::WallGeometry> {
+        let t = self.bodies.time;
+        self.contacts
+            .iter()
+            .flat_map(|c| c.walls.iter().map(move |w| w.geometry(t)))
+            .collect()
+    }
+
     /// Δt is the integrator's; fields and drag go to the interaction that
     /// owns them. Rigid runs have no thermostat.
     fn change(&mut self, change: &mote_run::Change) -> Result<String, String> {

@@ -77,6 +77,27 @@ impl Wall {
         }
     }
 
+    /// Where the wall is at time t, for the live viewer.
+    pub fn geometry(&self, t: f64) -> mote_run::WallGeometry {
+        let shift = self.velocity * t;
+        match self.shape {
+            WallShape::Plane { point, normal } => mote_run::WallGeometry::Plane {
+                point: (point + shift).to_array(),
+                normal: normal.to_array(),
+            },
+            WallShape::Cylinder {
+                point,
+                axis,
+                radius,
+            } => mote_run::WallGeometry::Cylinder {
+                point: (point + shift).to_array(),
+                axis: axis.to_array(),
+                radius,
+                angle: self.angular_speed * t,
+            },
+        }
+    }
+
     /// For a sphere at x at time t: the gap along the normal from the wall
     /// surface to the centre, and the unit normal into the particle side.
     #[inline(always)]
@@ -233,6 +254,10 @@ impl GranularWalls {
 impl Interaction for GranularWalls {
     fn name(&self) -> &'static str {
         "walls"
+    }
+
+    fn walls(&self, t: f64) -> Vec<mote_run::WallGeometry> {
+        self.walls.iter().map(|w| w.geometry(t)).collect()
     }
 
     fn exerts_torques(&self) -> bool {
