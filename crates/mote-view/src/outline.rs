@@ -87,7 +87,7 @@ pub fn extent(frame: &mote_io::xyz::Frame, walls: &[WallGeometry]) -> (V, V) {
             }
         }
     }
-    if !(lo[0] <= hi[0]) {
+    if lo[0] > hi[0] || lo[0].is_nan() {
         return ([0.0; 3], [1.0; 3]);
     }
     (lo, hi)
