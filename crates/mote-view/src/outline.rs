@@ -54,7 +54,7 @@ fn corners(lo: V, hi: V) -> [V; 8] {
 
 /// The box around the particles (each grown by its radius), the cell and
 /// the walls' reference points (a plane's point; a cylinder's point grown
-/// by its radius): a closed box of walls is drawn as exactly its faces.
+/// by its radius), cut by the planes across an axis.
 pub fn extent(frame: &mote_io::xyz::Frame, walls: &[WallGeometry]) -> (V, V) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -89,6 +89,21 @@ pub fn extent(frame: &mote_io::xyz::Frame, walls: &[WallGeometry]) -> (V, V) {
     }
     if lo[0] > hi[0] || lo[0].is_nan() {
         return ([0.0; 3], [1.0; 3]);
+    }
+    // A plane across an axis bounds the scene on its side: the extent ends
+    // there (a closed box of walls is then drawn as exactly its faces,
+    // whatever margin the cell has).
+    for w in walls {
+        if let WallGeometry::Plane { point, normal } = *w {
+            let n = unit(normal);
+            for a in 0..3 {
+                if n[a] > 1.0 - 1e-12 {
+                    lo[a] = point[a];
+                } else if n[a] < -1.0 + 1e-12 {
+                    hi[a] = point[a];
+                }
+            }
+        }
     }
     (lo, hi)
 }
@@ -231,6 +246,38 @@ mod tests {
             normal: [1.0, 1.0, 1.0],
         };
         assert_eq!(outlines(&[diagonal], [0.0; 3], [1.0; 3]).len(), 6);
+    }
+
+    #[test]
+    fn a_closed_box_of_walls_is_the_extent() {
+        let frame = mote_io::xyz::Frame {
+            positions: vec![[0.5, 0.5, 0.2]],
+            radii: vec![0.1],
+            cell: [[1.2, 0.0, 0.0], [0.0, 1.2, 0.0], [0.0, 0.0, 1.2]],
+            origin: [-0.1; 3],
+            ..Default::default()
+        };
+        let mut walls = Vec::new();
+        for a in 0..3 {
+            let mut n = [0.0; 3];
+            n[a] = 1.0;
+            walls.push(WallGeometry::Plane {
+                point: [0.0; 3],
+                normal: n,
+            });
+            n[a] = -1.0;
+            walls.push(WallGeometry::Plane {
+                point: [1.0; 3],
+                normal: n,
+            });
+        }
+        assert_eq!(extent(&frame, &walls), ([0.0; 3], [1.0; 3]));
+        let (lo, hi) = extent(&frame, &[]);
+        assert!(lo
+            .iter()
+            .chain(&hi)
+            .zip([-0.1, -0.1, -0.1, 1.1, 1.1, 1.1])
+            .all(|(a, b)| (a - b).abs() < 1e-12));
     }
 
     #[test]
