@@ -75,16 +75,13 @@ ${COLORS}void main() {
   color = categorical == 1 ? palette(value) : viridis(t);
 }`;
 
-const SPHERE_FS = `#version 300 es
-precision highp float;
-in vec2 corner;
-in vec3 color;
-in vec3 centre;
-in float radius;
+// Shading of both sphere programs: q is the fragment's place on the
+// sphere's disc (unit radius); the sphere's depth is written, so that
+// overlapping spheres (clumps) intersect exactly.
+const SHADE = `
 uniform mat4 proj;
 out vec4 fragment;
-void main() {
-  vec2 q = corner * 1.1;
+void shade(vec2 q, vec3 color, vec3 centre, float radius) {
   float d2 = dot(q, q);
   if (d2 > 1.0) discard;
   vec3 n = vec3(q, sqrt(1.0 - d2));
@@ -95,10 +92,19 @@ void main() {
   vec4 p = proj * vec4(centre + n * radius, 1.0);
   gl_FragDepth = 0.5 * p.z / p.w + 0.5;
 }`;
+const SPHERE_FS = `#version 300 es
+precision highp float;
+in vec2 corner;
+in vec3 color;
+in vec3 centre;
+in float radius;
+${SHADE}
+void main() { shade(corner * 1.1, color, centre, radius); }`;
 
-// Level of detail: one point per sphere (a quarter of the vertices), sized
-// to the sphere's projected diameter and shaded as a disc, depth at its
-// centre.
+// Level of detail: one point per sphere (a quarter of the vertices),
+// sized to the sphere's projected diameter with the quads' margin, shaded
+// and depth-written as the quads are. Points are clipped by their centre,
+// so spheres cut by the view's edge may drop out: the quads draw at rest.
 const POINT_VS = `#version 300 es
 layout(location = 0) in vec4 sphere;
 layout(location = 1) in float value;
@@ -107,26 +113,25 @@ uniform vec2 range;
 uniform int categorical;
 uniform float pixels;
 out vec3 color;
+out vec3 centre;
+out float radius;
 ${COLORS}
 void main() {
   vec4 c = view * vec4(sphere.xyz, 1.0);
+  centre = c.xyz;
+  radius = sphere.w;
   gl_Position = proj * c;
-  gl_PointSize = max(sphere.w * proj[1][1] * pixels / max(-c.z, 1e-30), 1.0);
+  gl_PointSize = max(1.1 * sphere.w * proj[1][1] * pixels / max(-c.z, 1e-30), 1.0);
   float t = clamp((value - range.x) / max(range.y - range.x, 1e-30), 0.0, 1.0);
   color = categorical == 1 ? palette(value) : viridis(t);
 }`;
 const POINT_FS = `#version 300 es
 precision highp float;
 in vec3 color;
-out vec4 fragment;
-void main() {
-  vec2 q = vec2(2.0 * gl_PointCoord.x - 1.0, 1.0 - 2.0 * gl_PointCoord.y);
-  float d2 = dot(q, q);
-  if (d2 > 1.0) discard;
-  vec3 n = vec3(q, sqrt(1.0 - d2));
-  float diffuse = max(dot(n, normalize(vec3(0.4, 0.6, 1.0))), 0.0);
-  fragment = vec4(color * (0.3 + 0.7 * diffuse), 1.0);
-}`;
+in vec3 centre;
+in float radius;
+${SHADE}
+void main() { shade(vec2(2.0 * gl_PointCoord.x - 1.0, 1.0 - 2.0 * gl_PointCoord.y) * 1.1, color, centre, radius); }`;
 
 const LINE_VS = `#version 300 es
 layout(location = 0) in vec3 p;
