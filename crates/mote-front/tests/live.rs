@@ -35,6 +35,8 @@ trajectory_every = 0
 #[derive(Default)]
 struct Seen {
     frames: Vec<(u64, f64, usize)>,
+    /// The forces shown with each frame.
+    forces: Vec<Vec<[f64; 3]>>,
     answers: Vec<(u64, Result<String, String>)>,
 }
 
@@ -65,12 +67,11 @@ impl Live for Tap {
         time: f64,
         frame: &mut dyn FnMut() -> Option<Shown>,
     ) -> Vec<Change> {
-        let f = frame().expect("the engine shows its particles").frame;
-        self.seen
-            .lock()
-            .unwrap()
-            .frames
-            .push((step, time, f.positions.len()));
+        let shown = frame().expect("the engine shows its particles");
+        let mut seen = self.seen.lock().unwrap();
+        seen.frames.push((step, time, shown.frame.positions.len()));
+        seen.forces.push(shown.forces);
+        drop(seen);
         if step == self.at {
             std::mem::take(&mut self.changes)
         } else {
@@ -118,6 +119,11 @@ fn changes_reach_the_next_step_and_are_recorded_as_events() {
     let (step, t, _) = seen.frames[41];
     assert_eq!(step, 40);
     assert!((t - 0.06).abs() < 1e-12, "t = {t}");
+    // F = m g at rest after priming (m = 1, g = −1 along z); after the
+    // change the shown force has the new gravity (damping −γ v beside it).
+    assert_eq!(seen.forces[0], vec![[0.0, 0.0, -1.0]; 2]);
+    let last = seen.forces[41][0];
+    assert!(last[2] < -1.5 && last[2] > -2.5, "{last:?}");
     let ok: Vec<&String> = seen
         .answers
         .iter()
@@ -198,6 +204,50 @@ fn a_rigid_run_takes_a_new_field() {
         refused.contains("temperature: the scene has none"),
         "{refused}"
     );
+    // The force on the body (a uniform B exerts none on a dipole), shown
+    // for each of its three spheres once it has stepped.
+    assert_eq!(seen.forces[5], vec![[0.0; 3]; 3]);
     let csv = std::fs::read_to_string(dir.path().join("observables.csv")).unwrap();
     assert_eq!(csv.matches("# event: step 10").count(), 1, "{csv}");
+}
+
+#[test]
+fn a_rigid_run_shows_the_force_on_each_sphere_s_body() {
+    let dir = tempfile::tempdir().unwrap();
+    let (seen, live) = Tap::slot(u64::MAX, Vec::new());
+    let options = RunOptions {
+        output: Some(dir.path().to_path_buf()),
+        steps: Some(2),
+        live,
+        ..RunOptions::default()
+    };
+    let input = Input::read("example:clumps-settling").unwrap();
+    mote_front::run_input(&input, &options, &mut Silent).unwrap();
+    let seen = seen.lock().unwrap();
+    // Before the first step no force was evaluated; after it every sphere
+    // shows its body's: m g for the free bodies placed apart, plus contact
+    // forces for those touching another or a wall.
+    assert!(seen.forces[0].is_empty());
+    let forces = &seen.forces[1];
+    let dir_frame = mote_io::trajectory::read_frames(&dir.path().join("trajectory.xyz")).unwrap();
+    let frame = &dir_frame[0];
+    assert_eq!(forces.len(), frame.positions.len());
+    let mut body_mass = std::collections::HashMap::new();
+    for (b, m) in frame.bodies.iter().zip(&frame.masses) {
+        *body_mass.entry(*b).or_insert(0.0) += m;
+    }
+    let falling = frame
+        .bodies
+        .iter()
+        .zip(forces)
+        .filter(|(b, f)| {
+            let w = -9.81 * body_mass[b];
+            f[0] == 0.0 && f[1] == 0.0 && ((f[2] - w) / w).abs() < 1e-12
+        })
+        .count();
+    assert!(
+        falling > forces.len() / 2,
+        "{falling} of {} spheres show m g",
+        forces.len()
+    );
 }

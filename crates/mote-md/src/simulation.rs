@@ -169,6 +169,17 @@ impl mote_run::Propagator for Simulation {
         Some(crate::output::frame_of(&self.system))
     }
 
+    /// F = m a from the accelerations leap-frog carries (the integrators
+    /// that carry none give none).
+    fn forces(&self) -> Vec<[f64; 3]> {
+        let sys = &self.system;
+        sys.carried_acceleration
+            .iter()
+            .zip(&sys.particles.mass)
+            .map(|(a, m)| (*a * *m).to_array())
+            .collect()
+    }
+
     fn walls(&self) -> Vec<mote_run::WallGeometry> {
         let t = self.system.time;
         self.forces

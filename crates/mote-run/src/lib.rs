@@ -63,6 +63,12 @@ pub trait Propagator {
     fn walls(&self) -> Vec<WallGeometry> {
         Vec::new()
     }
+    /// The force on each particle of [`Propagator::frame`] as of the last
+    /// force evaluation, for the live viewer's inspector (empty if the
+    /// engine keeps none).
+    fn forces(&self) -> Vec<[f64; 3]> {
+        Vec::new()
+    }
     /// Applies a change asked for from outside (the live viewer) before
     /// the next step: what changed, in words ("dt 0.001 → 0.0005"), or why
     /// it cannot.
@@ -274,6 +280,7 @@ impl<P: Propagator> Driver<P> {
     fn shown(state: &P) -> Option<Shown> {
         state.frame().map(|frame| Shown {
             frame,
+            forces: state.forces(),
             walls: state.walls(),
         })
     }

@@ -18,10 +18,12 @@ pub enum WallGeometry {
     },
 }
 
-/// What a viewer is shown of a state: its particles and its walls.
+/// What a viewer is shown of a state: its particles, the force on each
+/// (empty where the engine keeps none) and its walls.
 #[derive(Debug, Clone, Default)]
 pub struct Shown {
     pub frame: Frame,
+    pub forces: Vec<[f64; 3]>,
     pub walls: Vec<WallGeometry>,
 }
 

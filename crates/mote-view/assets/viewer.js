@@ -537,6 +537,7 @@ function trackLive(p) {
   const v = p.velocity || [NaN, NaN, NaN];
   track.time.push(p.time);
   track.speed.push(Math.hypot(...v));
+  (track.force = track.force || []).push(p.force ? Math.hypot(...p.force) : NaN);
   track.x.push(p.position[0]);
   track.y.push(p.position[1]);
   track.z.push(p.position[2]);

@@ -42,6 +42,8 @@ pub struct Snapshot {
     pub species: Arc<Vec<String>>,
     /// The walls as segments (x0, y0, z0, x1, y1, z1) around the frame.
     pub walls: Arc<Vec<[f64; 6]>>,
+    /// The force on each particle of the frame (empty: not kept).
+    pub forces: Arc<Vec<[f64; 3]>>,
     /// How the run ended, and whether it failed.
     pub ended: Option<(String, bool)>,
     /// The last [`LOG_KEPT`] answers and notes, and how many there were.
@@ -130,7 +132,11 @@ impl Session {
     }
 
     fn publish_frame(&self, step: u64, time: f64, shown: Shown) {
-        let Shown { frame, walls } = shown;
+        let Shown {
+            frame,
+            forces,
+            walls,
+        } = shown;
         let (lo, hi) = crate::outline::extent(&frame, &walls);
         let walls = crate::outline::outlines(&walls, lo, hi);
         let mut species: Vec<String> = frame.species.clone();
@@ -142,6 +148,7 @@ impl Session {
             s.serial += 1;
             s.frame = Some(Arc::new(frame));
             s.walls = Arc::new(walls);
+            s.forces = Arc::new(forces);
             if *s.species != species {
                 s.species = Arc::new(species);
             }
@@ -465,7 +472,13 @@ pub async fn client(mut socket: WebSocket, session: Arc<Session>) {
             "walls": *snap.walls,
             "quantities": mote_render::frame::quantities_of(frame),
             "color": color,
-            "particle": pick.and_then(|i| crate::particle_json(frame, i).ok()),
+            "particle": pick.and_then(|i| {
+                let mut p = crate::particle_json(frame, i).ok()?;
+                if let Some(f) = snap.forces.get(i) {
+                    p["force"] = serde_json::json!(f);
+                }
+                Some(p)
+            }),
         });
         if socket
             .send(Message::Text(head.to_string().into()))

@@ -216,6 +216,11 @@ impl Frbi {
         &self.interactions
     }
 
+    /// The wrenches of the last step (at its midpoint), one per body.
+    pub fn last_wrenches(&self) -> &[DE] {
+        &self.wrench
+    }
+
     /// The interactions, to change their settings between steps.
     pub fn interactions_mut(&mut self) -> &mut [Box<dyn BodyInteraction>] {
         &mut self.interactions

@@ -150,6 +150,22 @@ impl Propagator for RigidDynamics {
         Some(self.sphere_frame())
     }
 
+    /// The force on each sphere's body at the last step's midpoint (each
+    /// sphere of a body shows its body's).
+    fn forces(&self) -> Vec<[f64; 3]> {
+        let w = self.frbi.last_wrenches();
+        if w.len() != self.bodies.len() {
+            return Vec::new();
+        }
+        let mut world = super::interaction::WorldFrame::default();
+        world.update(&self.bodies);
+        world
+            .sphere_body
+            .iter()
+            .map(|&k| w[k as usize].v.to_array())
+            .collect()
+    }
+
     fn walls(&self) -> Vec<mote_run::WallGeometry> {
         let t = self.bodies.time;
         self.contacts
