@@ -182,8 +182,13 @@ pub fn encode_frame(f: &Frame, species: &[String], color: &str) -> Result<Vec<u8
             .chain(std::iter::repeat(0.0))
             .take(n)
             .collect()
-    } else {
+    } else if mote_render::frame::quantities_of(f).contains(&color) {
         mote_render::frame::quantity(f, color).map_err(|e| e.to_string())?
+    } else {
+        return Err(format!(
+            "cannot colour by '{color}': the frame has species, {}",
+            mote_render::frame::quantities_of(f).join(", ")
+        ));
     };
     let mut out = Vec::with_capacity(4 + 20 * n);
     out.extend((n as u32).to_le_bytes());
