@@ -143,6 +143,16 @@ pub fn run(global: &super::GlobalOpts, a: RenderArgs) -> anyhow::Result<ExitCode
         }
         vec![idx as usize]
     };
+    if let ColorBy::Quantity(q) = &color_by {
+        let has = mote_render::frame::quantities_of(&frames[chosen[0]]);
+        if !has.contains(&q.as_str()) {
+            bail!(
+                "--color-by {q}: {} has no column for it; it has species, {}",
+                a.traj.display(),
+                has.join(", ")
+            );
+        }
+    }
     let opts = RenderOptions {
         shadows: a.shadows,
         ao_samples: a.ao.unwrap_or(0),
