@@ -90,8 +90,11 @@ fn frames_become_coloured_scenes_with_a_colour_bar() {
     let f = frame();
     assert_eq!(quantity(&f, "speed").unwrap(), vec![5.0, 0.0, 1.0]);
     assert_eq!(quantity(&f, "vx").unwrap(), vec![3.0, 0.0, -1.0]);
-    let e = quantity(&f, "spin").unwrap_err().to_string();
-    assert!(e.contains("unknown quantity 'spin'"), "{e}");
+    let e = quantity(&f, "charge").unwrap_err().to_string();
+    assert!(e.contains("unknown quantity 'charge'"), "{e}");
+    // A known quantity the frame has no column for: NaN, and not listed.
+    assert!(quantity(&f, "spin").unwrap().iter().all(|w| w.is_nan()));
+    assert!(!mote_render::frame::quantities_of(&f).contains(&"spin"));
     let (scene, coloring) = scene_from_frame(
         &f,
         &ColorBy::Quantity("speed".into()),
