@@ -33,7 +33,7 @@ enum Command {
     Render(cmd::render::RenderArgs),
     /// Plot columns of an observables CSV (PNG or SVG).
     Plot(cmd::plot::PlotArgs),
-    /// Show a trajectory on a local web page (WebGL2; 127.0.0.1 unless --bind).
+    /// Show a trajectory, or run a scene live, on a local web page (WebGL2; 127.0.0.1 unless --bind).
     View(cmd::view::ViewArgs),
     /// Random close packings by growing spheres (Lubachevsky–Stillinger); `mote pack analyse FILE` analyses one.
     ///

@@ -149,7 +149,7 @@ pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> 
             label: file_name(&a.input),
             message,
         });
-        (app, "could not be read (the page says why)".into(), None)
+        (app, "cannot be shown (the page says why)".into(), None)
     });
     let addr = listener.local_addr()?;
     let host = if addr.ip().is_unspecified() {
