@@ -1,5 +1,6 @@
-// mote view: instanced sphere impostors in plain WebGL2.
-// Each particle is one quad facing the camera; the fragment shader cuts the
+// mote view: sphere impostors in plain WebGL2.
+// Each particle is one quad facing the camera (or, while the camera moves
+// in a large scene, one point); the fragment shader cuts the
 // disc, shades it as a sphere and writes the sphere's depth, so that
 // intersecting spheres (clumps) look right. window.moteScene holds what the
 // page shows, for tests and the console. A trajectory file comes frame by
@@ -66,7 +67,7 @@ out vec3 centre;
 out float radius;
 const vec2 C[4] = vec2[4](vec2(-1, -1), vec2(1, -1), vec2(-1, 1), vec2(1, 1));
 ${COLORS}void main() {
-  corner = C[gl_VertexID];
+  corner = C[gl_VertexID & 3];  // vertex 4i + c is corner c of sphere i
   radius = sphere.w;
   vec4 c = view * vec4(sphere.xyz, 1.0);
   centre = c.xyz;
@@ -184,8 +185,8 @@ function eye() {
           c.target[2] + c.distance * Math.cos(c.phi)];
 }
 
-let wallVao, wallBuf, wallCount = 0;
-let spheres, points, pointVao, lines, sphereVao, lineVao, sphereBuf, valueBuf, lineBuf, boxCount = 0;
+let wallVao, wallBuf, wallCount = 0, quadVao, quadBuf, indexBuf;
+let spheres, points, pointVao, lines, lineVao, sphereBuf, valueBuf, lineBuf, boxCount = 0;
 
 // The box's twelve edges, if the frame has a cell.
 function setBox(cell, o) {
@@ -207,19 +208,21 @@ function setup() {
   spheres = program(SPHERE_VS, SPHERE_FS);
   lines = program(LINE_VS, LINE_FS);
   points = program(POINT_VS, POINT_FS);
-  sphereVao = gl.createVertexArray();
-  gl.bindVertexArray(sphereVao);
-  sphereBuf = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
+  // The quads: four vertices per sphere, each with the sphere and its
+  // value (not instanced: SwiftShader draws instances 4.7 times slower).
+  quadVao = gl.createVertexArray();
+  gl.bindVertexArray(quadVao);
+  quadBuf = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, quadBuf);
   gl.enableVertexAttribArray(0);
-  gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 0, 0);
-  gl.vertexAttribDivisor(0, 1);
-  valueBuf = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
+  gl.vertexAttribPointer(0, 4, gl.FLOAT, false, 20, 0);
   gl.enableVertexAttribArray(1);
-  gl.vertexAttribPointer(1, 1, gl.FLOAT, false, 0, 0);
-  gl.vertexAttribDivisor(1, 1);
-  // The same buffers, one vertex per sphere.
+  gl.vertexAttribPointer(1, 1, gl.FLOAT, false, 20, 16);
+  indexBuf = gl.createBuffer();
+  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indexBuf);
+  sphereBuf = gl.createBuffer();
+  valueBuf = gl.createBuffer();
+  // The spheres and values as they come, one vertex per sphere.
   pointVao = gl.createVertexArray();
   gl.bindVertexArray(pointVao);
   gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
@@ -300,8 +303,8 @@ function draw(moving) {
     gl.bindVertexArray(pointVao);
     gl.drawArrays(gl.POINTS, 0, scene.n);
   } else {
-    gl.bindVertexArray(sphereVao);
-    gl.drawArraysInstanced(gl.TRIANGLE_STRIP, 0, 4, scene.n);
+    gl.bindVertexArray(quadVao);
+    gl.drawElements(gl.TRIANGLES, 6 * scene.n, gl.UNSIGNED_INT, 0);
   }
   if (boxCount || wallCount) {
     gl.useProgram(lines);
@@ -373,12 +376,34 @@ async function fetchFrame(k) {
 }
 
 // Hands a decoded frame to the GPU and sets the colour range.
+// The quads' vertices (the sphere and its value, four times) and the two
+// triangles of each.
+function expand(data) {
+  const n = data.n, s = data.spheres, v = data.values;
+  const out = new Float32Array(20 * n), idx = new Uint32Array(6 * n);
+  for (let i = 0; i < n; i++) {
+    for (let c = 0; c < 4; c++) {
+      const o = 20 * i + 5 * c;
+      out[o] = s[4 * i]; out[o + 1] = s[4 * i + 1]; out[o + 2] = s[4 * i + 2]; out[o + 3] = s[4 * i + 3];
+      out[o + 4] = v[i];
+    }
+    idx.set([4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 2, 4 * i + 1, 4 * i + 3], 6 * i);
+  }
+  gl.bindVertexArray(quadVao);
+  gl.bindBuffer(gl.ARRAY_BUFFER, quadBuf);
+  gl.bufferData(gl.ARRAY_BUFFER, out, gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, indexBuf);
+  gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, idx, gl.DYNAMIC_DRAW);
+  gl.bindVertexArray(null);
+}
+
 function upload(data) {
   if (!camera.home) frameCamera(data);
   gl.bindBuffer(gl.ARRAY_BUFFER, sphereBuf);
   gl.bufferData(gl.ARRAY_BUFFER, data.spheres, gl.DYNAMIC_DRAW);
   gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
   gl.bufferData(gl.ARRAY_BUFFER, data.values, gl.DYNAMIC_DRAW);
+  expand(data);
   let lo = Infinity, hi = -Infinity;
   for (const v of data.values) { if (v < lo) lo = v; if (v > hi) hi = v; }
   scene.range = lo <= hi ? [lo, hi > lo ? hi : lo + 1] : [0, 1];

@@ -4,7 +4,7 @@
 //! [`mote_io::trajectory::read_frames`] reads) and answers four requests:
 //!
 //! - `GET /` and `GET /viewer.js`: the page, compiled into the binary
-//!   (plain WebGL2, no libraries: instanced sphere impostors need one
+//!   (plain WebGL2, no libraries: sphere impostors need one
 //!   shader pair and a few hundred lines, and nothing is fetched at run
 //!   time);
 //! - `GET /api/meta`: JSON with the file's name, the frame count, each
