@@ -85,6 +85,18 @@ impl Input {
             .unwrap_or_else(|| PathBuf::from("out").join(&self.name))
     }
 
+    /// The folder a run of this input writes to: `option`, else the
+    /// scene's `[output] dir` (every engine's scene names it there), else
+    /// `out/<name>` — known before the run starts (the live viewer follows
+    /// the run's table there).
+    pub fn run_dir(&self, option: Option<&PathBuf>) -> PathBuf {
+        let scene = (!self.plist)
+            .then(|| toml::from_str::<toml::Table>(&self.text).ok())
+            .flatten()
+            .and_then(|t| t.get("output")?.get("dir")?.as_str().map(str::to_string));
+        self.output_dir(option, scene.as_ref())
+    }
+
     /// The engine that runs this input.
     pub fn engine(&self) -> Engine {
         if self.plist {

@@ -231,18 +231,17 @@ function setup() {
   gl.bindBuffer(gl.ARRAY_BUFFER, valueBuf);
   gl.enableVertexAttribArray(1);
   gl.vertexAttribPointer(1, 1, gl.FLOAT, false, 0, 0);
-  wallVao = gl.createVertexArray();
-  gl.bindVertexArray(wallVao);
-  wallBuf = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, wallBuf);
-  gl.enableVertexAttribArray(0);
-  gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
-  lineVao = gl.createVertexArray();
-  gl.bindVertexArray(lineVao);
-  lineBuf = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, lineBuf);
-  gl.enableVertexAttribArray(0);
-  gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+  // Lines (box, walls): a buffer of x, y, z pairs each.
+  const lineArray = () => {
+    const vao = gl.createVertexArray(), buf = gl.createBuffer();
+    gl.bindVertexArray(vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, buf);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+    return [vao, buf];
+  };
+  [wallVao, wallBuf] = lineArray();
+  [lineVao, lineBuf] = lineArray();
   gl.bindVertexArray(null);
   gl.enable(gl.DEPTH_TEST);
   gl.clearColor(1, 1, 1, 1);

@@ -2,92 +2,53 @@
 //! scene's extent (a box around the particles and the cell), a cylinder as
 //! its two end circles and four lines along it that turn with it.
 
+use glam::DVec3;
 use mote_run::WallGeometry;
 
 type V = [f64; 3];
 
-fn sub(a: V, b: V) -> V {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: V, b: V) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V, b: V) -> V {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn axpy(a: f64, x: V, y: V) -> V {
-    [a * x[0] + y[0], a * x[1] + y[1], a * x[2] + y[2]]
-}
-fn unit(a: V) -> V {
-    let l = dot(a, a).sqrt();
-    if l > 0.0 {
-        a.map(|x| x / l)
-    } else {
-        [1.0, 0.0, 0.0]
-    }
-}
-
 /// Two unit vectors u, v with (u, v, n) right-handed and orthonormal.
-fn basis(n: V) -> (V, V) {
-    let helper = if n[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let u = unit(cross(helper, n));
-    (u, cross(n, u))
+fn basis(n: DVec3) -> (DVec3, DVec3) {
+    let helper = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let u = helper.cross(n).normalize();
+    (u, n.cross(u))
 }
 
-fn corners(lo: V, hi: V) -> [V; 8] {
-    let mut c = [[0.0; 3]; 8];
-    for (k, p) in c.iter_mut().enumerate() {
-        for a in 0..3 {
-            p[a] = if k >> a & 1 == 1 { hi[a] } else { lo[a] };
-        }
-    }
-    c
+fn corners(lo: DVec3, hi: DVec3) -> [DVec3; 8] {
+    std::array::from_fn(|k| {
+        DVec3::select(glam::BVec3::new(k & 1 == 1, k & 2 == 2, k & 4 == 4), hi, lo)
+    })
 }
 
 /// The box around the particles (each grown by its radius), the cell and
 /// the walls' reference points (a plane's point; a cylinder's point grown
 /// by its radius), cut by the planes across an axis.
 pub fn extent(frame: &mote_io::xyz::Frame, walls: &[WallGeometry]) -> (V, V) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
+    let mut lo = DVec3::INFINITY;
+    let mut hi = DVec3::NEG_INFINITY;
+    let mut take = |p: DVec3, r: f64| {
+        lo = lo.min(p - r);
+        hi = hi.max(p + r);
+    };
     for w in walls {
-        let (p, r) = match *w {
-            WallGeometry::Plane { point, .. } => (point, 0.0),
-            WallGeometry::Cylinder { point, radius, .. } => (point, radius),
-        };
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a] - r);
-            hi[a] = hi[a].max(p[a] + r);
+        match *w {
+            WallGeometry::Plane { point, .. } => take(point.into(), 0.0),
+            WallGeometry::Cylinder { point, radius, .. } => take(point.into(), radius),
         }
     }
     for (i, p) in frame.positions.iter().enumerate() {
-        let r = frame.radii.get(i).copied().unwrap_or(0.0);
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a] - r);
-            hi[a] = hi[a].max(p[a] + r);
+        take((*p).into(), frame.radii.get(i).copied().unwrap_or(0.0));
+    }
+    let c = frame.cell.map(DVec3::from);
+    if c[0].x * c[1].y * c[2].z != 0.0 {
+        for k in corners(DVec3::ZERO, DVec3::ONE) {
+            take(
+                DVec3::from(frame.origin) + k.x * c[0] + k.y * c[1] + k.z * c[2],
+                0.0,
+            );
         }
     }
-    let c = frame.cell;
-    if c[0][0] * c[1][1] * c[2][2] != 0.0 {
-        for k in corners([0.0; 3], [1.0; 3]) {
-            let p: V = std::array::from_fn(|a| {
-                frame.origin[a] + k[0] * c[0][a] + k[1] * c[1][a] + k[2] * c[2][a]
-            });
-            for a in 0..3 {
-                lo[a] = lo[a].min(p[a]);
-                hi[a] = hi[a].max(p[a]);
-            }
-        }
-    }
-    if lo[0] > hi[0] || lo[0].is_nan() {
+    if lo.x > hi.x || lo.x.is_nan() {
         return ([0.0; 3], [1.0; 3]);
     }
     // A plane across an axis bounds the scene on its side: the extent ends
@@ -95,7 +56,7 @@ pub fn extent(frame: &mote_io::xyz::Frame, walls: &[WallGeometry]) -> (V, V) {
     // whatever margin the cell has).
     for w in walls {
         if let WallGeometry::Plane { point, normal } = *w {
-            let n = unit(normal);
+            let n = DVec3::from(normal).normalize();
             for a in 0..3 {
                 if n[a] > 1.0 - 1e-12 {
                     lo[a] = point[a];
@@ -105,45 +66,44 @@ pub fn extent(frame: &mote_io::xyz::Frame, walls: &[WallGeometry]) -> (V, V) {
             }
         }
     }
-    (lo, hi)
+    (lo.to_array(), hi.to_array())
 }
 
 /// Segments (x0, y0, z0, x1, y1, z1) drawing `walls` within [lo, hi].
 pub fn outlines(walls: &[WallGeometry], lo: V, hi: V) -> Vec<[f64; 6]> {
+    let (lo, hi) = (DVec3::from(lo), DVec3::from(hi));
+    let segment = |a: DVec3, b: DVec3| [a.x, a.y, a.z, b.x, b.y, b.z];
     let mut out = Vec::new();
     let box_corners = corners(lo, hi);
-    let size = dot(sub(hi, lo), sub(hi, lo)).sqrt().max(f64::MIN_POSITIVE);
+    let size = (hi - lo).length().max(f64::MIN_POSITIVE);
     for w in walls {
         match *w {
             WallGeometry::Plane { point, normal } => {
-                let n = unit(normal);
+                let (point, n) = (DVec3::from(point), DVec3::from(normal).normalize());
                 // Where the box's twelve edges cross the plane.
-                let mut hits: Vec<V> = Vec::new();
-                for (i, a) in box_corners.iter().enumerate() {
+                let tol = 1e-12 * size;
+                let mut hits: Vec<DVec3> = Vec::new();
+                for (i, &a) in box_corners.iter().enumerate() {
                     for bit in 0..3 {
                         if i >> bit & 1 == 1 {
                             continue;
                         }
                         let b = box_corners[i | 1 << bit];
-                        let (da, db) = (dot(sub(*a, point), n), dot(sub(b, point), n));
-                        let tol = 1e-12 * size;
+                        let (da, db) = ((a - point).dot(n), (b - point).dot(n));
                         if da.abs() <= tol {
-                            hits.push(*a);
+                            hits.push(a);
                         }
                         if db.abs() <= tol {
                             hits.push(b);
                         }
                         if (da < -tol && db > tol) || (da > tol && db < -tol) {
-                            hits.push(axpy(da / (da - db), sub(b, *a), *a));
+                            hits.push(a + (b - a) * (da / (da - db)));
                         }
                     }
                 }
-                let mut unique: Vec<V> = Vec::new();
+                let mut unique: Vec<DVec3> = Vec::new();
                 for h in hits {
-                    if unique
-                        .iter()
-                        .all(|u| dot(sub(*u, h), sub(*u, h)).sqrt() > 1e-9 * size)
-                    {
+                    if unique.iter().all(|u| u.distance(h) > 1e-9 * size) {
                         unique.push(h);
                     }
                 }
@@ -151,17 +111,12 @@ pub fn outlines(walls: &[WallGeometry], lo: V, hi: V) -> Vec<[f64; 6]> {
                     continue;
                 }
                 // Round the polygon in order of angle about its centre.
-                let centre = unique
-                    .iter()
-                    .fold([0.0; 3], |c, p| axpy(1.0 / unique.len() as f64, *p, c));
+                let centre = unique.iter().sum::<DVec3>() / unique.len() as f64;
                 let (u, v) = basis(n);
-                unique.sort_by(|p, q| {
-                    let angle = |x: &V| dot(sub(*x, centre), v).atan2(dot(sub(*x, centre), u));
-                    angle(p).total_cmp(&angle(q))
-                });
+                let angle = |x: &DVec3| (*x - centre).dot(v).atan2((*x - centre).dot(u));
+                unique.sort_by(|p, q| angle(p).total_cmp(&angle(q)));
                 for k in 0..unique.len() {
-                    let (a, b) = (unique[k], unique[(k + 1) % unique.len()]);
-                    out.push([a[0], a[1], a[2], b[0], b[1], b[2]]);
+                    out.push(segment(unique[k], unique[(k + 1) % unique.len()]));
                 }
             }
             WallGeometry::Cylinder {
@@ -170,33 +125,26 @@ pub fn outlines(walls: &[WallGeometry], lo: V, hi: V) -> Vec<[f64; 6]> {
                 radius,
                 angle,
             } => {
-                let n = unit(axis);
+                let (point, n) = (DVec3::from(point), DVec3::from(axis).normalize());
                 let (u, v) = basis(n);
-                let along: Vec<f64> = box_corners.iter().map(|c| dot(sub(*c, point), n)).collect();
-                let (s0, s1) = along
+                let (s0, s1) = box_corners
                     .iter()
+                    .map(|c| (*c - point).dot(n))
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
-                        (a.min(*s), b.max(*s))
+                        (a.min(s), b.max(s))
                     });
-                let at = |s: f64, phi: f64| {
-                    let radial = axpy(phi.sin(), v, u.map(|x| x * phi.cos()));
-                    axpy(radius, radial, axpy(s, n, point))
-                };
+                let at =
+                    |s: f64, phi: f64| point + s * n + radius * (phi.cos() * u + phi.sin() * v);
                 let steps = 48;
+                let turn = |k: usize| std::f64::consts::TAU * k as f64 / steps as f64;
                 for s in [s0, s1] {
                     for k in 0..steps {
-                        let (p0, p1) = (
-                            2.0 * std::f64::consts::PI * k as f64 / steps as f64,
-                            2.0 * std::f64::consts::PI * (k + 1) as f64 / steps as f64,
-                        );
-                        let (a, b) = (at(s, p0), at(s, p1));
-                        out.push([a[0], a[1], a[2], b[0], b[1], b[2]]);
+                        out.push(segment(at(s, turn(k)), at(s, turn(k + 1))));
                     }
                 }
                 for k in 0..4 {
                     let phi = angle + std::f64::consts::FRAC_PI_2 * k as f64;
-                    let (a, b) = (at(s0, phi), at(s1, phi));
-                    out.push([a[0], a[1], a[2], b[0], b[1], b[2]]);
+                    out.push(segment(at(s0, phi), at(s1, phi)));
                 }
             }
         }
@@ -219,13 +167,7 @@ mod tests {
         assert_eq!(lines.len(), 4);
         let length: f64 = lines
             .iter()
-            .map(|l| {
-                dot(
-                    sub([l[3], l[4], l[5]], [l[0], l[1], l[2]]),
-                    sub([l[3], l[4], l[5]], [l[0], l[1], l[2]]),
-                )
-                .sqrt()
-            })
+            .map(|l| DVec3::new(l[0], l[1], l[2]).distance(DVec3::new(l[3], l[4], l[5])))
             .sum();
         assert!((length - 4.0).abs() < 1e-12);
         assert!(lines.iter().all(|l| l[2] == 0.5 && l[5] == 0.5));

@@ -17,8 +17,10 @@ pub struct Table {
 }
 
 impl Table {
-    /// Parses whole lines (a trailing partial line is the caller's to keep).
-    fn take_lines(&mut self, text: &str) {
+    /// Parses whole lines (a trailing partial line is the caller's to keep);
+    /// the first line that is not a comment names the columns unless
+    /// `header_seen`.
+    fn take_lines(&mut self, text: &str, mut header_seen: bool) {
         for line in text.lines() {
             let line = line.trim();
             if line.is_empty() {
@@ -29,8 +31,9 @@ impl Table {
                 if comment.starts_with("event:") {
                     self.events.push(comment.to_string());
                 }
-            } else if self.columns.is_empty() {
+            } else if !header_seen {
                 self.columns = line.split(',').map(|c| c.trim().to_string()).collect();
+                header_seen = true;
             } else {
                 self.rows.push(
                     line.split(',')
@@ -44,7 +47,7 @@ impl Table {
     /// Reads a whole table.
     pub fn read(path: &Path) -> std::io::Result<Table> {
         let mut t = Table::default();
-        t.take_lines(&std::fs::read_to_string(path)?);
+        t.take_lines(&std::fs::read_to_string(path)?, false);
         Ok(t)
     }
 }
@@ -92,17 +95,8 @@ impl Follow {
         let whole = self.partial.rfind('\n').map(|k| k + 1).unwrap_or(0);
         let text: String = self.partial.drain(..whole).collect();
         let mut t = Table::default();
-        if self.columns_sent {
-            // Rows only: a placeholder name stops the first row being taken
-            // for the header.
-            t.columns = vec![String::new()];
-        }
-        t.take_lines(&text);
-        if self.columns_sent {
-            t.columns.clear();
-        } else if !t.columns.is_empty() {
-            self.columns_sent = true;
-        }
+        t.take_lines(&text, self.columns_sent);
+        self.columns_sent |= !t.columns.is_empty();
         (!t.rows.is_empty() || !t.events.is_empty() || !t.columns.is_empty()).then_some(t)
     }
 }

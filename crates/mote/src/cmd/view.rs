@@ -97,11 +97,7 @@ fn live_app(
             a.input
         ));
     }
-    let scene_dir = (!input.plist)
-        .then(|| toml::from_str::<toml::Table>(&input.text).ok())
-        .flatten()
-        .and_then(|t| t.get("output")?.get("dir")?.as_str().map(str::to_string));
-    let dir = input.output_dir(a.output.as_ref(), scene_dir.as_ref());
+    let dir = input.run_dir(a.output.as_ref());
     let session = Session::new(input.label.clone(), dir.clone(), a.paused);
     let options = RunOptions {
         input: Some(a.input.clone()),
