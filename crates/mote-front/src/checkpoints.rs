@@ -103,7 +103,11 @@ pub(crate) fn restore(
         dt: get("dt").map(|v| unhex(&v)).transpose()?,
         system: get("system").filter(|_| plist),
         solver: get("solver"),
-        output: get("output").map(PathBuf::from),
+        // Where the run goes on (`lock::resume_folder`), else where it was.
+        output: given
+            .output
+            .clone()
+            .or_else(|| get("output").map(PathBuf::from)),
         picture: given.picture.clone(),
         trajectory_format: get("trajectory-format"),
         seed: Some(cp.seed),

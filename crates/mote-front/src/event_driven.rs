@@ -46,7 +46,10 @@ pub(crate) fn resume(
     let options = RunOptions {
         resume: given.resume.clone(),
         checkpoint_every: get("checkpoint-every").and_then(|v| v.parse().ok()),
-        output: get("output").map(PathBuf::from),
+        output: given
+            .output
+            .clone()
+            .or_else(|| get("output").map(PathBuf::from)),
         picture: given.picture.clone(),
         trajectory_format: get("trajectory-format"),
         seed: Some(cp.seed),
@@ -117,8 +120,12 @@ fn run_events(
         scene.histogram = None;
     }
     let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
-    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
-    let _lock = crate::lock::FolderLock::take(&dir)?;
+    let folder = crate::lock::RunFolder::claim(
+        &dir,
+        &input.label,
+        &input.text,
+        resumed.zip(options.resume.as_deref()),
+    )?;
     let scene_dir = input.folder();
     let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
     monitor.start(&format!(
@@ -157,7 +164,10 @@ fn run_events(
                         .and_then(|t| std::path::Path::new(t).extension())
                         .map_or("xyz".into(), |e| e.to_string_lossy().into_owned()),
                 ),
-            ],
+            ]
+            .into_iter()
+            .chain(folder.checkpoint_options())
+            .collect(),
             input_label: input.label.clone(),
             input_text: input.text.clone(),
             ..Checkpoint::default()

@@ -19,7 +19,7 @@ pub mod packing;
 mod particles;
 mod rigid;
 pub mod seed;
-mod terminal;
+pub mod terminal;
 
 use std::path::PathBuf;
 
@@ -130,6 +130,8 @@ pub trait Monitor {
     /// `done` of `total` units (steps, or thousandths of the simulated
     /// time), with a short note such as the current time.
     fn progress(&mut self, done: u64, total: u64, note: &str);
+    /// A line to show before the run opens (where a resumed run goes on).
+    fn note(&mut self, _line: &str) {}
     /// The run has ended (successfully or not).
     fn finish(&mut self) {}
 }
@@ -171,6 +173,19 @@ pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, F
     if let Some(path) = &options.resume {
         // Checkpoints name their engine (point particles' older ones do not).
         let cp = mote_io::checkpoint::read(path)?;
+        let mut options = options.clone();
+        if cp.option("engine") != Some("packing") {
+            let (dir, elsewhere) = lock::resume_folder(&cp, path);
+            if elsewhere {
+                monitor.note(&format!(
+                    "{}: continuing the run in its folder {}",
+                    path.display(),
+                    dir.display()
+                ));
+            }
+            options.output = Some(dir);
+        }
+        let options = &options;
         let result = match cp.option("engine") {
             Some("rigid") => rigid::resume(&cp, options, monitor),
             Some("event-driven") => event_driven::resume(&cp, options, monitor),

@@ -4,7 +4,6 @@
 use std::path::Path;
 
 use mote_io::checkpoint::{self, Checkpoint};
-use mote_io::IoError;
 use mote_md::output::{ObservablesCsv, Trajectory};
 use mote_md::scene::{PlistSystem, Scene};
 use mote_md::{MdError, RunLength, RunReport, Simulation};
@@ -125,8 +124,12 @@ pub(crate) fn run(
     };
 
     let dir = input.output_dir(args.output.as_ref(), scene.output.dir.as_ref());
-    std::fs::create_dir_all(&dir).map_err(|e| IoError::os(&dir, e))?;
-    let _lock = crate::lock::FolderLock::take(&dir)?;
+    let folder = crate::lock::RunFolder::claim(
+        &dir,
+        &input.label,
+        &input.text,
+        resumed.as_ref().zip(options.resume.as_deref()),
+    )?;
     let total_steps = length.steps_from(built.simulation.system.time, built.simulation.dt);
     let append = resumed.is_some();
     if let Some(cp) = &resumed {
@@ -198,6 +201,7 @@ pub(crate) fn run(
                 .to_string(),
             ),
         ];
+        options.extend(folder.checkpoint_options());
         if let Some(s) = &args.solver {
             options.push(("solver".to_string(), s.clone()));
         }

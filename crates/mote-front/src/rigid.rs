@@ -50,8 +50,12 @@ fn run_with(
         .clone()
         .or_else(|| scene.output.dir.as_ref().map(std::path::PathBuf::from))
         .unwrap_or_else(|| std::path::Path::new("out").join(&input.name));
-    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
-    let _lock = crate::lock::FolderLock::take(&dir)?;
+    let folder = crate::lock::RunFolder::claim(
+        &dir,
+        &input.label,
+        &input.text,
+        resumed.zip(options.resume.as_deref()),
+    )?;
     let provenance = crate::provenance(&input.label, seed);
     let format = options.trajectory_format(
         scene
@@ -71,7 +75,10 @@ fn run_with(
                 ("checkpoint-every".into(), every.to_string()),
                 ("output".into(), dir.display().to_string()),
                 ("trajectory-format".into(), format.extension().to_string()),
-            ],
+            ]
+            .into_iter()
+            .chain(folder.checkpoint_options())
+            .collect(),
             input_label: input.label.clone(),
             input_text: input.text.clone(),
             ..Checkpoint::default()

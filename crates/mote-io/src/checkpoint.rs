@@ -225,7 +225,8 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
                 let [index, count, nlines] = w[..] else {
                     return Err(err(k, "carried needs: index count lines").into());
                 };
-                let mut values = Vec::with_capacity(count);
+                // Eight values a line: the lines there bound what is reserved.
+                let mut values = Vec::with_capacity(count.min(nlines.saturating_mul(8)));
                 for ln in k + 1..=k + nlines {
                     let line = lines
                         .get(ln)

@@ -152,6 +152,8 @@ pub fn parse_as(
     let mut general_given = 0;
     let lines = text.lines().enumerate().skip(1); // the first line is a title
     let mut ids = HashMap::new();
+    // `N atom types` of the header: types outside 1..=N are refused.
+    let mut declared_types: Option<u64> = None;
     for (k, raw) in lines {
         let line_no = k + 1;
         let line = raw.split('#').next().unwrap_or("").trim();
@@ -159,9 +161,13 @@ pub fn parse_as(
             continue;
         }
         let words: Vec<&str> = line.split_whitespace().collect();
+        // nan and inf parse as f64 but are no atom's or box's value.
         let num = |w: &str| -> Result<f64, ParseError> {
-            w.parse::<f64>()
-                .map_err(|_| err(line_no, format!("'{w}' is not a number")))
+            match w.parse::<f64>() {
+                Ok(x) if x.is_finite() => Ok(x),
+                Ok(_) => Err(err(line_no, format!("'{w}': must be a finite number"))),
+                Err(_) => Err(err(line_no, format!("'{w}' is not a number"))),
+            }
         };
         // Section headers stand alone on their line (type labels, which
         // may start rows of Masses, are not among them).
@@ -194,6 +200,12 @@ pub fn parse_as(
                         .map_err(|_| err(line_no, format!("'{n}' is not an atom count")))?,
                 )
             }
+            ("", [n, "atom", "types"]) => {
+                declared_types =
+                    Some(n.parse().map_err(|_| {
+                        err(line_no, format!("'{n}' is not a number of atom types"))
+                    })?)
+            }
             ("", [lo, hi, axis_lo, _]) if axis_lo.ends_with("lo") => {
                 let k = match *axis_lo {
                     "xlo" => 0,
@@ -203,6 +215,12 @@ pub fn parse_as(
                 };
                 data.lo[k] = num(lo)?;
                 data.hi[k] = num(hi)?;
+                if data.lo[k] > data.hi[k] {
+                    return Err(err(
+                        line_no,
+                        format!("{axis_lo} {lo} > its hi {hi}: lo must not exceed hi"),
+                    ));
+                }
                 data.bounded[k] = true;
             }
             ("", [a, b, c, "xy", "xz", "yz"]) => {
@@ -303,7 +321,17 @@ pub fn parse_as(
                     }
                     _ => 1,
                 };
-                atom.kind = whole(w[kind_at], "an atom type")? as u32;
+                let kind = whole(w[kind_at], "an atom type")?;
+                if let Some(n) = declared_types {
+                    if kind == 0 || kind > n {
+                        return Err(err(
+                            line_no,
+                            format!("atom type {kind}: the header declares types 1 to {n}"),
+                        ));
+                    }
+                }
+                atom.kind = u32::try_from(kind)
+                    .map_err(|_| err(line_no, format!("atom type {kind} is too large")))?;
                 match style {
                     AtomStyle::Atomic => atom.position = xyz(2)?,
                     AtomStyle::Charge => {

@@ -352,6 +352,15 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
         let n: usize = v
             .parse()
             .map_err(|_| err(at, format!("'{v}' is not a number of atoms")))?;
+        // Each atom is a line of its own: a count the rest of the file
+        // cannot hold is refused before anything is reserved for it.
+        let left = lines.len() - k;
+        if n > left {
+            return Err(err(
+                at,
+                format!("{n} atoms announced, but the file has only {left} lines left"),
+            ));
+        }
         let (at, l) = next(&mut k, "ITEM: BOX BOUNDS")?;
         let Some(rest) = l.strip_prefix("ITEM: BOX BOUNDS") else {
             return Err(err(
@@ -372,17 +381,15 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
                 let (at, l) = next(&mut k, "a cell vector and origin component")?;
                 let v: Result<Vec<f64>, _> = l.split_whitespace().map(str::parse).collect();
                 match v {
-                    Ok(v) if v.len() == 4 => {
+                    Ok(v) if v.len() == 4 && v.iter().all(|x| x.is_finite()) => {
                         cell[d] = [v[0], v[1], v[2]];
                         origin[d] = v[3];
                     }
-                    _ => {
-                        return Err(err(
-                            at,
-                            "expected four numbers: a cell vector and a component of the origin"
-                                .into(),
-                        ))
-                    }
+                    _ => return Err(err(
+                        at,
+                        "expected four finite numbers: a cell vector and a component of the origin"
+                            .into(),
+                    )),
                 }
             }
             let frame = atoms(&mut k, &next, &err, n, cell, origin, pbc, time, timestep)?;
@@ -408,6 +415,15 @@ pub fn parse(text: &str, name: &str) -> Result<Vec<DumpFrame>, ParseError> {
                         "expected {want} numbers (lo hi{})",
                         if triclinic { " tilt" } else { "" }
                     ),
+                ));
+            }
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(err(at, "box bounds must be finite numbers".into()));
+            }
+            if v[0] > v[1] {
+                return Err(err(
+                    at,
+                    format!("box bounds {} > {}: lo must not exceed hi", v[0], v[1]),
                 ));
             }
             row[..want].copy_from_slice(&v);
@@ -480,7 +496,7 @@ fn atoms<'a>(
     let (id_col, type_col) = (col("id"), col("type"));
     let (radius_col, diameter_col, mass_col, mol_col) =
         (col("radius"), col("diameter"), col("mass"), col("mol"));
-    let mut rows: Vec<(u64, usize)> = Vec::with_capacity(n);
+    let mut rows: Vec<(u64, usize, usize)> = Vec::with_capacity(n);
     let mut frame = Frame {
         time: time.unwrap_or(timestep as f64),
         cell,
@@ -501,9 +517,14 @@ fn atoms<'a>(
                 ),
             ));
         }
-        let num = |c: usize| {
-            f[c].parse::<f64>()
-                .map_err(|_| err(at, format!("'{}' is not a number", f[c])))
+        // nan and inf parse as f64 but are no atom's value.
+        let num = |c: usize| match f[c].parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            Ok(_) => Err(err(
+                at,
+                format!("{} = {}: must be a finite number", cols[c], f[c]),
+            )),
+            Err(_) => Err(err(at, format!("'{}' is not a number", f[c]))),
         };
         let vec3 = |c: [usize; 3]| -> Result<[f64; 3], ParseError> {
             Ok([num(c[0])?, num(c[1])?, num(c[2])?])
@@ -527,13 +548,21 @@ fn atoms<'a>(
         frame
             .species
             .push(type_col.map_or_else(|| "1".to_string(), |c| f[c].to_string()));
-        frame.radii.push(match (radius_col, diameter_col) {
+        let radius = match (radius_col, diameter_col) {
             (Some(c), _) => num(c)?,
             (None, Some(c)) => 0.5 * num(c)?,
             (None, None) => 0.0,
-        });
+        };
+        if radius < 0.0 {
+            return Err(err(at, format!("radius {radius}: must not be negative")));
+        }
+        frame.radii.push(radius);
         if let Some(c) = mass_col {
-            frame.masses.push(num(c)?);
+            let m = num(c)?;
+            if m <= 0.0 {
+                return Err(err(at, format!("mass {m}: must be positive")));
+            }
+            frame.masses.push(m);
         }
         if let Some(c) = omega {
             frame.angular_velocities.push(vec3(c)?);
@@ -554,10 +583,16 @@ fn atoms<'a>(
             Some(c) => whole(c, "an atom id")?,
             None => j as u64 + 1,
         };
-        rows.push((id, j));
+        rows.push((id, j, at));
     }
-    // Rows in id order.
-    rows.sort_by_key(|r| r.0);
+    // Rows in id order; an id given twice is refused at its second line.
+    rows.sort_by_key(|r| (r.0, r.2));
+    if let Some(w) = rows.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(err(
+            w[1].2,
+            format!("atom id {} again (first on line {})", w[1].0, w[0].2 + 1),
+        ));
+    }
     let order: Vec<usize> = rows.iter().map(|r| r.1).collect();
     fn permute<T: Clone>(v: &mut Vec<T>, order: &[usize]) {
         if v.len() == order.len() {
@@ -682,7 +717,10 @@ mod tests {
         assert_eq!(f.radii, [0.125]);
         let bad = text.replace("0 0 4 0.5", "0 0 4");
         let e = parse(&bad, "o.dump").unwrap_err().to_string();
-        assert!(e.starts_with("o.dump:8: expected four numbers"), "{e}");
+        assert!(
+            e.starts_with("o.dump:8: expected four finite numbers"),
+            "{e}"
+        );
     }
 
     /// Exact mode: a packing's positions and radii come back bit for bit

@@ -447,11 +447,11 @@ fn parse_frame(
             .split_whitespace()
             .filter_map(|s| s.parse().ok())
             .collect();
-        if v.len() != 9 {
+        if v.len() != 9 || v.iter().any(|x| !x.is_finite()) {
             return Err(ParseError::new(
                 name,
                 k + 2,
-                format!("Lattice=\"{l}\" needs nine numbers (three cell vectors)"),
+                format!("Lattice=\"{l}\" needs nine finite numbers (three cell vectors)"),
             ));
         }
         frame.cell = [[v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]];
@@ -487,6 +487,8 @@ fn parse_frame(
     }
     let width: usize = cols.iter().map(|c| c.count).sum();
     let mut momenta: Vec<[f64; 3]> = Vec::new();
+    // Ids seen in this frame, with their line: one given twice is refused.
+    let mut seen = std::collections::HashMap::new();
     for j in 0..n {
         let ln = k + 2 + j;
         let line = lines.get(ln).ok_or_else(|| {
@@ -512,9 +514,19 @@ fn parse_frame(
                 ),
             ));
         }
-        let num = |s: &str| {
-            s.parse::<f64>()
-                .map_err(|_| ParseError::new(name, ln + 1, format!("'{s}' is not a number")))
+        // nan and inf parse as f64 but are no particle's value.
+        let num = |s: &str| match s.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            Ok(_) => Err(ParseError::new(
+                name,
+                ln + 1,
+                format!("'{s}': must be a finite number"),
+            )),
+            Err(_) => Err(ParseError::new(
+                name,
+                ln + 1,
+                format!("'{s}' is not a number"),
+            )),
         };
         let int = |s: &str| {
             s.parse::<i64>()
@@ -543,13 +555,41 @@ fn parse_frame(
                 Role::Position => frame.positions.push(vec3(v)?),
                 Role::Velocity => frame.velocities.push(vec3(v)?),
                 Role::Momentum => momenta.push(vec3(v)?),
-                Role::Radius => frame.radii.push(num(v[0])?),
-                Role::Mass => frame.masses.push(num(v[0])?),
+                Role::Radius => {
+                    let r = num(v[0])?;
+                    if r < 0.0 {
+                        return Err(ParseError::new(
+                            name,
+                            ln + 1,
+                            format!("radius {r}: must not be negative"),
+                        ));
+                    }
+                    frame.radii.push(r);
+                }
+                Role::Mass => {
+                    let m = num(v[0])?;
+                    if m < 0.0 {
+                        return Err(ParseError::new(
+                            name,
+                            ln + 1,
+                            format!("mass {m}: must not be negative"),
+                        ));
+                    }
+                    frame.masses.push(m);
+                }
                 Role::Id => {
                     let id = int(v[0])?;
-                    frame.ids.push(u64::try_from(id).map_err(|_| {
+                    let id = u64::try_from(id).map_err(|_| {
                         ParseError::new(name, ln + 1, format!("id {id} is negative"))
-                    })?);
+                    })?;
+                    if let Some(first) = seen.insert(id, ln) {
+                        return Err(ParseError::new(
+                            name,
+                            ln + 1,
+                            format!("id {id} again (first on line {})", first + 1),
+                        ));
+                    }
+                    frame.ids.push(id);
                 }
                 Role::Omega => frame.angular_velocities.push(vec3(v)?),
                 Role::Dipole => frame.dipoles.push(vec3(v)?),

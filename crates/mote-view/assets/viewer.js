@@ -582,7 +582,11 @@ function liveStatus() {
 }
 function connectLive() {
   return new Promise((resolve) => {
-    const ws = new WebSocket(`ws://${location.host}/api/live`);
+    // The run's token came in the URL mote view printed; without it the
+    // server refuses the socket.
+    const token = params.get("token") || "";
+    if (!token) note("this live run needs its token: open the URL mote view printed (…/?token=…)");
+    const ws = new WebSocket(`ws://${location.host}/api/live?token=${encodeURIComponent(token)}`);
     ws.binaryType = "arraybuffer";
     live = ws;
     let head = null;

@@ -33,6 +33,7 @@ use axum::Router;
 use mote_io::xyz::Frame;
 use serde::Deserialize;
 
+pub mod doors;
 pub mod live;
 pub mod outline;
 pub mod table;
@@ -94,8 +95,18 @@ impl Trajectory {
     }
 
     /// Particle `i` through all frames, as the JSON of `/api/track/I`:
-    /// time, x, y, z and speed (NaN where a frame lacks it).
-    pub fn track(&self, i: usize) -> serde_json::Value {
+    /// time, x, y, z and speed (NaN where a frame lacks it); an error if
+    /// no frame has particle `i`.
+    pub fn track(&self, i: usize) -> Result<serde_json::Value, String> {
+        let most = self
+            .frames
+            .iter()
+            .map(|f| f.positions.len())
+            .max()
+            .unwrap_or(0);
+        if i >= most {
+            return Err(format!("no particle {i}: the largest frame has {most}"));
+        }
         let column = |a: usize| -> Vec<f64> {
             self.frames
                 .iter()
@@ -115,13 +126,13 @@ impl Trajectory {
         let json = |v: Vec<f64>| -> Vec<Option<f64>> {
             v.into_iter().map(|x| x.is_finite().then_some(x)).collect()
         };
-        serde_json::json!({
+        Ok(serde_json::json!({
             "time": self.frames.iter().map(|f| f.time).collect::<Vec<_>>(),
             "x": json(column(0)),
             "y": json(column(1)),
             "z": json(column(2)),
             "speed": json(speed),
-        })
+        }))
     }
 
     /// Frame `k` as the binary of `/api/frame/K`, coloured by `color`.
@@ -214,7 +225,7 @@ struct FrameQuery {
     color: Option<String>,
 }
 
-fn text(status: StatusCode, body: String) -> Response {
+pub(crate) fn text(status: StatusCode, body: String) -> Response {
     (
         status,
         [(header::CONTENT_TYPE, "text/plain; charset=utf-8")],
@@ -333,7 +344,10 @@ async fn track(State(app): State<Arc<App>>, Path(i): Path<String>) -> Response {
         return no_file();
     };
     match i.parse::<usize>() {
-        Ok(i) => axum::Json(t.track(i)).into_response(),
+        Ok(i) => match t.track(i) {
+            Ok(v) => axum::Json(v).into_response(),
+            Err(m) => text(StatusCode::NOT_FOUND, m),
+        },
         Err(_) => text(StatusCode::NOT_FOUND, format!("not a particle: {i}")),
     }
 }
@@ -349,10 +363,30 @@ async fn observables(State(app): State<Arc<App>>) -> Response {
     }
 }
 
-/// The live run's socket.
-async fn socket(State(app): State<Arc<App>>, ws: WebSocketUpgrade) -> Response {
+/// The live socket's query: the run's token.
+#[derive(Deserialize)]
+struct LiveQuery {
+    token: Option<String>,
+}
+
+/// The live run's socket; it needs the run's token.
+async fn socket(
+    State(app): State<Arc<App>>,
+    Query(q): Query<LiveQuery>,
+    ws: WebSocketUpgrade,
+) -> Response {
     match &*app {
         App::Live(session) => {
+            if !q
+                .token
+                .as_deref()
+                .is_some_and(|t| doors::token_matches(t, &session.token))
+            {
+                return text(
+                    StatusCode::FORBIDDEN,
+                    "this live run needs its token: open the URL mote view printed".into(),
+                );
+            }
             let session = Arc::clone(session);
             ws.on_upgrade(move |socket| live::client(socket, session))
         }
@@ -360,8 +394,8 @@ async fn socket(State(app): State<Arc<App>>, ws: WebSocketUpgrade) -> Response {
     }
 }
 
-/// The page's routes; anything else is 404.
-pub fn router(app: Arc<App>) -> Router {
+/// The page's routes behind the doors ([`doors`]); anything else is 404.
+pub fn router(app: Arc<App>, doors: doors::Doors) -> Router {
     Router::new()
         .route(
             "/",
@@ -387,6 +421,7 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/api/live", get(socket))
         .fallback(|| async { text(StatusCode::NOT_FOUND, "not found".into()) })
         .with_state(app)
+        .layer(axum::middleware::from_fn_with_state(doors, doors::guard))
 }
 
 /// A listener on `host` (an IP address) and `port` (0: any free one), and
@@ -410,8 +445,9 @@ pub async fn serve(
     app: Arc<App>,
     shutdown: impl std::future::Future<Output = ()> + Send + 'static,
 ) -> std::io::Result<()> {
+    let doors = doors::Doors::new(listener.local_addr()?);
     let listener = tokio::net::TcpListener::from_std(listener)?;
-    axum::serve(listener, router(app))
+    axum::serve(listener, router(app, doors))
         .with_graceful_shutdown(shutdown)
         .await
 }

@@ -56,6 +56,8 @@ pub struct Session {
     pub label: String,
     /// The run's output folder (its observables.csv is followed).
     pub dir: PathBuf,
+    /// What the page must show to open the socket (`doors::new_token`).
+    pub token: String,
     latest: watch::Sender<Snapshot>,
     wanted: AtomicBool,
     paused: AtomicBool,
@@ -70,6 +72,7 @@ impl Session {
         Arc::new(Session {
             label,
             dir,
+            token: crate::doors::new_token(),
             latest: watch::Sender::new(Snapshot::default()),
             wanted: AtomicBool::new(true),
             paused: AtomicBool::new(paused),

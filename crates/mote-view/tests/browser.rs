@@ -213,7 +213,10 @@ fn a_live_run_advances_and_takes_a_change_from_the_page() {
     let port = common::start_app(std::sync::Arc::new(mote_view::App::Live(session.clone())));
     let mut page = cdp::Browser::open(
         &browser,
-        &format!("http://127.0.0.1:{port}/?set=dt:0.000025&run=1&color=speed"),
+        &format!(
+            "http://127.0.0.1:{port}/?set=dt:0.000025&run=1&color=speed&token={}",
+            session.token
+        ),
     );
     let limit = std::time::Duration::from_secs(60);
     let state = page.state_when(limit, |s| {

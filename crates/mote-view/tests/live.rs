@@ -74,8 +74,13 @@ fn start(n: usize) -> (Arc<Session>, Arc<Mutex<Vec<Change>>>, u16) {
     (session, taken, port)
 }
 
-fn connect(port: u16) -> WebSocket<tungstenite::stream::MaybeTlsStream<TcpStream>> {
-    let (ws, _) = tungstenite::connect(format!("ws://127.0.0.1:{port}/api/live")).unwrap();
+/// The page's socket to the run, with the run's token.
+fn connect(
+    port: u16,
+    session: &Session,
+) -> WebSocket<tungstenite::stream::MaybeTlsStream<TcpStream>> {
+    let url = format!("ws://127.0.0.1:{port}/api/live?token={}", session.token);
+    let (ws, _) = tungstenite::connect(url).unwrap();
     ws
 }
 
@@ -105,7 +110,7 @@ fn send(ws: &mut WebSocket<tungstenite::stream::MaybeTlsStream<TcpStream>>, json
 #[test]
 fn frames_follow_the_page_and_changes_and_pause_reach_the_run() {
     let (session, taken, port) = start(10);
-    let mut ws = connect(port);
+    let mut ws = connect(port, &session);
     let (head, bytes) = next_frame(&mut ws);
     assert_eq!(head["count"], 10);
     assert_eq!(bytes, 4 + 20 * 10);
@@ -193,13 +198,13 @@ fn a_client_that_stops_reading_holds_memory_bounded() {
     let (session, _, port) = start(100_000);
     // Frames as fast as the page takes them, whatever they cost the run.
     session.set_frame_share(1.0);
-    let mut stuck = connect(port);
+    let mut stuck = connect(port, &session);
     // It asks for frames again and again but reads nothing.
     for _ in 0..200 {
         send(&mut stuck, r#"{"do":"ready"}"#);
     }
     // A page that reads a frame every 20 ms or so keeps frames coming.
-    let mut slow = connect(port);
+    let mut slow = connect(port, &session);
     let _ = next_frame(&mut slow);
     let before = resident();
     let t0 = Instant::now();
@@ -226,4 +231,45 @@ fn a_client_that_stops_reading_holds_memory_bounded() {
         grown / 1e6
     );
     drop(stuck);
+}
+
+/// The live socket's doors: without the run's token, with a wrong one, from
+/// another page's origin or to a foreign host name, the handshake is
+/// refused (403) and the run sees nothing; the page's own origin with the
+/// token gets frames.
+#[test]
+fn the_live_socket_needs_the_token_and_the_pages_own_origin() {
+    use tungstenite::client::IntoClientRequest;
+    let (session, _, port) = start(10);
+    let attempt = |path: String, extra: &[(&'static str, String)]| {
+        let mut request = format!("ws://127.0.0.1:{port}{path}")
+            .into_client_request()
+            .unwrap();
+        for (name, value) in extra {
+            request.headers_mut().insert(*name, value.parse().unwrap());
+        }
+        match tungstenite::connect(request) {
+            Ok(_) => 101,
+            Err(tungstenite::Error::Http(r)) => r.status().as_u16(),
+            Err(e) => panic!("{e}"),
+        }
+    };
+    let with = format!("/api/live?token={}", session.token);
+    let wrong = format!("/api/live?token={}", mote_view::doors::new_token());
+    assert_eq!(attempt("/api/live".into(), &[]), 403);
+    assert_eq!(attempt(wrong, &[]), 403);
+    assert_eq!(
+        attempt(with.clone(), &[("origin", "http://evil.example".into())]),
+        403
+    );
+    assert_eq!(
+        attempt(with.clone(), &[("host", format!("evil.example:{port}"))]),
+        403
+    );
+    assert_eq!(
+        attempt(with, &[("origin", format!("http://127.0.0.1:{port}"))]),
+        101
+    );
+    let mut ws = connect(port, &session);
+    assert_eq!(next_frame(&mut ws).0["count"], 10);
 }

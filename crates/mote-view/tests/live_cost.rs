@@ -28,7 +28,11 @@ fn run(watched: bool) -> (f64, u64) {
     let mut frames = 0;
     let mut ws = None;
     if watched {
-        let (mut w, _) = tungstenite::connect(format!("ws://127.0.0.1:{port}/api/live")).unwrap();
+        let (mut w, _) = tungstenite::connect(format!(
+            "ws://127.0.0.1:{port}/api/live?token={}",
+            session.token
+        ))
+        .unwrap();
         w.send(Message::Text(r#"{"do":"resume"}"#.into())).unwrap();
         ws = Some(w);
     }

@@ -31,10 +31,15 @@ fn start() -> u16 {
 /// A raw HTTP/1.1 GET (the path is sent as given, `..` included):
 /// status code and body.
 fn get(port: u16, path: &str) -> (u16, Vec<u8>) {
+    get_with(port, path, &format!("Host: localhost:{port}\r\n"))
+}
+
+/// A raw GET with the header lines `headers` (each ending in CRLF).
+fn get_with(port: u16, path: &str, headers: &str) -> (u16, Vec<u8>) {
     let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
     write!(
         s,
-        "GET {path} HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n"
+        "GET {path} HTTP/1.1\r\n{headers}Connection: close\r\n\r\n"
     )
     .unwrap();
     let mut raw = Vec::new();
@@ -135,4 +140,57 @@ fn no_request_reaches_a_file() {
             "{path}"
         );
     }
+}
+
+/// The doors: a `Host` that is not the server's own (DNS rebinding: a
+/// site's name pointed at 127.0.0.1) and a foreign `Origin` are refused
+/// before anything is answered; the server's own names are let in.
+#[test]
+fn foreign_hosts_and_origins_are_refused() {
+    let port = start();
+    for host in [
+        format!("Host: evil.example:{port}\r\n"),
+        format!("Host: 127.0.0.1.nip.io:{port}\r\n"),
+        format!("Host: 127.0.0.1:{}\r\n", port.wrapping_add(1)),
+        String::new(),
+    ] {
+        for path in ["/", "/api/meta", "/api/frame/0"] {
+            let (status, body) = get_with(port, path, &host);
+            assert_eq!(status, 403, "{host:?} {path}");
+            assert!(String::from_utf8_lossy(&body).contains("own address"));
+        }
+    }
+    for own in [
+        format!("Host: 127.0.0.1:{port}\r\n"),
+        format!("Host: localhost:{port}\r\n"),
+        format!("Host: [::1]:{port}\r\n"),
+        format!("Host: 127.0.0.1:{port}\r\nOrigin: http://localhost:{port}\r\n"),
+    ] {
+        assert_eq!(get_with(port, "/api/meta", &own).0, 200, "{own:?}");
+    }
+    for origin in [
+        "https://evil.example".to_string(),
+        "null".to_string(),
+        format!("http://evil.example:{port}"),
+    ] {
+        let headers = format!("Host: 127.0.0.1:{port}\r\nOrigin: {origin}\r\n");
+        assert_eq!(get_with(port, "/api/meta", &headers).0, 403, "{origin}");
+    }
+}
+
+/// Indices out of range are 404 with what there is, in every API path.
+#[test]
+fn out_of_range_indices_are_not_found() {
+    let port = start();
+    for path in [
+        "/api/track/2",
+        "/api/track/18446744073709551615",
+        "/api/particle/0/2",
+        "/api/particle/3/0",
+        "/api/frame/3",
+    ] {
+        let (status, body) = get(port, path);
+        assert_eq!(status, 404, "{path}: {}", String::from_utf8_lossy(&body));
+    }
+    assert_eq!(get(port, "/api/track/1").0, 200);
 }

@@ -4,6 +4,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+#[macro_use]
+mod out;
 mod cmd;
 
 /// mote — many-particle simulation toolkit.
@@ -92,7 +94,22 @@ fn end_quietly_on_closed_pipes() {
 
 fn main() -> ExitCode {
     end_quietly_on_closed_pipes();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help, version, or a usage error: clap's text, then its status
+        // (or 1 where the text could not be written).
+        Err(e) => {
+            let what = if e.use_stderr() {
+                "standard error"
+            } else {
+                "standard output"
+            };
+            if let Err(io) = e.print() {
+                mote_front::terminal::stream_failed(what, &io);
+            }
+            return ended(ExitCode::from(e.exit_code().clamp(0, 255) as u8));
+        }
+    };
     if matches!(
         cli.command,
         Command::Run(_) | Command::Edmd(_) | Command::Pack(_) | Command::View(_)
@@ -112,11 +129,24 @@ fn main() -> ExitCode {
         Command::View(args) => cmd::view::run(&global, args),
     };
     let result = pool.and_then(|pool| pool.install(command));
-    match result {
+    ended(match result {
         Ok(code) => code,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            tell!("error: {err:#}");
             ExitCode::FAILURE
         }
+    })
+}
+
+/// The exit status: `code`, or 1 with a one-line message (if stderr can
+/// still take it) where writing to stdout or stderr failed.
+fn ended(code: ExitCode) -> ExitCode {
+    match mote_front::terminal::stream_failure() {
+        Some(why) if code == ExitCode::SUCCESS => {
+            let line = format!("mote: {why}\n");
+            let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
+            ExitCode::FAILURE
+        }
+        _ => code,
     }
 }

@@ -727,3 +727,107 @@ fn killed_toning_nip_resumes_bit_for_bit() {
         );
     }
 }
+
+/// Runs own their folders: a checkpoint left in a folder by an older run is
+/// refused once a newer run has written there (nothing trimmed); a copy of a
+/// checkpoint resumes in its run's folder, saying where, and is refused once
+/// another run owns that folder (no two runs spliced into one table).
+#[test]
+fn a_checkpoint_resumes_only_into_its_own_runs_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| {
+        let o = mote(args, dir.path());
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let first = [
+        "--seed",
+        "1",
+        "run",
+        "example:sun-earth",
+        "--steps",
+        "200",
+        "--checkpoint-every",
+        "100",
+        "-q",
+        "-o",
+        "f",
+    ];
+    assert_eq!(run(&first).0, Some(0));
+    std::fs::copy(
+        dir.path().join("f/checkpoint.mote"),
+        dir.path().join("copy.mote"),
+    )
+    .unwrap();
+
+    // The copy goes on in f, and says so.
+    let (code, err) = run(&["run", "--resume", "copy.mote"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("continuing the run in its folder"), "{err}");
+    assert!(err.contains("/f"), "{err}");
+
+    // A newer run (another seed, no checkpoints) takes the folder.
+    let second = [
+        "--seed",
+        "2",
+        "run",
+        "example:sun-earth",
+        "--steps",
+        "50",
+        "-q",
+        "-o",
+        "f",
+    ];
+    assert_eq!(run(&second).0, Some(0));
+    let table = std::fs::read(dir.path().join("f/observables.csv")).unwrap();
+    for checkpoint in ["f/checkpoint.mote", "copy.mote"] {
+        let (code, err) = run(&["run", "--resume", checkpoint]);
+        assert_eq!(code, Some(1), "{checkpoint}: {err}");
+        assert!(err.contains("cannot resume into"), "{err}");
+        assert!(err.contains("holds the files of run"), "{err}");
+        assert_eq!(
+            std::fs::read(dir.path().join("f/observables.csv")).unwrap(),
+            table,
+            "the newer run's table was changed"
+        );
+    }
+}
+
+/// Two runs started together into one folder: never both run (the lock is
+/// taken atomically), and the table that is left is one run's, whole.
+#[test]
+fn two_runs_started_together_never_both_write_one_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    for trial in 0..8 {
+        let out = format!("race{trial}");
+        let spawn = || {
+            Command::new(env!("CARGO_BIN_EXE_mote"))
+                .args(["run", "example:eos", "--until", "40", "-q", "-o", &out])
+                .current_dir(dir.path())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap()
+        };
+        let (a, b) = (spawn(), spawn());
+        let (a, b) = (a.wait_with_output().unwrap(), b.wait_with_output().unwrap());
+        let ok = [&a, &b].iter().filter(|o| o.status.success()).count();
+        assert_eq!(
+            ok,
+            1,
+            "trial {trial}: {} / {}",
+            String::from_utf8_lossy(&a.stderr),
+            String::from_utf8_lossy(&b.stderr)
+        );
+        let loser = if a.status.success() { &b } else { &a };
+        assert!(String::from_utf8_lossy(&loser.stderr).contains("is writing into this folder"));
+        let table = std::fs::read_to_string(dir.path().join(&out).join("observables.csv")).unwrap();
+        let rows: Vec<&str> = table.lines().filter(|l| !l.starts_with('#')).collect();
+        let width = rows[0].split(',').count();
+        assert!(
+            rows.iter().all(|r| r.split(',').count() == width),
+            "a torn row"
+        );
+    }
+}

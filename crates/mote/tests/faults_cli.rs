@@ -178,3 +178,57 @@ fn a_closed_pipe_ends_the_output_quietly() {
         "{status:?}: {err}"
     );
 }
+
+/// A full stdout or stderr (`> /dev/full`) ends mote with one line saying
+/// which stream failed and exit status 1, never a panic; a run still writes
+/// all its files first (found with `mote --help > /dev/full`).
+#[test]
+fn a_full_stdout_or_stderr_ends_with_a_message_and_status_1() {
+    if !have_dev_full() {
+        return;
+    }
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let out_arg = out.display().to_string();
+    let cases: [&[&str]; 5] = [
+        &["--help"],
+        &["--version"],
+        &["examples"],
+        &["run", "--help"],
+        &["run", "example:sun-earth", "--steps", "20", "-o", &out_arg],
+    ];
+    for args in cases {
+        let o = mote().args(args).stdout(full()).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(
+            err.contains("mote: cannot write to standard output: No space left on device"),
+            "{args:?}: {err}"
+        );
+    }
+    let table = std::fs::read_to_string(out.join("observables.csv")).unwrap();
+    // Its header and the rows of steps 0, 10 and 20: the whole table.
+    assert_eq!(
+        table.lines().filter(|l| !l.starts_with('#')).count(),
+        4,
+        "{table}"
+    );
+    // stderr full: the opening line fails; the run completes, status 1.
+    let o = mote()
+        .args(["run", "example:sun-earth", "--steps", "20", "-o", &out_arg])
+        .stderr(full())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("Ran 20 steps"));
+    // A usage error keeps its own status (2), whatever stderr does.
+    let o = mote().args(["--bogus"]).stderr(full()).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}

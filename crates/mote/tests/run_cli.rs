@@ -108,6 +108,24 @@ fn examples_are_listed_and_written_and_each_one_runs() {
     }
     let o = mote(&["examples", "--write", "scenes"], dir.path());
     assert!(o.status.success());
+    // Writing again leaves unchanged files be; an edited scene is kept
+    // (nothing written, its name in the message) unless --force.
+    let o = mote(&["examples", "--write", "scenes"], dir.path());
+    assert!(o.status.success());
+    let edited = dir.path().join("scenes/sun-earth.toml");
+    let original = std::fs::read_to_string(&edited).unwrap();
+    std::fs::write(&edited, "# my edit\n").unwrap();
+    let o = mote(&["examples", "--write", "scenes"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("sun-earth.toml") && err.contains("--force"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&edited).unwrap(), "# my edit\n");
+    let o = mote(&["examples", "--write", "scenes", "--force"], dir.path());
+    assert!(o.status.success());
+    assert_eq!(std::fs::read_to_string(&edited).unwrap(), original);
     let mut engines = std::collections::HashSet::new();
     for entry in std::fs::read_dir(dir.path().join("scenes")).unwrap() {
         let path = entry.unwrap().path();

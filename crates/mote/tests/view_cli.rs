@@ -27,7 +27,9 @@ fn start(args: &[&str]) -> (std::process::Child, u16) {
         .unwrap_or_else(|| panic!("no address in {line:?}"));
     let port: u16 = url
         .trim_start_matches("http://127.0.0.1:")
-        .trim_end_matches('/')
+        .split('/')
+        .next()
+        .unwrap()
         .parse()
         .unwrap();
     (child, port)
@@ -37,7 +39,7 @@ fn get(port: u16, path: &str) -> String {
     let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
     write!(
         s,
-        "GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
+        "GET {path} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n"
     )
     .unwrap();
     let mut reply = String::new();

@@ -693,8 +693,7 @@ pub(crate) fn run(
     let spec = &scene.packing;
     let settings = spec.settings(seed, Naming::Scene(source), &base)?;
     let method = spec.method(Naming::Scene(source))?;
-    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
-    let _lock = crate::lock::FolderLock::take(&dir)?;
+    let _folder = crate::lock::RunFolder::fresh(&dir, &input.label, &input.text)?;
     let how = match method {
         Method::Hard => format!("by growth (rate {}", spec.rate),
         Method::Soft { min_pressure } => {

@@ -38,7 +38,7 @@ pub struct EdmdArgs {
 pub fn run(global: &super::GlobalOpts, args: EdmdArgs) -> anyhow::Result<ExitCode> {
     if args.list {
         for (name, text) in EXAMPLES {
-            println!(
+            say!(
                 "example:{name:<18} {}",
                 mote_front::examples::description(text)
             );

@@ -16,7 +16,9 @@ pub mod view;
 /// gives the exit status: 0 for help and version, 2 for a usage error.
 pub fn parse_words<T: clap::Parser>(name: &str, args: &[String]) -> Result<T, ExitCode> {
     T::try_parse_from(std::iter::once(name.to_string()).chain(args.iter().cloned())).map_err(|e| {
-        let _ = e.print();
+        if let Err(io) = e.print() {
+            mote_front::terminal::stream_failed("standard output", &io);
+        }
         if e.use_stderr() {
             ExitCode::from(2)
         } else {

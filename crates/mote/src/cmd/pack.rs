@@ -247,12 +247,12 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     )?;
     if !quiet {
         for line in &packed.summary {
-            println!("{line}");
+            say!("{line}");
         }
     }
     // A signal stopped it: the packing so far is written; exit 128 + signal.
     if let Ending::Interrupted { signal, message } = &packed.ending {
-        eprintln!("mote pack: {message}");
+        tell!("mote pack: {message}");
         return Ok(ExitCode::from((128 + signal).clamp(0, 255) as u8));
     }
     Ok(ExitCode::SUCCESS)
@@ -343,13 +343,13 @@ fn analyse_dim<const D: usize>(
             .iter()
             .cloned()
             .fold((0.0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
-        println!(
+        say!(
             "{}: {n} {}",
             a.file.display(),
             if D == 2 { "disks" } else { "spheres" }
         );
-        println!("packing fraction      {phi:.6}");
-        println!(
+        say!("packing fraction      {phi:.6}");
+        say!(
             "contacts (gap < {:e}) mean {:.4} over all; {} rattlers (< {} contacts, {:.2} %); backbone mean {:.4} (isostatic {})",
             a.tol,
             mean_all,
@@ -360,13 +360,13 @@ fn analyse_dim<const D: usize>(
             2 * D
         );
         let s = stable_contacts(&simbox, &pos, radii, a.tol);
-        println!(
+        say!(
             "force balance         {} rattlers ({:.2} %) when contacts all in one hemisphere also rattle, recursively; backbone mean {:.4}",
             s.rattlers(),
             100.0 * s.rattlers() as f64 / n as f64,
             s.backbone_z
         );
-        println!(
+        say!(
             "{}                   {q:.4} over {bonds} bonds < {}·(r_i + r_j) ({})",
             if D == 2 { "|psi6|" } else { "Q6  " },
             a.bond,
@@ -382,13 +382,14 @@ fn analyse_dim<const D: usize>(
                 "no hexatic order"
             }
         );
-        println!(
+        say!(
             "g(r) peak             {:.3} at r = {:.3} mean diameters",
-            peak.1, peak.0
+            peak.1,
+            peak.0
         );
         match overlap {
-            None => println!("overlaps              none"),
-            Some((i, j, g)) => println!("deepest overlap       {i}, {j}: |r|/sigma - 1 = {g:.3e}"),
+            None => say!("overlaps              none"),
+            Some((i, j, g)) => say!("deepest overlap       {i}, {j}: |r|/sigma - 1 = {g:.3e}"),
         }
     }
     Ok(ExitCode::SUCCESS)

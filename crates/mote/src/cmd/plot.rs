@@ -115,7 +115,7 @@ pub fn run(global: &super::GlobalOpts, a: PlotArgs) -> anyhow::Result<ExitCode> 
     };
     plot.write(&a.output)?;
     if !global.quiet {
-        eprintln!(
+        tell!(
             "{} series, {} points -> {}",
             ys.len(),
             x.len(),

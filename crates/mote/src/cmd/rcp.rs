@@ -42,7 +42,7 @@ pub fn run(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCo
                 Err(Exit::Done) => Ok(ExitCode::SUCCESS),
                 Err(Exit::Error(msg)) => {
                     out.flush().ok();
-                    eprintln!("{msg}");
+                    tell!("{msg}");
                     Ok(ExitCode::from(ERROR_EXIT))
                 }
                 Err(Exit::Io(e)) => Err(e.into()),
@@ -726,9 +726,9 @@ fn optimize(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitC
     let started = std::time::Instant::now();
     let opt = design::optimise(&pops, &est, objective, &search)?;
     let total: f64 = opt.populations.iter().map(|q| q.volume()).sum();
-    println!("population,d43,sigma,volume_fraction");
+    say!("population,d43,sigma,volume_fraction");
     for (k, q) in opt.populations.iter().enumerate() {
-        println!(
+        say!(
             "{},{},{:.6},{:.6}",
             k + 1,
             q.d43(),
@@ -736,10 +736,10 @@ fn optimize(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitC
             q.volume() / total
         );
     }
-    println!("phi = {:.6}", opt.phi);
-    println!("evaluations = {}", opt.evaluations);
+    say!("phi = {:.6}", opt.phi);
+    say!("evaluations = {}", opt.evaluations);
     if !global.quiet {
-        eprintln!(
+        tell!(
             "{} evaluations of {} rods in {:.2} s",
             opt.evaluations,
             est.rods,
@@ -827,7 +827,7 @@ fn scan(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode>
         .filter(|&i| result.phi[i].is_finite())
         .max_by(|&i, &j| result.phi[i].total_cmp(&result.phi[j]));
     if let Some(b) = best {
-        println!(
+        say!(
             "max phi = {:.6} at {} = {}, {} = {}",
             result.phi[b],
             x.param,
@@ -836,9 +836,9 @@ fn scan(global: &super::GlobalOpts, args: &[String]) -> anyhow::Result<ExitCode>
             y.value(b / x.count)
         );
     }
-    println!("evaluations = {}", result.evaluations);
+    say!("evaluations = {}", result.evaluations);
     if !global.quiet {
-        eprintln!(
+        tell!(
             "{} points, {} evaluations in {:.2} s; wrote {}{}",
             points,
             result.evaluations,

@@ -232,7 +232,7 @@ pub fn run(global: &super::GlobalOpts, a: RenderArgs) -> anyhow::Result<ExitCode
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
         }
         if !global.quiet {
-            eprintln!(
+            tell!(
                 "frame {k} (t = {}): {} spheres -> {}",
                 frame.time,
                 scene.spheres.len(),

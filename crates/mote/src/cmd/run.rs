@@ -83,22 +83,22 @@ pub fn report(outcome: &mote_front::Outcome, quiet: bool) -> ExitCode {
         Ending::Finished => {
             if !quiet {
                 for line in &outcome.summary {
-                    println!("{line}");
+                    say!("{line}");
                 }
             }
             ExitCode::SUCCESS
         }
         Ending::Unstable(message) => {
-            eprintln!("error: {message}");
-            eprintln!(
+            tell!("error: {message}");
+            tell!(
                 "the files written up to that point are kept in {}",
                 outcome.dir.display()
             );
             ExitCode::from(3)
         }
         Ending::Interrupted { signal, message } => {
-            eprintln!("{message}");
-            eprintln!(
+            tell!("{message}");
+            tell!(
                 "the files are flushed in {}{}",
                 outcome.dir.display(),
                 if outcome.dir.join("checkpoint.mote").exists() {

@@ -115,7 +115,7 @@ fn live_app(
             Ok(outcome) => {
                 super::run::report(outcome, quiet);
             }
-            Err(e) => eprintln!("error: {e}"),
+            Err(e) => tell!("error: {e}"),
         }
         live::ending(result)
     })
@@ -127,7 +127,7 @@ fn live_app(
 pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> {
     let (listener, loopback) = mote_view::bind(&a.bind, a.port).map_err(|m| anyhow!(m))?;
     if !loopback {
-        eprintln!(
+        tell!(
             "warning: listening on {}: other machines on the network can see this page",
             a.bind
         );
@@ -139,7 +139,7 @@ pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> 
     };
     let mut failed = false;
     let (app, line, run) = made.unwrap_or_else(|message| {
-        eprintln!("error: {message}");
+        tell!("error: {message}");
         failed = true;
         let app = Arc::new(App::Failed {
             label: file_name(&a.input),
@@ -153,20 +153,25 @@ pub fn run(global: &super::GlobalOpts, a: ViewArgs) -> anyhow::Result<ExitCode> 
     } else {
         addr.ip().to_string()
     };
+    // A live run's page carries the run's token (mote_view::doors).
+    let query = match &*app {
+        App::Live(session) => format!("?token={}", session.token),
+        _ => String::new(),
+    };
     let url = if addr.is_ipv6() {
-        format!("http://[{host}]:{}/", addr.port())
+        format!("http://[{host}]:{}/{query}", addr.port())
     } else {
-        format!("http://{host}:{}/", addr.port())
+        format!("http://{host}:{}/{query}", addr.port())
     };
     if !global.quiet || failed {
-        println!("mote view {}: {line}; open {url} (Ctrl-C ends)", a.input);
+        say!("mote view {}: {line}; open {url} (Ctrl-C ends)", a.input);
     }
     // The address is flushed before anything waits.
     use std::io::Write;
     std::io::stdout().flush().ok();
     if a.open {
         if let Err(e) = std::process::Command::new("xdg-open").arg(&url).spawn() {
-            eprintln!("warning: could not open a browser ({e}); open {url} yourself");
+            tell!("warning: could not open a browser ({e}); open {url} yourself");
         }
     }
     let runtime = tokio::runtime::Builder::new_multi_thread()
