@@ -112,6 +112,7 @@ pub(crate) fn restore(
         trajectory_format: get("trajectory-format"),
         seed: Some(cp.seed),
         threads: given.threads,
+        force: given.force,
         live: given.live.clone(),
     };
     Ok((input, options))

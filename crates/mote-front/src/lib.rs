@@ -60,6 +60,8 @@ pub struct RunOptions {
     /// Worker threads the caller asked for. The caller sets up the rayon
     /// pool; the opening line reports the pool's actual size.
     pub threads: Option<usize>,
+    /// Run even where the run is longer than `mote_run::MAX_STEPS` steps.
+    pub force: bool,
     /// The live viewer's tap (`mote view SCENE`): sees every step, hands
     /// back changes, may pause the run.
     pub live: mote_run::LiveSlot,
@@ -228,6 +230,16 @@ const WHY_NO_SYSTEM: &str = "it chooses the model of an MPPphys particle file";
 fn threads_phrase() -> String {
     let n = rayon::current_num_threads();
     format!("{n} thread{}", if n == 1 { "" } else { "s" })
+}
+
+/// A number as people write it: plain between 10⁻⁴ and 10⁶, else in
+/// exponent form (`1e-300`, not three hundred zeros).
+pub(crate) fn number(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// ", seed 7" or ", seed 7 (chosen)".

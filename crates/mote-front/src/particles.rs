@@ -122,6 +122,13 @@ pub(crate) fn run(
             input.label
         ),
     };
+    let total_steps = length
+        .steps_from(built.simulation.system.time, built.simulation.dt)
+        .map_err(|e| FrontError::request(format!("{}: {e}", input.label)))?;
+    if resumed.is_none() {
+        mote_run::check_run_length(total_steps, built.simulation.dt, options.force)
+            .map_err(|m| FrontError::request(format!("{}: {m}", input.label)))?;
+    }
 
     let dir = input.output_dir(args.output.as_ref(), scene.output.dir.as_ref());
     let folder = crate::lock::RunFolder::claim(
@@ -130,7 +137,6 @@ pub(crate) fn run(
         &input.text,
         resumed.as_ref().zip(options.resume.as_deref()),
     )?;
-    let total_steps = length.steps_from(built.simulation.system.time, built.simulation.dt);
     let append = resumed.is_some();
     if let Some(cp) = &resumed {
         resume_state(cp, &mut built.simulation, &input.label)?;
@@ -153,7 +159,10 @@ pub(crate) fn run(
             scene.units,
             out.observables_every,
             built.probes.clone(),
-            sim.system.boundary.periodic.iter().all(|p| *p),
+            // The pressure where the box is periodic and every interaction
+            // gives its virial (the summary says which does not).
+            sim.system.boundary.periodic.iter().all(|p| *p)
+                && sim.forces.without_virial().is_empty(),
             &sim.forces
                 .interactions
                 .iter()
@@ -219,7 +228,7 @@ pub(crate) fn run(
         });
     }
 
-    let steps = length.steps_from(sim.system.time, sim.dt);
+    let steps = length.steps_from(sim.system.time, sim.dt)?;
     let last_step = sim.system.step + steps;
     let propagator = if sim.brownian.is_some() {
         "Brownian dynamics".to_string()
@@ -231,7 +240,7 @@ pub(crate) fn run(
         input.label,
         sim.system.particles.len(),
         propagator,
-        sim.dt,
+        crate::number(sim.dt),
         steps,
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase(),
@@ -301,8 +310,19 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
             sim.max_energy_error(),
         )
     };
+    let without = sim.forces.without_virial();
+    let pressure = if sim.system.boundary.periodic.iter().all(|p| *p) && !without.is_empty() {
+        format!(
+            " No pressure column: {} do{} not compute {} virial.",
+            without.join(", "),
+            if without.len() == 1 { "es" } else { "" },
+            if without.len() == 1 { "its" } else { "their" }
+        )
+    } else {
+        String::new()
+    };
     format!(
-        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). {energy} Output in {}: {}.",
+        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). {energy}{pressure} Output in {}: {}.",
         report.steps,
         report.last.time,
         t_unit,

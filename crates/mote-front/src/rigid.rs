@@ -93,6 +93,7 @@ fn run_with(
         dt: options.dt,
         steps: options.steps,
         until: options.until,
+        force: options.force,
         checkpoints,
         resume: resumed.cloned(),
         trajectory_format: Some(format),
@@ -101,7 +102,7 @@ fn run_with(
     monitor.start(&format!(
         "mote run {}: rigid clumps (FRBI) with dt = {}, {}, {}",
         input.label,
-        options.dt.unwrap_or(scene.run.get_ref().dt),
+        crate::number(options.dt.unwrap_or(scene.run.get_ref().dt)),
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase(),
     ));
@@ -138,7 +139,7 @@ fn run_with(
         input.label,
         report.bodies,
         report.spheres,
-        report.dt,
+        crate::number(report.dt),
         report.steps,
         report.time,
         report.wall_seconds,

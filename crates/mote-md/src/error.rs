@@ -21,4 +21,7 @@ pub enum MdError {
     /// that step written.
     #[error("the run was interrupted by signal {signal} after step {step} (t = {time})")]
     Interrupted { signal: i32, step: u64, time: f64 },
+    /// A run length that is no count of steps (`until` with `dt = 1e-300`).
+    #[error("{0}")]
+    Length(String),
 }

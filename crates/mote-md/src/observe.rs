@@ -59,10 +59,11 @@ impl Observables {
         let (potential, _) = ff.potential_energy(&state);
         let nf = sys.degrees_of_freedom();
         let volume = sys.boundary.volume();
-        let pressure = if sys.boundary.periodic.iter().all(|p| *p) && volume.is_finite() {
-            (2.0 * translational + ff.virial()) / (3.0 * volume)
-        } else {
-            f64::NAN
+        let pressure = match ff.virial() {
+            Some(w) if sys.boundary.periodic.iter().all(|p| *p) && volume.is_finite() => {
+                (2.0 * translational + w) / (3.0 * volume)
+            }
+            _ => f64::NAN,
         };
         Self {
             time: sys.time,

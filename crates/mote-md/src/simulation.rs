@@ -15,24 +15,22 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 pub enum RunLength {
     /// A number of steps.
     Steps(u64),
-    /// Until the simulated time reaches T (the last step may end at most
-    /// one step after T only by round-off: steps = ⌈(T − t)/Δt⌉).
+    /// Until the first step at or past the simulated time T
+    /// ([`mote_run::steps_until`], the rule of every engine).
     Until(f64),
 }
 
 impl RunLength {
-    /// Number of steps from time `t` with step `dt`.
-    pub fn steps_from(self, t: f64, dt: f64) -> u64 {
+    /// Number of steps from time `t` with step `dt`; an error where `Until`
+    /// gives no count a run can take (a non-finite end, `dt = 1e-300`).
+    pub fn steps_from(self, t: f64, dt: f64) -> Result<u64, MdError> {
         match self {
-            RunLength::Steps(n) => n,
-            RunLength::Until(end) => {
-                let n = (end - t) / dt;
-                if n <= 0.0 {
-                    0
-                } else {
-                    (n - 1e-9 * n.max(1.0)).ceil() as u64
-                }
-            }
+            RunLength::Steps(n) => Ok(n),
+            RunLength::Until(end) => mote_run::steps_until(t, end, dt).ok_or_else(|| {
+                MdError::Length(format!(
+                    "until {end} from t = {t} with dt = {dt:e}: not a number of steps a run can take"
+                ))
+            }),
         }
     }
 }
@@ -84,7 +82,7 @@ impl Simulation {
         length: RunLength,
         mut progress: impl FnMut(&System),
     ) -> Result<RunReport, MdError> {
-        let last = self.system.step + length.steps_from(self.system.time, self.dt);
+        let last = self.system.step + length.steps_from(self.system.time, self.dt)?;
         mote_run::Driver::new().run(self, |_| last, |s| progress(&s.system))
     }
 

@@ -14,21 +14,66 @@ const MADELUNG_NACL: f64 = 1.747_564_594_633;
 /// The 8 ions of rock salt's cubic cell (nearest-neighbour distance 1) in a
 /// periodic box of side 2.
 fn rock_salt(method_keys: &str) -> String {
+    rock_salt_scaled(method_keys, 1.0)
+}
+
+/// The same crystal with every length times `a`.
+fn rock_salt_scaled(method_keys: &str, a: f64) -> String {
+    let side = 2.0 * a;
     let mut s = format!(
-        "units = \"lj\"\n[run]\ndt = 0.001\n[box]\nlo = [0.0, 0.0, 0.0]\nhi = [2.0, 2.0, 2.0]\nperiodic = [true, true, true]\n[coulomb]\n{method_keys}\n"
+        "units = \"lj\"\n[run]\ndt = 0.001\n[box]\nlo = [0.0, 0.0, 0.0]\nhi = [{side:?}, {side:?}, {side:?}]\nperiodic = [true, true, true]\n[coulomb]\n{method_keys}\n"
     );
     for i in 0..2 {
         for j in 0..2 {
             for k in 0..2 {
                 let q = if (i + j + k) % 2 == 0 { 1.0 } else { -1.0 };
+                let at = |n: i32| (n as f64 + 0.25) * a;
                 s += &format!(
-                    "[[particle]]\nposition = [{}.25, {}.25, {}.25]\ncharge = {q:.1}\n",
-                    i, j, k
+                    "[[particle]]\nposition = [{:?}, {:?}, {:?}]\ncharge = {q:.1}\n",
+                    at(i),
+                    at(j),
+                    at(k)
                 );
             }
         }
     }
     s
+}
+
+/// The pressure of a static ionic crystal under Ewald is U/(3V) (the
+/// Coulomb virial is U), and it is −dU/dV of the crystal strained evenly,
+/// measured by central differences of the Ewald energy.
+#[test]
+fn ewald_pressure_of_static_rock_salt_is_u_over_3v_and_minus_du_dv() {
+    let keys = "method = \"ewald\"\naccuracy = 1e-12";
+    let mut built = common::build(&rock_salt(keys));
+    let sim = &mut built.simulation;
+    // One step: the forces vanish by symmetry, so nothing moves (K = 0).
+    common::steps(sim, 1, |_| {});
+    let o = Observables::measure(&sim.system, &mut sim.forces);
+    assert!(o.kinetic < 1e-30, "K = {}", o.kinetic);
+    let volume = 8.0;
+    let expected = o.potential / (3.0 * volume);
+    assert!(
+        ((o.pressure - expected) / expected).abs() < 1e-6,
+        "P = {}, U/(3V) = {expected}",
+        o.pressure
+    );
+    // −dU/dV from the energies of the crystal scaled by 1 ± h.
+    let h = 1e-4;
+    let energy = |a: f64| {
+        let mut b = common::build(&rock_salt_scaled(keys, a));
+        let s = &mut b.simulation;
+        Observables::measure(&s.system, &mut s.forces).potential
+    };
+    let (up, down) = (energy(1.0 + h), energy(1.0 - h));
+    let dv = 8.0 * ((1.0 + h).powi(3) - (1.0 - h).powi(3));
+    let minus_du_dv = -(up - down) / dv;
+    assert!(
+        ((o.pressure - minus_du_dv) / minus_du_dv).abs() < 1e-6,
+        "P = {}, −dU/dV = {minus_du_dv}",
+        o.pressure
+    );
 }
 
 #[test]
@@ -137,4 +182,35 @@ fn a_charge_is_accelerated_by_the_electric_field() {
     let exact = 2.0 * 1.5 / (0.5 * omega) * ((omega * t + phase).sin() - phase.sin());
     let vy = sim.system.particles.velocity[0].y;
     assert!((vy - exact).abs() < 1e-5, "v_y = {vy}, exact {exact}");
+}
+
+/// One stretched spring in a periodic box: W = r_ij · F_ij = −D (r − l) r,
+/// so P = W/(3V) at rest; an interaction without a virial (direct
+/// gravity) takes the pressure away, never leaving a number without its part.
+#[test]
+fn spring_pressure_and_a_pressure_not_given() {
+    let text = "units = \"lj\"\n[run]\ndt = 1e-12\n\
+        [box]\nlo = [0.0, 0.0, 0.0]\nhi = [10.0, 10.0, 10.0]\nperiodic = [true, true, true]\n\
+        [[particle]]\nposition = [4.0, 5.0, 5.0]\n\
+        [[particle]]\nposition = [5.5, 5.0, 5.0]\n\
+        [[spring]]\npairs = [[0, 1]]\nstiffness = 3.0\nrest_length = 1.0\n";
+    let mut built = common::build(text);
+    let sim = &mut built.simulation;
+    common::steps(sim, 1, |_| {});
+    let o = Observables::measure(&sim.system, &mut sim.forces);
+    let expected = -3.0 * 0.5 * 1.5 / (3.0 * 1000.0);
+    assert!(
+        ((o.pressure - expected) / expected).abs() < 1e-9,
+        "P = {}, expected {expected}",
+        o.pressure
+    );
+    assert!(sim.forces.without_virial().is_empty());
+    let charged = text.replace("[[spring]]", "[gravity]\nG = 1.0\n[[spring]]");
+    let mut built = common::build(&charged);
+    let sim = &mut built.simulation;
+    common::steps(sim, 1, |_| {});
+    assert_eq!(sim.forces.without_virial(), ["gravity"]);
+    assert!(Observables::measure(&sim.system, &mut sim.forces)
+        .pressure
+        .is_nan());
 }

@@ -228,7 +228,7 @@ fn lj_through_list(
     let state = State::new(pos, &zero, &mass, 0.0).in_box(b);
     let mut force = vec![DVec3::ZERO; pos.len()];
     lj.add_forces(&state, &mut force);
-    let virial = lj.virial();
+    let virial = lj.virial().unwrap();
     let energy = lj.potential_energy(&state);
     (force, energy, virial)
 }

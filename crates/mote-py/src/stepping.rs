@@ -134,7 +134,9 @@ pub fn run_loop<T: HasEngine + pyo3::PyClass<Frozen = pyo3::pyclass::boolean_str
                 PyValueError::new_err("the scene gives no run length: give steps= or until=")
             })?,
         };
-        let total = length.steps_from(time, dt);
+        let total = length
+            .steps_from(time, dt)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
         (
             step,
             total,

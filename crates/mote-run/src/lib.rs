@@ -25,6 +25,46 @@ use mote_io::xyz::Frame;
 mod steer;
 pub use steer::{Change, FieldKind, Live, LiveSlot, Shown, WallGeometry};
 
+/// The most steps a run takes without being told `--force`: a run longer
+/// than this is far more likely a time step or an end time mistyped
+/// (`dt = 1e-300`) than a plan.
+pub const MAX_STEPS: u64 = 1_000_000_000;
+
+/// The number of steps of size `dt` from time `t` to the first step at or
+/// past `end`, the one rule of every time-stepped engine:
+///
+/// n = ⌈(end − t)/Δt − 10⁻⁹·max(1, (end − t)/Δt)⌉,
+///
+/// the small relative slack keeping an end that is a whole number of steps
+/// as written (`until = 0.3` with `dt = 0.1`, where 0.3/0.1 = 3.0000000000000004)
+/// from a step past it by round-off. Zero when `end ≤ t`; `None` when the
+/// count is not a finite number a u64 holds (an end or a step that is not
+/// finite, or `dt = 1e-300`).
+pub fn steps_until(t: f64, end: f64, dt: f64) -> Option<u64> {
+    let n = (end - t) / dt;
+    if dt.is_nan() || dt <= 0.0 || n.is_nan() {
+        return None;
+    }
+    if n <= 0.0 {
+        return Some(0);
+    }
+    let n = (n - 1e-9 * n.max(1.0)).ceil();
+    // 2^64 is the first f64 a u64 cannot hold.
+    (n < 18_446_744_073_709_551_616.0).then_some(n as u64)
+}
+
+/// Refuses a run of more than [`MAX_STEPS`] steps unless `force`d; the
+/// message says how many steps of what.
+pub fn check_run_length(steps: u64, dt: f64, force: bool) -> Result<(), String> {
+    if steps > MAX_STEPS && !force {
+        return Err(format!(
+            "{steps} steps of dt = {dt:e}: more than {MAX_STEPS}, which is most likely a time step \
+             or an end time mistyped; give --force to run them"
+        ));
+    }
+    Ok(())
+}
+
 /// Something that moves a state forward step by step.
 pub trait Propagator {
     /// Whole-system observables of one instant, handed to the observers.
@@ -289,6 +329,46 @@ impl<P: Propagator> Driver<P> {
         let mut cp = c.template.clone();
         state.save(&mut cp)?;
         Ok(checkpoint::write(&c.path, &cp)?)
+    }
+}
+
+#[cfg(test)]
+mod length_tests {
+    use super::*;
+
+    #[test]
+    fn steps_until_reach_the_first_step_at_or_past_the_end() {
+        assert_eq!(steps_until(0.0, 0.3, 0.1), Some(3));
+        assert_eq!(steps_until(0.0, 0.35, 0.1), Some(4));
+        assert_eq!(steps_until(0.0, 0.32, 0.1), Some(4));
+        assert_eq!(steps_until(0.0, 365.25, 0.5), Some(731));
+        assert_eq!(steps_until(1.0, 1.0, 0.1), Some(0));
+        assert_eq!(steps_until(2.0, 1.0, 0.1), Some(0));
+        // Every count from 1 to 10⁴ steps of an awkward dt comes back.
+        let dt = 0.1 + 0.2;
+        for n in 1..10_000u64 {
+            assert_eq!(steps_until(0.0, n as f64 * dt, dt), Some(n), "{n}");
+            let past = steps_until(0.0, (n as f64 + 0.5) * dt, dt).unwrap();
+            assert_eq!(past, n + 1);
+            assert!(past as f64 * dt >= (n as f64 + 0.5) * dt);
+        }
+        for bad in [
+            (0.0, f64::NAN, 0.1),
+            (0.0, 1.0, 0.0),
+            (0.0, 1.0, -1.0),
+            (0.0, 10.0, 1e-300),
+        ] {
+            assert_eq!(steps_until(bad.0, bad.1, bad.2), None, "{bad:?}");
+        }
+        assert_eq!(steps_until(0.0, f64::INFINITY, 0.1), None);
+    }
+
+    #[test]
+    fn runs_longer_than_a_billion_steps_need_force() {
+        assert!(check_run_length(MAX_STEPS, 0.1, false).is_ok());
+        let e = check_run_length(MAX_STEPS + 1, 1e-9, false).unwrap_err();
+        assert!(e.contains("--force"), "{e}");
+        assert!(check_run_length(MAX_STEPS + 1, 1e-9, true).is_ok());
     }
 }
 

@@ -66,6 +66,85 @@ fn until_overrides_the_scene() {
     assert_eq!(*table.column("time").unwrap().last().unwrap(), 10.0);
 }
 
+/// One rule for every time-stepped engine: `--until T` (or a scene's
+/// `[run] until`) runs to the first step at or past T, ⌈T/Δt⌉ steps
+/// (rigid runs took round(T/Δt) and stopped short of T for 0.0322/0.001);
+/// the event-driven engine ends at T itself; a count of steps no run can
+/// take is refused, and more than 10⁹ steps needs --force.
+#[test]
+fn every_engine_runs_to_the_first_step_at_or_past_until() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| {
+        let o = mote(args, dir.path());
+        let text =
+            String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+        (o.status.code(), text)
+    };
+    // Point particles: 1.2 / 0.5 → 3 steps, t = 1.5; 1.0 / 0.5 → 2.
+    let (code, out) = run(&[
+        "run",
+        "example:sun-earth",
+        "--dt",
+        "0.5",
+        "--until",
+        "1.2",
+        "-o",
+        "p",
+    ]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("Ran 3 steps to t = 1.500000e0"), "{out}");
+    let (_, out) = run(&[
+        "run",
+        "example:sun-earth",
+        "--dt",
+        "0.5",
+        "--until",
+        "1",
+        "-o",
+        "p",
+    ]);
+    assert!(out.contains("Ran 2 steps to t = 1.000000e0"), "{out}");
+    // Rigid clumps, from the command line and from the scene.
+    let (code, out) = run(&[
+        "run",
+        "example:magnet-in-field",
+        "--dt",
+        "0.001",
+        "--until",
+        "0.0322",
+        "-o",
+        "r",
+    ]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("33 steps to t = 3.300000e-2"), "{out}");
+    let scene = include_str!("../../../examples/rigid/magnet-in-field.toml")
+        .replace("dt = 0.01\nsteps = 20000", "dt = 0.01\nuntil = 0.322");
+    std::fs::write(dir.path().join("magnet.toml"), scene).unwrap();
+    let (code, out) = run(&["run", "magnet.toml", "-o", "r"]);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(out.contains("33 steps to t = 3.300000e-1"), "{out}");
+    // Event-driven: the run ends at T.
+    let (code, out) = run(&["run", "example:cradle", "--until", "0.7", "-o", "e"]);
+    assert_eq!(code, Some(0), "{out}");
+    let table = mote_io::csv::read_table(&dir.path().join("e/observables.csv")).unwrap();
+    assert_eq!(*table.column("time").unwrap().last().unwrap(), 0.7);
+    // Counts no run can take, and runs past 10⁹ steps.
+    for engine in ["example:sun-earth", "example:magnet-in-field"] {
+        let (code, out) = run(&["run", engine, "--dt", "1e-300", "--until", "1.2", "-o", "x"]);
+        assert_eq!(code, Some(1), "{out}");
+        assert!(
+            out.contains("not a number of steps a run can take"),
+            "{out}"
+        );
+        let (code, out) = run(&["run", engine, "--dt", "1e-9", "--until", "1.2", "-o", "x"]);
+        assert_eq!(code, Some(1), "{out}");
+        assert!(
+            out.contains("1199999999 steps") && out.contains("--force"),
+            "{out}"
+        );
+    }
+}
+
 /// `mote examples` lists every engine's examples under a heading each,
 /// and every example, written out, runs through `mote run` (a few steps,
 /// or a short time for the event-driven ones).

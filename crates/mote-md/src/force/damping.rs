@@ -11,6 +11,11 @@ pub struct GlobalDamping {
 }
 
 impl Interaction for GlobalDamping {
+    /// Not part of the pressure (see [`Interaction::virial`]).
+    fn virial(&self) -> Option<f64> {
+        Some(0.0)
+    }
+
     fn name(&self) -> &'static str {
         "damping"
     }

@@ -91,6 +91,11 @@ impl ElectricField {
 }
 
 impl Interaction for ElectricField {
+    /// Not part of the pressure (see [`Interaction::virial`]).
+    fn virial(&self) -> Option<f64> {
+        Some(0.0)
+    }
+
     fn name(&self) -> &'static str {
         "electric_field"
     }

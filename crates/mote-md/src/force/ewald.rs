@@ -610,6 +610,8 @@ pub struct EwaldCoulomb {
     pub ewald: Ewald,
     /// Coulomb constant of the unit system.
     pub k: f64,
+    /// The energy of the last force evaluation, which is its virial.
+    last_energy: f64,
 }
 
 impl EwaldCoulomb {
@@ -617,7 +619,11 @@ impl EwaldCoulomb {
     /// units, i.e. including `k`) for these charges.
     pub fn new(k: f64, charge: &[f64], box_length: f64, r_cut: f64, accuracy: f64) -> Self {
         let ewald = Ewald::for_charges(box_length, r_cut, accuracy / k.abs(), charge);
-        Self { ewald, k }
+        Self {
+            ewald,
+            k,
+            last_energy: 0.0,
+        }
     }
 }
 
@@ -628,8 +634,10 @@ impl Interaction for EwaldCoulomb {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let mut f = vec![DVec3::ZERO; force.len()];
-        self.ewald
+        let u = self
+            .ewald
             .charges(state.position, state.charges(), Some(&mut f));
+        self.last_energy = self.k * u;
         for (a, b) in force.iter_mut().zip(&f) {
             *a += *b * self.k;
         }
@@ -637,6 +645,14 @@ impl Interaction for EwaldCoulomb {
 
     fn potential_energy(&mut self, state: &State) -> f64 {
         self.k * self.ewald.charges(state.position, state.charges(), None)
+    }
+
+    /// W = U: the tin-foil Ewald energy of charges is homogeneous of degree
+    /// −1 in all lengths (box included; the neutralising background's
+    /// −πQ²/(2Vα²) too, α scaling as 1/L), so W = −dU/dλ at λ = 1 = U,
+    /// and the Coulomb pressure is U/(3V) (Allen & Tildesley, 2nd ed., §5.5).
+    fn virial(&self) -> Option<f64> {
+        Some(self.last_energy)
     }
 }
 
@@ -649,6 +665,8 @@ pub struct EwaldDipoles {
     pub ewald: Ewald,
     /// μ₀/4π (or 1 in reduced units).
     pub k: f64,
+    /// The energy of the last force evaluation (a third of its virial).
+    last_energy: f64,
 }
 
 impl EwaldDipoles {
@@ -656,7 +674,11 @@ impl EwaldDipoles {
     /// the moments of each evaluation from [`State::dipole`]).
     pub fn new(k: f64, dipole: &[DVec3], box_length: f64, r_cut: f64, accuracy: f64) -> Self {
         let ewald = Ewald::for_dipoles(box_length, r_cut, accuracy / k.abs(), dipole);
-        Self { ewald, k }
+        Self {
+            ewald,
+            k,
+            last_energy: 0.0,
+        }
     }
 }
 
@@ -671,8 +693,10 @@ impl Interaction for EwaldDipoles {
             return;
         }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-        self.ewald
+        let u = self
+            .ewald
             .dipoles(state.position, state.dipole, &mut f, &mut h);
+        self.last_energy = self.k * u;
         for (a, b) in force.iter_mut().zip(&f) {
             *a += *b * self.k;
         }
@@ -694,8 +718,10 @@ impl Interaction for EwaldDipoles {
             return;
         }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-        self.ewald
+        let u = self
+            .ewald
             .dipoles(state.position, state.dipole, &mut f, &mut h);
+        self.last_energy = self.k * u;
         for i in 0..n {
             force[i] += f[i] * self.k;
             torque[i] += state.dipole[i].cross(h[i]) * self.k;
@@ -712,6 +738,12 @@ impl Interaction for EwaldDipoles {
             * self
                 .ewald
                 .dipoles(state.position, state.dipole, &mut f, &mut h)
+    }
+
+    /// W = 3U: the tin-foil Ewald energy of fixed dipoles is homogeneous of
+    /// degree −3 in all lengths, so W = −dU/dλ at λ = 1 = 3U.
+    fn virial(&self) -> Option<f64> {
+        Some(3.0 * self.last_energy)
     }
 }
 

@@ -220,9 +220,13 @@ pub trait Interaction: Send {
         None
     }
     /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation, for
-    /// the pressure P V = N k T + W/3 of periodic systems (0 if not tracked).
-    fn virial(&self) -> f64 {
-        0.0
+    /// the pressure P V = N k T + W/3 of periodic systems; `None` where the
+    /// interaction does not compute it (the pressure is then not given,
+    /// rather than given without its part). External fields, damping and
+    /// walls give `Some(0)`: as in LAMMPS, where fixes add no virial unless
+    /// told to (`fix_modify virial yes`), they are not part of the pressure.
+    fn virial(&self) -> Option<f64> {
+        None
     }
     /// The (cut-off, skin) of the pairs this interaction reads from the
     /// shared neighbour list ([`State::neighbours`]); `None` if it reads none.
@@ -408,9 +412,20 @@ impl ForceField {
         }
     }
 
-    /// Total virial of the last force evaluation.
-    pub fn virial(&self) -> f64 {
+    /// Total virial of the last force evaluation; `None` if an interaction
+    /// does not compute its part ([`ForceField::without_virial`]).
+    pub fn virial(&self) -> Option<f64> {
         self.interactions.iter().map(|i| i.virial()).sum()
+    }
+
+    /// The interactions that do not compute their virial: with any of them
+    /// the pressure is not given.
+    pub fn without_virial(&self) -> Vec<&'static str> {
+        self.interactions
+            .iter()
+            .filter(|i| i.virial().is_none())
+            .map(|i| i.name())
+            .collect()
     }
 
     /// Total potential energy, and its parts by interaction name.

@@ -26,6 +26,8 @@ pub struct Spring {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SpringNetwork {
     pub springs: Vec<Spring>,
+    /// W = Σ r_ij · F_ij of the last force evaluation.
+    pub virial: f64,
 }
 
 impl SpringNetwork {
@@ -50,11 +52,19 @@ impl Interaction for SpringNetwork {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let (x, v) = (state.position, state.velocity);
+        let mut virial = 0.0;
         for s in &self.springs {
             let f = Self::force_on_i(s, x[s.i], x[s.j], v[s.i], v[s.j]);
             force[s.i] += f;
             force[s.j] -= f;
+            // r_ij · F_ij with r_ij = x_i − x_j and F_ij = f on i.
+            virial += (x[s.i] - x[s.j]).dot(f);
         }
+        self.virial = virial;
+    }
+
+    fn virial(&self) -> Option<f64> {
+        Some(self.virial)
     }
 
     /// U = Σ ½ D (|x_j − x_i| − l)².

@@ -32,8 +32,11 @@ pub struct RigidRun {
     pub dt: Option<f64>,
     /// Replaces the run length by a number of steps.
     pub steps: Option<u64>,
-    /// Replaces the run length by an end time (steps = round(t/dt)).
+    /// Replaces the run length by an end time (to the first step at or
+    /// past it, [`mote_run::steps_until`]).
     pub until: Option<f64>,
+    /// Run even where that is more than [`mote_run::MAX_STEPS`] steps.
+    pub force: bool,
     /// Write checkpoints on this schedule (the template holds the run's
     /// input and options; the time step and the run's length are added).
     pub checkpoints: Option<Checkpoints>,
@@ -44,6 +47,16 @@ pub struct RigidRun {
     pub trajectory_format: Option<mote_io::trajectory::Format>,
     /// The live viewer's tap, if the run is watched.
     pub live: mote_run::LiveSlot,
+}
+
+/// Steps from t = 0 to the first step at or past `t` (the rule of every
+/// engine, [`mote_run::steps_until`]).
+pub(crate) fn steps_until(t: f64, dt: f64) -> Result<u64, MdError> {
+    mote_run::steps_until(0.0, t, dt).ok_or_else(|| {
+        MdError::Length(format!(
+            "until {t} with dt = {dt:e}: not a number of steps a run can take"
+        ))
+    })
 }
 
 /// Rigid bodies moved by the FRBI with a fixed step.
@@ -476,16 +489,19 @@ pub fn run_rigid_scene(
                 ParseError::new(file_label, 0, format!("time step {dt}: must be > 0")).into(),
             );
         }
-        built.steps = match scene.run.get_ref().until {
-            Some(t) => (t / dt).round() as u64,
-            None => built.steps,
-        };
+        if let Some(t) = scene.run.get_ref().until {
+            built.steps = steps_until(t, dt)?;
+        }
         built.dt = dt;
     }
     if let Some(n) = options.steps {
         built.steps = n;
     } else if let Some(t) = options.until {
-        built.steps = (t / built.dt).round() as u64;
+        built.steps = steps_until(t, built.dt)?;
+    }
+    if options.resume.is_none() {
+        mote_run::check_run_length(built.steps, built.dt, options.force)
+            .map_err(|m| MdError::Length(format!("{file_label}: {m}")))?;
     }
     let dir = options
         .out_dir

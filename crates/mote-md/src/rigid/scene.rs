@@ -882,7 +882,18 @@ impl RigidScene {
         }
         let steps = match (run.steps, run.until) {
             (Some(s), None) => s,
-            (None, Some(t)) => (t / run.dt).round() as u64,
+            (None, Some(t)) => match mote_run::steps_until(0.0, t, run.dt) {
+                Some(n) => n,
+                None => {
+                    return Err(err(
+                        rspan,
+                        format!(
+                            "[run] until = {t} with dt = {}: not a number of steps a run can take",
+                            run.dt
+                        ),
+                    ))
+                }
+            },
             _ => {
                 return Err(err(
                     rspan,

@@ -182,6 +182,7 @@ impl Scene {
         if !made.springs.is_empty() {
             b.forces.push(SpringNetwork {
                 springs: made.springs,
+                virial: 0.0,
             });
         }
         add(&self.field, self, &mut b)?;

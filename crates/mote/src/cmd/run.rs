@@ -45,6 +45,10 @@ pub struct RunArgs {
     /// [output] trajectory_format).
     #[arg(long, value_name = "FORMAT", conflicts_with = "resume")]
     pub trajectory_format: Option<String>,
+    /// Run even if the run takes more than 10⁹ steps (refused otherwise as
+    /// a likely mistyped time step or end time).
+    #[arg(long)]
+    pub force: bool,
 }
 
 impl RunArgs {
@@ -63,6 +67,7 @@ impl RunArgs {
             trajectory_format: self.trajectory_format,
             seed: global.seed,
             threads: global.threads,
+            force: self.force,
             live: Default::default(),
         }
     }

@@ -656,8 +656,8 @@ impl Interaction for DipoleDipole {
         }
     }
 
-    fn virial(&self) -> f64 {
-        self.virial
+    fn virial(&self) -> Option<f64> {
+        Some(self.virial)
     }
 
     /// The ghost list's build (see [`GhostList::carried_state`]): rows are
@@ -845,6 +845,11 @@ impl Zeeman {
 }
 
 impl Interaction for Zeeman {
+    /// Not part of the pressure (see [`Interaction::virial`]).
+    fn virial(&self) -> Option<f64> {
+        Some(0.0)
+    }
+
     fn name(&self) -> &'static str {
         "zeeman"
     }

@@ -305,8 +305,8 @@ impl Interaction for GranularContacts {
         u
     }
 
-    fn virial(&self) -> f64 {
-        self.virial
+    fn virial(&self) -> Option<f64> {
+        Some(self.virial)
     }
 
     fn neighbour_reach(&self) -> Option<(f64, f64)> {

@@ -252,6 +252,11 @@ impl GranularWalls {
 }
 
 impl Interaction for GranularWalls {
+    /// Not part of the pressure (see [`Interaction::virial`]).
+    fn virial(&self) -> Option<f64> {
+        Some(0.0)
+    }
+
     fn name(&self) -> &'static str {
         "walls"
     }

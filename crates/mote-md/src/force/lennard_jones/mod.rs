@@ -225,8 +225,8 @@ impl Interaction for LennardJones {
         energy
     }
 
-    fn virial(&self) -> f64 {
-        self.virial
+    fn virial(&self) -> Option<f64> {
+        Some(self.virial)
     }
 
     /// The neighbour list's build (see [`GhostList::carried_state`]): rows
