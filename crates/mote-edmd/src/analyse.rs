@@ -20,8 +20,19 @@ pub fn for_pairs<const D: usize>(
     let n = pos.len();
     let mut ncell = [1usize; D];
     for d in 0..D {
-        let m = (simbox.size[d] / cutoff).floor() as usize;
-        ncell[d] = m.clamp(1, 1 << 10);
+        let m = (simbox.size[d] / cutoff).floor();
+        ncell[d] = if m.is_finite() { m as usize } else { 1 << 10 }.clamp(1, 1 << 10);
+    }
+    // At most about four cells a particle: cells larger than the cut-off
+    // are still right, and a box far larger than its spheres (or spheres
+    // of no size) must not make a grid of 2³⁰ empty cells.
+    let most = 4.0 * n.max(1) as f64;
+    let total = ncell.iter().map(|&m| m as f64).product::<f64>();
+    if total > most {
+        let shrink = (most / total).powf(1.0 / D as f64);
+        for m in ncell.iter_mut() {
+            *m = ((*m as f64 * shrink).floor() as usize).max(1);
+        }
     }
     // fewer than 3 cells on a periodic axis: neighbour cells would repeat
     let small = (0..D).any(|d| simbox.boundary[d] == Boundary::Periodic && ncell[d] < 3);

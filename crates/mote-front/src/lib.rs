@@ -121,8 +121,40 @@ impl RunOptions {
         if self.checkpoint_every == Some(0) {
             error::refuse!("{input}: --checkpoint-every 0: must be at least 1 step");
         }
+        if let Some(p) = &self.picture {
+            check_picture_path(p)?;
+        }
         Ok(())
     }
+}
+
+/// A picture is written as PNG: a path naming another format (`x.pdf`,
+/// `x.jpg`) is refused before anything runs, not filled with PNG bytes.
+pub fn check_picture_path(path: &std::path::Path) -> Result<(), FrontError> {
+    let png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        error::refuse!(
+            "{}: pictures are written as PNG: give a name ending in .png",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// The format of a packing or trajectory file named `path`, by its
+/// extension; an extension that names no format mote writes is refused
+/// (rather than written as extended XYZ under that name).
+pub fn written_format(path: &std::path::Path) -> Result<mote_io::trajectory::Format, FrontError> {
+    mote_io::trajectory::Format::of_path(path).ok_or_else(|| {
+        FrontError::request(format!(
+            "{}: the format follows the extension: .xyz (extended XYZ), .dump (LAMMPS), \
+             .gsd (HOOMD) or .pvd/.vtp (VTK)",
+            path.display()
+        ))
+    })
 }
 
 /// What a caller shows while a run goes: the opening line and progress.

@@ -578,3 +578,80 @@ fn the_soft_method_packs_and_says_what_it_found() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("bad.toml:4: [packing] walls = \"x\""), "{err}");
 }
+
+/// Degenerate packings: spheres of no size are refused at once (they made
+/// `analyse` build 2³⁰ cells and grow memory at 1 GB/s); a box of 1e300
+/// around real spheres is analysed in a moment (at most four cells a
+/// sphere).
+#[test]
+fn analyse_refuses_spheres_of_no_size_and_survives_a_huge_box() {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = |side: &str, radius: &str| {
+        let mut s = format!(
+            "1000\nLattice=\"{side} 0 0 0 {side} 0 0 0 {side}\" Properties=species:S:1:pos:R:3:radius:R:1 pbc=\"T T T\"\n"
+        );
+        for k in 0..1000 {
+            s += &format!("A {} {} {} {radius}\n", k % 10, (k / 10) % 10, k / 100);
+        }
+        s
+    };
+    for (name, side, radius) in [("zero.xyz", "10", "0"), ("huge.xyz", "1e300", "0.5")] {
+        std::fs::write(dir.path().join(name), frame(side, radius)).unwrap();
+    }
+    let start = std::time::Instant::now();
+    let o = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(["pack", "analyse", "zero.xyz"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("sphere 0 has radius 0"), "{err}");
+    let o = Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(["pack", "analyse", "huge.xyz"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("packing fraction      0.000000"));
+    assert!(start.elapsed().as_secs_f64() < 20.0);
+}
+
+/// Files follow their extension or are refused before anything is packed:
+/// `-o x.pdf` and `-o x.vtu` wrote extended XYZ under those names.
+#[test]
+fn packing_files_follow_their_extension_or_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, why) in [
+        (["-o", "x.pdf"], "the format follows the extension"),
+        (["-o", "x.vtu"], "the format follows the extension"),
+        (["--picture", "x.jpg"], "pictures are written as PNG"),
+    ] {
+        let o = mote()
+            .args(["pack", "--n", "50", "--max-pressure", "1e3"])
+            .args(args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(why) && !err.contains("mote pack: "), "{err}");
+        assert!(!dir.path().join(args[1]).exists());
+    }
+    let o = mote()
+        .args([
+            "run",
+            "example:sun-earth",
+            "--steps",
+            "2",
+            "--picture",
+            "x.pdf",
+            "-o",
+            "o",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(!dir.path().join("o").exists(), "refused before the run");
+}

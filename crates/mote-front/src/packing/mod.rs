@@ -359,7 +359,7 @@ impl PackFiles {
     ) -> Result<(), FrontError> {
         if let Some(path) = &self.xyz {
             use mote_io::trajectory::{Format, TrajectoryWriter};
-            let format = Format::of_path(path).unwrap_or_default();
+            let format: Format = crate::written_format(path)?;
             TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, frame)?;
             write_pov(frame, &Stem(path.with_extension("")).with("pov"))?;
         }

@@ -178,6 +178,14 @@ impl PackArgs {
 /// `mote run` (`mote_front::packing`), spelled as options.
 fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     let quiet = global.quiet;
+    // Files named for formats mote does not write are refused before the
+    // packing is made, not after.
+    if let Some(o) = &a.output {
+        mote_front::written_format(o)?;
+    }
+    if let Some(p) = &a.picture {
+        mote_front::check_picture_path(p)?;
+    }
     let spec = a.spec();
     let (seed, chosen) = mote_front::seed::resolve(global.seed, None);
     let settings = spec.settings(seed, Naming::Options, Path::new("."))?;
@@ -273,7 +281,26 @@ fn analyse_cmd(global: &GlobalOpts, a: &AnalyseArgs) -> anyhow::Result<ExitCode>
         a.tol >= 0.0 && a.bond > 1.0 && a.rmax > 0.0,
         "--tol must be ≥ 0, --bond > 1 and --rmax > 0"
     );
+    // A packing is of spheres with a size, in a box of finite size.
+    if let Some((i, r)) = frame
+        .radii
+        .iter()
+        .enumerate()
+        .find(|(_, r)| !(r.is_finite() && **r > 0.0))
+    {
+        anyhow::bail!(
+            "{}: sphere {i} has radius {r}: a packing's spheres have positive radii",
+            a.file.display()
+        );
+    }
+    if let Some(d) = (0..3).find(|&d| !frame.cell[d][d].is_finite()) {
+        anyhow::bail!(
+            "{}: the cell has no finite length on axis {d}",
+            a.file.display()
+        );
+    }
     if let Some(png) = &a.picture {
+        mote_front::check_picture_path(png)?;
         mote_render::frame::picture(frame, png, 800, 800)?;
     }
     let flat = frame.positions.iter().all(|p| p[2] == 0.0) && !frame.pbc[2];
