@@ -365,6 +365,11 @@ impl Scene {
             line: span.map_or(1, |s| source.line_of(s.start)),
             message: message.trim().to_string(),
         };
+        source.finite_numbers().map_err(|e| EdmdError::Scene {
+            file: file.to_string(),
+            line: e.line,
+            message: e.message.clone(),
+        })?;
         let document = toml_edit::ImDocument::parse(text).map_err(|e| at(e.span(), e.message()))?;
         let mut root = document.into_table();
         let hoisted = hoist_event_driven(&mut root, &source)?;

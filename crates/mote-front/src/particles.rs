@@ -122,6 +122,15 @@ pub(crate) fn run(
             input.label
         ),
     };
+    if let (RunLength::Until(t), None) = (length, &resumed) {
+        let t0 = built.simulation.system.time;
+        if t <= t0 {
+            refuse!(
+                "{}: until {t}: the run starts at t = {t0}: nothing to run",
+                input.label
+            );
+        }
+    }
     let total_steps = length
         .steps_from(built.simulation.system.time, built.simulation.dt)
         .map_err(|e| FrontError::request(format!("{}: {e}", input.label)))?;
@@ -299,6 +308,17 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
         format!(
             "Overdamped dynamics conserve no energy: potential energy went from {:.9e} to {:.9e} {}.",
             report.initial.potential, report.last.potential, e_unit
+        )
+    } else if sim.thermostat.is_some() {
+        // A bath exchanges energy with the system: a "drift" would mean
+        // nothing; the temperature is what the thermostat holds.
+        format!(
+            "A thermostat exchanges energy with a bath (no drift to report): total energy went from {:.9e} to {:.9e} {}, k_B T from {:.6e} to {:.6e}.",
+            report.initial.total_energy(),
+            report.last.total_energy(),
+            e_unit,
+            report.initial.kt,
+            report.last.kt,
         )
     } else {
         format!(

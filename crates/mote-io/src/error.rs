@@ -50,6 +50,53 @@ impl<'a> Source<'a> {
         Self { file, text }
     }
 
+    /// Refuses a TOML text that spells a number `nan` or `inf` anywhere
+    /// (`cutoff = nan` switched an interaction off without a word): no key
+    /// of any scene takes a number that is not finite. The error names the
+    /// line and the key. Text that is not TOML passes, for the scene's own
+    /// parser to report.
+    pub fn finite_numbers(&self) -> Result<(), ParseError> {
+        use toml_edit::{Item, Value};
+        fn value(src: &Source, key: &str, v: &Value) -> Result<(), ParseError> {
+            match v {
+                Value::Float(f) if !f.value().is_finite() => Err(ParseError::new(
+                    src.file,
+                    f.span().map_or(1, |s| src.line_of(s.start)),
+                    format!("{key} = {}: a number here must be finite", f.value()),
+                )),
+                Value::Array(a) => a
+                    .iter()
+                    .enumerate()
+                    .try_for_each(|(k, v)| value(src, &format!("{key}[{k}]"), v)),
+                Value::InlineTable(t) => t
+                    .iter()
+                    .try_for_each(|(k, v)| value(src, &format!("{key}.{k}"), v)),
+                _ => Ok(()),
+            }
+        }
+        fn item(src: &Source, key: &str, i: &Item) -> Result<(), ParseError> {
+            let join = |k: &str| {
+                if key.is_empty() {
+                    k.to_string()
+                } else {
+                    format!("{key}.{k}")
+                }
+            };
+            match i {
+                Item::Value(v) => value(src, key, v),
+                Item::Table(t) => t.iter().try_for_each(|(k, i)| item(src, &join(k), i)),
+                Item::ArrayOfTables(a) => a
+                    .iter()
+                    .try_for_each(|t| t.iter().try_for_each(|(k, i)| item(src, &join(k), i))),
+                Item::None => Ok(()),
+            }
+        }
+        match toml_edit::ImDocument::parse(self.text) {
+            Ok(doc) => item(self, "", doc.as_item()),
+            Err(_) => Ok(()),
+        }
+    }
+
     /// One-based line of a byte offset (offsets past the end give the last line).
     pub fn line_of(&self, offset: usize) -> usize {
         let end = offset.min(self.text.len());

@@ -678,6 +678,7 @@ pub(crate) fn run(
         ],
     )?;
     let source = mote_io::Source::new(&input.label, &input.text);
+    source.finite_numbers().map_err(FrontError::Parse)?;
     let scene: PackingScene = toml::from_str(&input.text)
         .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))?;
     if scene.run.is_some() {

@@ -472,6 +472,7 @@ pub fn is_rigid_scene(text: &str) -> bool {
 impl RigidScene {
     /// Parses a scene; errors are `file:line: message`.
     pub fn parse(text: &str, file: &str) -> Result<Self, ParseError> {
+        Source::new(file, text).finite_numbers()?;
         toml::from_str::<RigidScene>(text)
             .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
     }
@@ -882,6 +883,12 @@ impl RigidScene {
         }
         let steps = match (run.steps, run.until) {
             (Some(s), None) => s,
+            (None, Some(t)) if t <= 0.0 => {
+                return Err(err(
+                    rspan,
+                    format!("[run] until = {t}: must be a time after the start (t = 0)"),
+                ))
+            }
             (None, Some(t)) => match mote_run::steps_until(0.0, t, run.dt) {
                 Some(n) => n,
                 None => {

@@ -28,6 +28,18 @@ pub struct GravitySettings {
     pub theta: Option<f64>,
 }
 
+/// Two particles at exactly one position, if any (lowest indices of the
+/// first such pair in sorted order).
+pub(crate) fn coincident(position: &[DVec3]) -> Option<(usize, usize)> {
+    let mut order: Vec<usize> = (0..position.len()).collect();
+    let key = |i: &usize| position[*i].to_array().map(f64::to_bits);
+    order.sort_unstable_by_key(key);
+    order
+        .windows(2)
+        .find(|w| position[w[0]] == position[w[1]])
+        .map(|w| (w[0].min(w[1]), w[0].max(w[1])))
+}
+
 pub(crate) fn direct() -> String {
     "direct".into()
 }
@@ -37,6 +49,17 @@ impl Section for GravitySettings {
         let err = |msg: String| b.src.error(span.clone(), msg);
         if self.softening.is_nan() || self.softening < 0.0 {
             return Err(err("[gravity] softening must not be negative".into()));
+        }
+        if self.softening == 0.0 {
+            // Unsoftened gravity is infinite where two particles coincide
+            // (the pair would be skipped as 0/0 and the run go on wrong).
+            if let Some((i, j)) = coincident(&b.particles.position) {
+                return Err(err(format!(
+                    "particles {i} and {j} coincide at {:?}: unsoftened gravity is infinite there; \
+                     move one, or give [gravity] softening > 0",
+                    b.particles.position[i].to_array()
+                )));
+            }
         }
         let g = self.g.unwrap_or(scene.units.gravitational_constant());
         match (self.method.as_str(), self.theta) {

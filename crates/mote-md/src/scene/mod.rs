@@ -159,6 +159,7 @@ fn add<T: Section>(
 impl Scene {
     /// Parses a scene; errors are `file:line: message`.
     pub fn parse(text: &str, file: &str) -> Result<Scene, ParseError> {
+        Source::new(file, text).finite_numbers()?;
         toml::from_str::<Scene>(text)
             .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
     }

@@ -146,7 +146,16 @@ impl RunSettings {
         let length = match (self.steps, self.until) {
             (Some(_), Some(_)) => return Err(src.whole("[run] takes steps or until, not both")),
             (Some(s), None) => Some(RunLength::Steps(s)),
-            (None, Some(t)) => Some(RunLength::Until(t)),
+            (None, Some(t)) if t > 0.0 => Some(RunLength::Until(t)),
+            (None, Some(t)) => {
+                return Err(ParseError::new(
+                    src.file,
+                    src.key_line("until"),
+                    format!(
+                        "until = {t}: must be a time after the start (t = 0); steps = 0 runs none"
+                    ),
+                ))
+            }
             (None, None) => None,
         };
         Ok((integrator, dt, length))
