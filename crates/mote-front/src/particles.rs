@@ -140,6 +140,15 @@ pub(crate) fn run(
     }
 
     let dir = input.output_dir(args.output.as_ref(), scene.output.dir.as_ref());
+    if resumed.is_none() && !options.force {
+        check_disk(
+            &dir,
+            &scene.output,
+            total_steps,
+            built.simulation.system.particles.len(),
+        )
+        .map_err(|m| FrontError::request(format!("{}: {m}", input.label)))?;
+    }
     let folder = crate::lock::RunFolder::claim(
         &dir,
         &input.label,
@@ -351,6 +360,42 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
         dir.display(),
         files
     )
+}
+
+/// Refuses a run whose files would not fit on the disk of `dir`: a lower
+/// bound of what it writes (40 bytes a particle a trajectory frame, GSD's
+/// positions and velocities in f32 with a type; 100 bytes an observables
+/// row) against the free space of the nearest folder that exists.
+fn check_disk(
+    dir: &Path,
+    out: &mote_md::scene::OutputSettings,
+    steps: u64,
+    particles: usize,
+) -> Result<(), String> {
+    let frames = |every: u64| {
+        if every > 0 {
+            (steps / every + 1) as f64
+        } else {
+            0.0
+        }
+    };
+    let bytes = frames(out.trajectory_every) * particles as f64 * 40.0
+        + frames(out.observables_every) * 100.0;
+    let existing = dir
+        .ancestors()
+        .find(|p| p.exists())
+        .unwrap_or(Path::new("."));
+    match mote_io::system::free_disk(existing) {
+        Some(free) if bytes > free as f64 => Err(format!(
+            "the run writes at least {} into {} ({} steps, {particles} particles) and its disk has {} free; \
+             write less often ([output] trajectory_every), or give --force",
+            mote_io::system::human_bytes(bytes),
+            dir.display(),
+            steps,
+            mote_io::system::human_bytes(free as f64)
+        )),
+        _ => Ok(()),
+    }
 }
 
 fn rel(e: f64, e0: f64) -> f64 {

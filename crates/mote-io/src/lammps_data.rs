@@ -188,6 +188,26 @@ pub fn parse_as(
                 }
                 "Velocities" => "velocities",
                 "Masses" => "masses",
+                // What mote would drop: refused, never read as if absent.
+                "Bonds" | "Angles" | "Dihedrals" | "Impropers" => {
+                    return Err(err(
+                        line_no,
+                        format!(
+                            "{}: mote reads a data file's atoms, not its topology, which would be dropped; \
+                             give bonds as [[spring]] pairs in the scene and remove the section",
+                            words[0]
+                        ),
+                    ))
+                }
+                "Ellipsoids" | "Lines" | "Triangles" | "Bodies" => {
+                    return Err(err(
+                        line_no,
+                        format!(
+                            "{}: extended particles are not read by mote (they would be dropped)",
+                            words[0]
+                        ),
+                    ))
+                }
                 "Atom" if words.get(1..3) == Some(&["Type", "Labels"][..]) => "labels",
                 _ => "other",
             };

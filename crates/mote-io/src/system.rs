@@ -48,6 +48,35 @@ pub fn check_fits(what: &str, bytes: f64) -> Result<(), String> {
     }
 }
 
+/// Bytes free to an unprivileged writer on the file system holding `dir`
+/// (`statvfs`: f_bavail × f_frsize), or `None` where that cannot be read
+/// or the file system has no blocks at all (/proc, /sys: there writing
+/// fails for its own reason, which the writer reports).
+pub fn free_disk(dir: &std::path::Path) -> Option<u64> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let path = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+        let mut stat = std::mem::MaybeUninit::<libc::statvfs>::zeroed();
+        // SAFETY: a NUL-terminated path and a buffer of the struct's size.
+        let rc = unsafe { libc::statvfs(path.as_ptr(), stat.as_mut_ptr()) };
+        if rc != 0 {
+            return None;
+        }
+        // SAFETY: statvfs succeeded and filled it.
+        let stat = unsafe { stat.assume_init() };
+        if stat.f_blocks == 0 {
+            return None;
+        }
+        Some((stat.f_bavail as u64).saturating_mul(stat.f_frsize as u64))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
+}
+
 /// A request to stop the run in progress, by signal number (SIGINT 2,
 /// SIGTERM 15; 0: none). Signal handlers set it (async-signal-safe: one
 /// atomic store); every engine's loop reads it once a step and then ends

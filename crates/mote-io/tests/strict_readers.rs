@@ -110,3 +110,15 @@ fn data_types_and_boxes_are_checked() {
         "must be a finite number",
     );
 }
+
+/// Topology is refused at its section, not dropped without a word.
+#[test]
+fn data_topology_is_refused_not_dropped() {
+    let bonded = DATA.replace("1 atom types\n", "1 atom types\n1 bonds\n1 bond types\n")
+        + "\nBonds\n\n1 1 1 2\n";
+    let e = lammps_data::parse(&bonded, "t").unwrap_err().to_string();
+    assert!(
+        e.contains("t:21: Bonds: mote reads a data file's atoms, not its topology"),
+        "{e}"
+    );
+}

@@ -232,3 +232,27 @@ fn a_full_stdout_or_stderr_ends_with_a_message_and_status_1() {
     let o = mote().args(["--bogus"]).stderr(full()).output().unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// A run whose files cannot fit on the disk is refused before it starts
+/// (4000 atoms written every step for 9·10⁸ steps: 144 TB at least), and
+/// nothing is made.
+#[test]
+fn a_run_that_cannot_fit_on_the_disk_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = "units = \"lj\"\n[run]\ndt = 0.005\nsteps = 900000000\n\
+        [lennard_jones]\ncutoff = 2.5\n[[fcc]]\ncells = [10, 10, 10]\ndensity = 0.8\n\
+        [output]\ntrajectory_every = 1\n";
+    std::fs::write(dir.path().join("big.toml"), scene).unwrap();
+    let o = mote()
+        .args(["run", "big.toml", "-o", "out"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the run writes at least 144.0 TB into out"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").exists());
+}
