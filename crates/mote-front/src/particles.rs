@@ -372,13 +372,8 @@ fn check_disk(
     steps: u64,
     particles: usize,
 ) -> Result<(), String> {
-    let frames = |every: u64| {
-        if every > 0 {
-            (steps / every + 1) as f64
-        } else {
-            0.0
-        }
-    };
+    // Every `every` steps and at the start; never where `every` is 0.
+    let frames = |every: u64| steps.checked_div(every).map_or(0.0, |n| (n + 1) as f64);
     let bytes = frames(out.trajectory_every) * particles as f64 * 40.0
         + frames(out.observables_every) * 100.0;
     let existing = dir

@@ -68,7 +68,10 @@ pub fn free_disk(dir: &std::path::Path) -> Option<u64> {
         if stat.f_blocks == 0 {
             return None;
         }
-        Some((stat.f_bavail as u64).saturating_mul(stat.f_frsize as u64))
+        // The fields' widths differ between platforms (u32 on some).
+        #[allow(clippy::unnecessary_cast)]
+        let (blocks, size) = (stat.f_bavail as u64, stat.f_frsize as u64);
+        Some(blocks.saturating_mul(size))
     }
     #[cfg(not(unix))]
     {
