@@ -57,7 +57,10 @@ pub struct Frame {
 
 impl Frame {
     /// A cell enclosing all positions with their radii (for open systems),
-    /// padded by `pad` on every side.
+    /// padded by `pad` on every side. An axis along which nothing extends
+    /// (a planar system, one particle) gets the largest extent of the
+    /// others, or 1 where there is none, with the particles in its middle:
+    /// a cell of 2.2e-308 is no box a reader can use.
     pub fn bounding_cell(
         positions: &[[f64; 3]],
         radii: &[f64],
@@ -78,10 +81,15 @@ impl Frame {
             lo = [0.0; 3];
             hi = [1.0; 3];
         }
+        let widest = (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
         let mut cell = [[0.0; 3]; 3];
         for d in 0..3 {
-            let len = (hi[d] - lo[d]).max(f64::MIN_POSITIVE) + 2.0 * pad;
-            cell[d][d] = len;
+            let mut len = hi[d] - lo[d];
+            if len <= 0.0 {
+                len = if widest > 0.0 { widest } else { 1.0 };
+                lo[d] -= 0.5 * len;
+            }
+            cell[d][d] = len + 2.0 * pad;
             lo[d] -= pad;
         }
         (cell, lo)
@@ -699,6 +707,18 @@ fn key_value<'a>(comment: &'a str, key: &str) -> Option<&'a str> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A planar system's cell has a usable thickness: the widest extent,
+    /// the plane in its middle; one point gets a unit cell around it.
+    #[test]
+    fn flat_and_single_point_cells_have_a_size() {
+        let (cell, origin) = Frame::bounding_cell(&[[0.0, 0.0, 2.0], [4.0, 1.0, 2.0]], &[], 0.0);
+        assert_eq!([cell[0][0], cell[1][1], cell[2][2]], [4.0, 1.0, 4.0]);
+        assert_eq!(origin, [0.0, 0.0, 0.0]);
+        let (cell, origin) = Frame::bounding_cell(&[[1.0, 1.0, 1.0]], &[], 0.5);
+        assert_eq!([cell[0][0], cell[1][1], cell[2][2]], [2.0, 2.0, 2.0]);
+        assert_eq!(origin, [0.0, 0.0, 0.0]);
+    }
 
     #[test]
     fn frames_round_trip() {

@@ -176,8 +176,18 @@ pub fn scene_from_frame(
 /// A radius for point particles: a third of the mean spacing `(V/N)^(1/d)` in the
 /// frame's bounding box, d the number of axes along which the particles spread.
 pub fn default_radius(frame: &Frame) -> f64 {
-    let (cell, _) = Frame::bounding_cell(&frame.positions, &[], 0.0);
-    let ext = [cell[0][0], cell[1][1], cell[2][2]];
+    // The extent of the positions themselves (a bounding cell gives flat
+    // axes a thickness, which is not a spread).
+    let mut ext = [0.0f64; 3];
+    for d in 0..3 {
+        let (lo, hi) = frame
+            .positions
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[d]), hi.max(p[d]))
+            });
+        ext[d] = (hi - lo).max(0.0);
+    }
     let n = frame.positions.len().max(1) as f64;
     // Mean spacing in the dimensions the particles spread in (a flat or linear
     // arrangement has zero extent along some axes).
