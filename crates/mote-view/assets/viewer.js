@@ -21,7 +21,11 @@ function fail(message) {
   e.style.display = "block";
   publish();
 }
-window.addEventListener("error", (e) => fail(`${e.message} (${e.filename}:${e.lineno})`));
+window.addEventListener("error", (e) => {
+  // An error already shown (thrown to stop the script) is not shown twice.
+  if (e.error && e.error.shown) return;
+  fail(`${e.message} (${e.filename}:${e.lineno})`);
+});
 window.addEventListener("unhandledrejection", (e) => fail(String(e.reason)));
 const consoleError = console.error;
 console.error = (...args) => { scene.errors.push(args.join(" ")); consoleError(...args); };
@@ -37,6 +41,14 @@ if (params.get("color")) scene.color = params.get("color");
 
 const canvas = $("view");
 const gl = canvas.getContext("webgl2", { antialias: true });
+if (!gl) {
+  // Without WebGL2 nothing can be drawn: say why, rather than the "null"
+  // of the first call on a missing context.
+  const why = "this browser gives the page no WebGL2 context (turned off, or no graphics driver): " +
+    "try another browser, or enable hardware acceleration";
+  fail(why);
+  throw Object.assign(new Error(why), { shown: true });
+}
 
 // Colour maps of both sphere programs: viridis for quantities, a palette
 // of eight for species.

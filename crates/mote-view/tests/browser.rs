@@ -270,3 +270,33 @@ fn a_live_run_advances_and_takes_a_change_from_the_page() {
     }
     mote_io::system::request_stop(15);
 }
+
+/// A browser without WebGL2 gets one line that says so (it said "null"
+/// from the first call on the missing context).
+#[test]
+fn a_browser_without_webgl2_is_told_why() {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: no Chromium (install Debian's chromium, or set MOTE_CHROMIUM)");
+        return;
+    };
+    let port = start();
+    let out = headless(
+        &browser,
+        &[
+            "--dump-dom".into(),
+            "--disable-webgl".into(),
+            "--disable-webgl2".into(),
+        ],
+        &format!("http://127.0.0.1:{port}/"),
+    );
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let state = page_state(&dom);
+    let errors: Vec<String> = state["errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_str().unwrap_or("").to_string())
+        .collect();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(errors[0].contains("no WebGL2 context"), "{errors:?}");
+}
