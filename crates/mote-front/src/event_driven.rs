@@ -120,12 +120,19 @@ fn run_events(
         scene.histogram = None;
     }
     let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
-    let folder = crate::lock::RunFolder::claim(
-        &dir,
-        &input.label,
-        &input.text,
-        resumed.zip(options.resume.as_deref()),
-    )?;
+    // A run that writes no files (`--no-output`) takes no folder: it
+    // neither makes one nor marks the current one as its own.
+    let writes = !words.no_output || options.checkpoint_every.is_some() || resumed.is_some();
+    let folder = if writes {
+        Some(crate::lock::RunFolder::claim(
+            &dir,
+            &input.label,
+            &input.text,
+            resumed.zip(options.resume.as_deref()),
+        )?)
+    } else {
+        None
+    };
     let scene_dir = input.folder();
     let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
     monitor.start(&format!(
@@ -166,7 +173,11 @@ fn run_events(
                 ),
             ]
             .into_iter()
-            .chain(folder.checkpoint_options())
+            .chain(
+                folder
+                    .iter()
+                    .flat_map(crate::lock::RunFolder::checkpoint_options),
+            )
             .collect(),
             input_label: input.label.clone(),
             input_text: input.text.clone(),

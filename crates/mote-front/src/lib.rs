@@ -264,16 +264,6 @@ fn threads_phrase() -> String {
     format!("{n} thread{}", if n == 1 { "" } else { "s" })
 }
 
-/// A number as people write it: plain between 10⁻⁴ and 10⁶, else in
-/// exponent form (`1e-300`, not three hundred zeros).
-pub(crate) fn number(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) || !x.is_finite() {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
-
 /// ", seed 7" or ", seed 7 (chosen)".
 fn seed_phrase(seed: u64, chosen: bool) -> String {
     format!("seed {seed}{}", if chosen { " (chosen)" } else { "" })

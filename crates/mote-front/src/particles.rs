@@ -258,7 +258,7 @@ pub(crate) fn run(
         input.label,
         sim.system.particles.len(),
         propagator,
-        crate::number(sim.dt),
+        mote_io::system::human_number(sim.dt),
         steps,
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase(),
@@ -363,8 +363,8 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
 }
 
 /// Refuses a run whose files would not fit on the disk of `dir`: a lower
-/// bound of what it writes (40 bytes a particle a trajectory frame, GSD's
-/// positions and velocities in f32 with a type; 100 bytes an observables
+/// bound of what it writes (12 bytes a particle a trajectory frame, a
+/// position in f32, the least any format writes; 100 bytes an observables
 /// row) against the free space of the nearest folder that exists.
 fn check_disk(
     dir: &Path,
@@ -374,7 +374,7 @@ fn check_disk(
 ) -> Result<(), String> {
     // Every `every` steps and at the start; never where `every` is 0.
     let frames = |every: u64| steps.checked_div(every).map_or(0.0, |n| (n + 1) as f64);
-    let bytes = frames(out.trajectory_every) * particles as f64 * 40.0
+    let bytes = frames(out.trajectory_every) * particles as f64 * 12.0
         + frames(out.observables_every) * 100.0;
     let existing = dir
         .ancestors()

@@ -102,7 +102,7 @@ fn run_with(
     monitor.start(&format!(
         "mote run {}: rigid clumps (FRBI) with dt = {}, {}, {}",
         input.label,
-        crate::number(options.dt.unwrap_or(scene.run.get_ref().dt)),
+        mote_io::system::human_number(options.dt.unwrap_or(scene.run.get_ref().dt)),
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase(),
     ));
@@ -139,7 +139,7 @@ fn run_with(
         input.label,
         report.bodies,
         report.spheres,
-        crate::number(report.dt),
+        mote_io::system::human_number(report.dt),
         report.steps,
         report.time,
         report.wall_seconds,

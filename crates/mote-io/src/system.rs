@@ -35,6 +35,16 @@ pub fn human_bytes(bytes: f64) -> String {
     }
 }
 
+/// A number as people write it: plain between 10⁻⁴ and 10⁶, else with an
+/// exponent (`1e-300` and `1e308`, not hundreds of digits).
+pub fn human_number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// `Err(message)` when `bytes` (a lower bound of what `what` needs) exceeds
 /// the available memory; the message gives both numbers.
 pub fn check_fits(what: &str, bytes: f64) -> Result<(), String> {

@@ -234,7 +234,7 @@ fn a_full_stdout_or_stderr_ends_with_a_message_and_status_1() {
 }
 
 /// A run whose files cannot fit on the disk is refused before it starts
-/// (4000 atoms written every step for 9·10⁸ steps: 144 TB at least), and
+/// (4000 atoms written every step for 9·10⁸ steps: 43 TB at least), and
 /// nothing is made.
 #[test]
 fn a_run_that_cannot_fit_on_the_disk_is_refused() {
@@ -251,7 +251,7 @@ fn a_run_that_cannot_fit_on_the_disk_is_refused() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("the run writes at least 144.0 TB into out"),
+        err.contains("the run writes at least 43.2 TB into out"),
         "{err}"
     );
     assert!(!dir.path().join("out").exists());

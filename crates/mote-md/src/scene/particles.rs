@@ -544,16 +544,6 @@ fn refuse_too_large(scene: &Scene, src: Source) -> Result<(), ParseError> {
 
 /// Makes every particle of the scene, in the order of the module's doc,
 /// drawing from `rng` in that order.
-/// A number as people write it: plain between 10⁻⁴ and 10⁶, else with an
-/// exponent (1e308, not 309 digits).
-fn short(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
-
 pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<Made, ParseError> {
     refuse_too_large(scene, src)?;
     let file = src.file;
@@ -584,14 +574,17 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
                 span,
                 format!(
                     "mass must be positive and at most 1e100, found {}",
-                    short(p.mass)
+                    mote_io::system::human_number(p.mass)
                 ),
             ));
         }
         if !(0.0..=1e100).contains(&p.radius) {
             return Err(err(
                 span,
-                format!("radius must be in [0, 1e100], found {}", short(p.radius)),
+                format!(
+                    "radius must be in [0, 1e100], found {}",
+                    mote_io::system::human_number(p.radius)
+                ),
             ));
         }
         if p.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
