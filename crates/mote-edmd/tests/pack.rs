@@ -6,7 +6,7 @@
 //! spheropack's published φ_J curve, the 2-D bidisperse packing, the
 //! lognormal family against `mote rcp` and the isostatic N = 10⁴ packing are
 //! `#[ignore]`d (minutes each): run them with
-//! `cargo test --release -p mote-edmd --test pack -- --ignored --nocapture`.
+//! `cargo test --release -p mote-edmd --test edmd pack:: -- --ignored --nocapture`.
 
 use mote_edmd::analyse::{bond_order, contacts, deepest_overlap};
 use mote_edmd::pack::{Finish, PackSettings, Packer, SizeSpec, Stop};

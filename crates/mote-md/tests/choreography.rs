@@ -1,6 +1,6 @@
 //! Circular choreographies (002 §4.3, Eq. 16, Table 1).
 
-mod common;
+use crate::common;
 
 use common::*;
 use mote_md::init::choreography_speed;

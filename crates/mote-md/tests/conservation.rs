@@ -1,6 +1,6 @@
 //! Conservation laws and fixed degrees of freedom.
 
-mod common;
+use crate::common;
 
 use common::*;
 use mote_md::{DVec3, Observables};

@@ -12,7 +12,7 @@
 //! α = mH/k_BT. Statistical errors from block averages (12 blocks of 1 τ after 3 τ of equilibration,
 //! τ = time unit σ²ξ_t/k_BT).
 //!
-//! `cargo test -p mote-md --test dipolar_mmf -- --ignored --nocapture`
+//! `cargo test -p mote-md --test md dipolar_mmf:: -- --ignored --nocapture`
 
 use std::f64::consts::PI;
 

@@ -1,5 +1,5 @@
 //! Timed runs (ignored; figures for BENCHMARKS.md), one thread unless stated:
-//! `cargo test --release -p mote-md --test dipolar_perf -- --ignored --nocapture --test-threads 1`
+//! `cargo test --release -p mote-md --test md dipolar_perf:: -- --ignored --nocapture --test-threads 1`
 //!
 //! - the dipolar LJ fluid of ../shared/bench/lammps.dipole3d.in (32000
 //!   atoms, fcc ρ* = 0.8442, |μ| = 0.75, LJ + dipoles cut at 2.5, skin 0.3,

@@ -3,7 +3,7 @@
 //! a cubic lattice of parallel dipoles, Coulomb's circular orbit, and a
 //! charge accelerated by a constant and an oscillating field.
 
-mod common;
+use crate::common;
 
 use mote_md::{DVec3, Observables};
 

@@ -1,7 +1,7 @@
 //! Sun–Earth in astronomical units (002 §4.1): period, and the error
 //! behaviour of each integrator (max error over the run, not the final value).
 
-mod common;
+use crate::common;
 
 use common::*;
 use mote_md::{Integrator, Observables, Stepper};

@@ -1,7 +1,7 @@
 //! Lennard-Jones fluids: neighbour lists against brute force, energy
 //! conservation, the equation of state of Johnson, Zollweg & Gubbins (1993).
 
-mod common;
+use crate::common;
 
 use common::*;
 use mote_md::neighbor::VerletList;

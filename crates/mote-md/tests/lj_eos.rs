@@ -2,7 +2,7 @@
 //! of state of Johnson, Zollweg & Gubbins (1993), with the standard
 //! long-range tail corrections for the cut-off at 2.5σ (truncated, not shifted).
 
-mod common;
+use crate::common;
 
 use common::*;
 use mote_md::force::LennardJones;

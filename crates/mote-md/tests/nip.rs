@@ -114,7 +114,7 @@ fn toning_nip_example_runs_and_writes_nip_csv() {
 
 /// The development itself: 10⁴ steps (0.5 ms; about a minute in release):
 /// toner develops onto the image, hardly onto the background.
-/// `cargo test --release -p mote-md --test nip -- --ignored --nocapture`
+/// `cargo test --release -p mote-md --test md nip:: -- --ignored --nocapture`
 #[test]
 #[ignore]
 fn toning_nip_develops_the_image_not_the_background() {

@@ -1,7 +1,7 @@
 //! A mass on a damped spring (002 Eq. 3) against the analytic solutions of
 //! the under-, critically and over-damped oscillator.
 
-mod common;
+use crate::common;
 
 use common::*;
 

@@ -1,6 +1,6 @@
 //! An MPPphys particle file and its TOML twin run identical physics.
 
-mod common;
+use crate::common;
 
 use mote_md::scene::{PlistSystem, Scene};
 

@@ -12,7 +12,7 @@ use mote_view::live::Session;
 use mote_view::App;
 use tungstenite::{Message, WebSocket};
 
-mod common;
+use crate::common;
 
 /// A stand-in for a run: `n` particles moving along x, stepping `h`
 /// (changed by `Change::Dt`) for ever; the changes it took are recorded.

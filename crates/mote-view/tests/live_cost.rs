@@ -3,7 +3,7 @@
 //! client that takes every frame it can (as a page on a fast GPU would).
 //! Prints steps per second of both and the frames delivered.
 //!
-//!     cargo test --release -p mote-view --test live_cost -- --ignored --nocapture
+//!     cargo test --release -p mote-view --test view live_cost:: -- --ignored --nocapture
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -12,7 +12,7 @@ use mote_view::live::{self, Session};
 use mote_view::App;
 use tungstenite::Message;
 
-mod common;
+use crate::common;
 
 fn run(watched: bool) -> (f64, u64) {
     let dir = tempfile::tempdir().unwrap();

@@ -6,7 +6,7 @@
 //! time to the first frame, and redraws per second at full resolution and
 //! while the camera moves (level of detail).
 //!
-//!     cargo test --release -p mote-view --test render_cost -- --ignored --nocapture
+//!     cargo test --release -p mote-view --test view render_cost:: -- --ignored --nocapture
 
 use std::time::Duration;
 
@@ -14,8 +14,8 @@ use mote_io::xyz::Frame;
 use rand::{Rng, SeedableRng};
 
 #[allow(dead_code)] // the screenshot helper is the live browser test's
-mod cdp;
-mod common;
+use crate::cdp;
+use crate::common;
 
 #[test]
 #[ignore]

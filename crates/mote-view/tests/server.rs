@@ -8,7 +8,7 @@ use std::net::TcpStream;
 use mote_io::xyz::Frame;
 use mote_view::bind;
 
-mod common;
+use crate::common;
 
 fn frames() -> Vec<Frame> {
     (0..3)

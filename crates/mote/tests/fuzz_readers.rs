@@ -4,7 +4,7 @@
 //! doubled or dropped) and handed to the reader, which must answer Ok or a
 //! `file:line` error: never panic, never take more than a second. A short
 //! run belongs to the suite; the long one is
-//! `cargo test --release -p mote --test fuzz_readers -- --ignored --nocapture`.
+//! `cargo test --release -p mote --test cli fuzz_readers:: -- --ignored --nocapture`.
 //! `mote rcp`'s standard input is fuzzed through the program itself (its
 //! reader is the command's): every mutated input must end in under five
 //! seconds with status 0 or spherepack1d's 255 and no panic.

@@ -8,7 +8,7 @@
 //! The samples go to stdout (and to `MOTE_SOAK_LOG` when set), with the
 //! bytes per particle.
 //!
-//! `cargo test --release -p mote --test soak -- --ignored --nocapture`
+//! `cargo test --release -p mote --test cli soak:: -- --ignored --nocapture`
 //! (two runs of an hour each; `MOTE_SOAK_THREADS` sets `--threads`, 1 by
 //! default).
 

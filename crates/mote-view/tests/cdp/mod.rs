@@ -2,6 +2,7 @@
 //! Playwright and chromedriver speak), for pages that change in real time:
 //! the test reads the page's state while it runs instead of after a
 //! virtual-time budget.
+#![allow(dead_code)] // each test binary uses some of it
 
 use std::io::{Read, Write};
 use std::net::TcpStream;

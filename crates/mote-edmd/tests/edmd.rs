@@ -1,0 +1,9 @@
+//! The integration tests of mote-edmd, one binary (`cargo test -p mote-edmd --test edmd MODULE::`).
+
+mod conservation;
+mod cradle;
+mod pack;
+mod polydisperse;
+mod robust;
+mod scene;
+mod statistics;
