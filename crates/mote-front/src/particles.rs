@@ -181,6 +181,7 @@ pub(crate) fn run(
             // gives its virial (the summary says which does not).
             sim.system.boundary.periodic.iter().all(|p| *p)
                 && sim.forces.without_virial().is_empty(),
+            sim.forces.pressure_tensor,
             &sim.forces
                 .interactions
                 .iter()

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use crate::force::{ForceField, State};
+use crate::force::{ForceField, State, Virial};
 use crate::particles::System;
 
 /// Whole-system observables at one instant.
@@ -23,6 +23,10 @@ pub struct Observables {
     pub kt: f64,
     /// P = (2K + W)/(3V) from the virial W of the last force evaluation; NaN without a periodic box.
     pub pressure: f64,
+    /// P_αβ = (Σ m v_α v_β + W_αβ)/V as [xx, yy, zz, xy, xz, yz], when the
+    /// force field measures it ([`ForceField::pressure_tensor`]) in a box
+    /// periodic on every axis; NaN otherwise.
+    pub pressure_tensor: [f64; 6],
     /// The force the particles exert on each wall (name, force), from the
     /// last force evaluation.
     pub wall_forces: Vec<(String, DVec3)>,
@@ -65,8 +69,19 @@ impl Observables {
             }
             _ => f64::NAN,
         };
+        let mut pressure_tensor = [f64::NAN; 6];
+        if ff.pressure_tensor && pressure.is_finite() {
+            if let Some(w) = ff.virial_tensor(&state) {
+                let mut kinetic = Virial::default();
+                for (m, v) in p.mass.iter().zip(&p.velocity) {
+                    kinetic += Virial::pair(*v, *v * *m);
+                }
+                pressure_tensor = (kinetic + w).scaled(1.0 / volume).0;
+            }
+        }
         Self {
             time: sys.time,
+            pressure_tensor,
             kinetic,
             rotational,
             potential,

@@ -17,13 +17,15 @@ use crate::units::UnitSystem;
 use mote_run::Observer;
 
 /// observables.csv: time, energies, momentum, angular momentum, step, k_B T,
-/// the pressure (only for a box periodic on every axis), probes, the total
+/// the pressure (only for a box periodic on every axis) and its tensor
+/// (`pxx pyy pzz pxy pxz pyz`, when the force field measures it), probes, the total
 /// magnetic moment (when there are dipoles), the force on each wall.
 pub struct ObservablesCsv {
     writer: CsvWriter,
     every: u64,
     probes: Vec<Probe>,
     pressure: bool,
+    tensor: bool,
     walls: usize,
     magnetic: bool,
 }
@@ -37,6 +39,7 @@ impl ObservablesCsv {
         every: u64,
         probes: Vec<Probe>,
         pressure: bool,
+        tensor: bool,
         walls: &[String],
         magnetic: bool,
         append: bool,
@@ -65,6 +68,12 @@ impl ObservablesCsv {
         if !pressure {
             columns.pop();
             unit_row.pop();
+        }
+        if tensor {
+            for axes in crate::force::Virial::AXES {
+                columns.push(format!("p{axes}"));
+                unit_row.push(format!("{e}/{l}^3"));
+            }
         }
         for probe in &probes {
             columns.push(probe.label());
@@ -99,6 +108,7 @@ impl ObservablesCsv {
             every,
             probes,
             pressure,
+            tensor,
             walls: walls.len(),
             magnetic,
         })
@@ -115,6 +125,9 @@ impl Observer<Simulation> for ObservablesCsv {
         let mut row: Vec<f64> = obs.values(sys.step).to_vec();
         if !self.pressure {
             row.pop();
+        }
+        if self.tensor {
+            row.extend(obs.pressure_tensor);
         }
         row.extend(self.probes.iter().map(|p| p.read(sys)));
         if self.magnetic {

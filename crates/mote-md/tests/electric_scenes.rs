@@ -13,7 +13,7 @@ const MADELUNG_NACL: f64 = 1.747_564_594_633;
 
 /// The 8 ions of rock salt's cubic cell (nearest-neighbour distance 1) in a
 /// periodic box of side 2.
-fn rock_salt(method_keys: &str) -> String {
+pub fn rock_salt(method_keys: &str) -> String {
     rock_salt_scaled(method_keys, 1.0)
 }
 

@@ -22,6 +22,7 @@ mod magnet;
 mod nip;
 mod oscillator;
 mod plist_twin;
+mod pressure;
 mod rigid_contacts;
 mod rigid_field;
 mod rigid_free_flight;

@@ -17,7 +17,7 @@
 
 use glam::DVec3;
 
-use super::{DirectGravity, Interaction, State};
+use super::{DirectGravity, Interaction, State, Virial};
 
 /// Coulomb's law between all pairs of charges, in open space.
 #[derive(Debug, Clone)]
@@ -94,6 +94,10 @@ impl Interaction for ElectricField {
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
+    }
+
+    fn virial_tensor(&mut self, _: &State) -> Option<Virial> {
+        Some(Virial::default())
     }
 
     fn name(&self) -> &'static str {

@@ -14,6 +14,7 @@ mod lennard_jones;
 pub mod slab;
 mod springs;
 mod uniform;
+mod virial;
 
 pub use damping::GlobalDamping;
 pub use electric::{DirectCoulomb, ElectricField};
@@ -21,6 +22,7 @@ pub use gravity::DirectGravity;
 pub use lennard_jones::LennardJones;
 pub use springs::{Spring, SpringNetwork};
 pub use uniform::UniformField;
+pub use virial::Virial;
 
 /// "(1, 0, 0)": a vector as a change's answer writes it.
 pub(crate) fn vector_text(v: DVec3) -> String {
@@ -228,6 +230,16 @@ pub trait Interaction: Send {
     fn virial(&self) -> Option<f64> {
         None
     }
+    /// The virial tensor W_αβ = Σ_pairs r_ij,α F_ij,β at `state` (see
+    /// [`Virial`]), computed when a run asks for the pressure tensor
+    /// (`[output] pressure_tensor`), not at every step; `None` where the
+    /// interaction does not compute it (the run is then refused, never
+    /// given a tensor without its part). Fields, damping and walls give
+    /// zero, as [`Interaction::virial`] says.
+    fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        let _ = state;
+        None
+    }
     /// The (cut-off, skin) of the pairs this interaction reads from the
     /// shared neighbour list ([`State::neighbours`]); `None` if it reads none.
     fn neighbour_reach(&self) -> Option<(f64, f64)> {
@@ -276,6 +288,9 @@ fn sharing<'a>(state: &State<'a>, neighbours: &'a Option<(VerletList, usize)>) -
 #[derive(Default)]
 pub struct ForceField {
     pub interactions: Vec<Box<dyn Interaction>>,
+    /// Measure the pressure tensor with the observables (a pass of its
+    /// own over the pairs: only when a run writes it).
+    pub pressure_tensor: bool,
     force: Vec<DVec3>,
     torque: Vec<DVec3>,
     /// The shared half list and the number of interactions it was made for.
@@ -416,6 +431,27 @@ impl ForceField {
     /// does not compute its part ([`ForceField::without_virial`]).
     pub fn virial(&self) -> Option<f64> {
         self.interactions.iter().map(|i| i.virial()).sum()
+    }
+
+    /// The virial tensor at `state`, summed over the interactions; `None`
+    /// if one does not compute its part ([`ForceField::without_virial_tensor`]).
+    pub fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        self.refresh_neighbours(state);
+        let state = &sharing(state, &self.neighbours);
+        self.interactions
+            .iter_mut()
+            .map(|i| i.virial_tensor(state))
+            .sum()
+    }
+
+    /// The interactions that do not compute their virial tensor.
+    pub fn without_virial_tensor(&mut self, state: &State) -> Vec<&'static str> {
+        self.refresh_neighbours(state);
+        let state = &sharing(state, &self.neighbours);
+        self.interactions
+            .iter_mut()
+            .filter_map(|i| i.virial_tensor(state).is_none().then(|| i.name()))
+            .collect()
     }
 
     /// The interactions that do not compute their virial: with any of them

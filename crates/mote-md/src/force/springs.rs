@@ -3,11 +3,12 @@
 //! F_i = Σ_j [ D_ij (x_j − x_i)/|x_j − x_i| (|x_j − x_i| − l_ij) + c_ij (v_j − v_i) ],
 //!
 //! with stiffness D, damping c (along the full relative velocity, as in the
-//! seed) and rest length l; F_j = −F_i for each spring.
+//! seed) and rest length l; F_j = −F_i for each spring. In a periodic box
+//! x_j − x_i is the minimum image, so a spring may cross the box's faces.
 
 use glam::DVec3;
 
-use super::{Interaction, State};
+use super::{Interaction, State, Virial};
 
 /// One spring.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,10 +32,10 @@ pub struct SpringNetwork {
 }
 
 impl SpringNetwork {
-    /// Elastic plus damping force on particle i of one spring.
+    /// Elastic plus damping force on particle i of one spring whose
+    /// separation is d = x_j − x_i.
     #[inline]
-    fn force_on_i(s: &Spring, xi: DVec3, xj: DVec3, vi: DVec3, vj: DVec3) -> DVec3 {
-        let d = xj - xi;
+    fn force_on_i(s: &Spring, d: DVec3, vi: DVec3, vj: DVec3) -> DVec3 {
         let len = d.length();
         let elastic = if len > 0.0 {
             d * (s.stiffness * (len - s.rest_length) / len)
@@ -52,13 +53,15 @@ impl Interaction for SpringNetwork {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let (x, v) = (state.position, state.velocity);
+        let image = state.boundary.image();
         let mut virial = 0.0;
         for s in &self.springs {
-            let f = Self::force_on_i(s, x[s.i], x[s.j], v[s.i], v[s.j]);
+            let d = image.apply(x[s.j] - x[s.i]);
+            let f = Self::force_on_i(s, d, v[s.i], v[s.j]);
             force[s.i] += f;
             force[s.j] -= f;
-            // r_ij · F_ij with r_ij = x_i − x_j and F_ij = f on i.
-            virial += (x[s.i] - x[s.j]).dot(f);
+            // r_ij · F_ij with r_ij = x_i − x_j = −d and F_ij = f on i.
+            virial -= d.dot(f);
         }
         self.virial = virial;
     }
@@ -67,12 +70,27 @@ impl Interaction for SpringNetwork {
         Some(self.virial)
     }
 
+    fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        let (x, v) = (state.position, state.velocity);
+        let image = state.boundary.image();
+        Some(
+            self.springs
+                .iter()
+                .map(|s| {
+                    let d = image.apply(x[s.j] - x[s.i]);
+                    Virial::pair(-d, Self::force_on_i(s, d, v[s.i], v[s.j]))
+                })
+                .sum(),
+        )
+    }
+
     /// U = Σ ½ D (|x_j − x_i| − l)².
     fn potential_energy(&mut self, state: &State) -> f64 {
+        let (x, image) = (state.position, state.boundary.image());
         self.springs
             .iter()
             .map(|s| {
-                let stretch = (state.position[s.j] - state.position[s.i]).length() - s.rest_length;
+                let stretch = image.apply(x[s.j] - x[s.i]).length() - s.rest_length;
                 0.5 * s.stiffness * stretch * stretch
             })
             .sum()

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Interaction, State};
+use super::{Interaction, State, Virial};
 
 /// Uniform acceleration g acting on every particle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -14,6 +14,10 @@ impl Interaction for UniformField {
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
+    }
+
+    fn virial_tensor(&mut self, _: &State) -> Option<Virial> {
+        Some(Virial::default())
     }
 
     fn name(&self) -> &'static str {

@@ -494,6 +494,12 @@ impl RigidScene {
                 "[output] inspect names point particles; a rigid scene has bodies (their observables are in observables.csv)".into(),
             ));
         }
+        if let Some(p) = &self.output.pressure_tensor {
+            return Err(err(
+                p.span(),
+                "[output] pressure_tensor: the rigid engine does not measure pressure yet".into(),
+            ));
+        }
         let mut frbi = Frbi::new();
         if let Some(f) = &rigid.free_flight {
             frbi.flight = match f.get_ref().as_str() {

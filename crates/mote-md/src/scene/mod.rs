@@ -207,9 +207,14 @@ impl Scene {
         if self.run.centre_of_mass {
             system.to_centre_of_mass_frame();
         }
+        let mut forces = b.forces;
+        if let Some(asked) = &self.output.pressure_tensor {
+            forces.pressure_tensor = *asked.get_ref();
+            pressure_tensor_measurable(&system, &mut forces, asked.span(), src)?;
+        }
         Ok(Built {
             simulation: {
-                let mut sim = Simulation::new(system, b.forces, Stepper::new(integrator), dt, seed);
+                let mut sim = Simulation::new(system, forces, Stepper::new(integrator), dt, seed);
                 sim.thermostat = thermostat;
                 sim.brownian = brownian;
                 sim
@@ -219,6 +224,40 @@ impl Scene {
             seed,
         })
     }
+}
+
+/// Refuses `[output] pressure_tensor = true` where the tensor cannot be
+/// given: a box not periodic on every axis, or an interaction that does
+/// not compute its virial tensor.
+fn pressure_tensor_measurable(
+    system: &System,
+    forces: &mut ForceField,
+    span: Range<usize>,
+    src: Source,
+) -> Result<(), ParseError> {
+    if !forces.pressure_tensor {
+        return Ok(());
+    }
+    if !system.boundary.periodic.iter().all(|p| *p) {
+        return Err(src.error(
+            span,
+            "pressure_tensor needs a box periodic on every axis ([box] periodic = [true, true, true])",
+        ));
+    }
+    let p = &system.particles;
+    let state = crate::force::State::of(system, &p.position, &p.velocity, system.time, 0.0);
+    let without = forces.without_virial_tensor(&state);
+    if !without.is_empty() {
+        return Err(src.error(
+            span,
+            format!(
+                "pressure_tensor: {} do{} not compute the virial tensor yet",
+                without.join(", "),
+                if without.len() == 1 { "es" } else { "" }
+            ),
+        ));
+    }
+    Ok(())
 }
 
 pub(crate) fn one() -> f64 {

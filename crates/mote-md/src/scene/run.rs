@@ -63,6 +63,9 @@ pub struct OutputSettings {
     /// Per-particle quantities added to observables.csv, e.g. `["z[30]", "speed[1]"]`.
     #[serde(default)]
     pub inspect: Vec<Spanned<String>>,
+    /// Add the pressure tensor (`pxx pyy pzz pxy pxz pyz`) to
+    /// observables.csv; a box periodic on every axis is needed.
+    pub pressure_tensor: Option<Spanned<bool>>,
 }
 
 fn default_observables_every() -> u64 {
@@ -80,6 +83,7 @@ impl Default for OutputSettings {
             trajectory_every: default_trajectory_every(),
             trajectory_format: None,
             inspect: Vec::new(),
+            pressure_tensor: None,
         }
     }
 }

@@ -66,7 +66,7 @@ mod avx512;
 mod listed;
 mod tiled;
 
-use super::{Interaction, Spin, State};
+use super::{Interaction, Spin, State, Virial};
 use crate::boundary::Boundary;
 use crate::neighbor::{Copy4, GhostList};
 use crate::units::UnitSystem;
@@ -848,6 +848,10 @@ impl Interaction for Zeeman {
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
+    }
+
+    fn virial_tensor(&mut self, _: &State) -> Option<Virial> {
+        Some(Virial::default())
     }
 
     fn name(&self) -> &'static str {

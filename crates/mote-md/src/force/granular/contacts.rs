@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::history::PairHistories;
 use super::law::{ContactLaw, History};
-use crate::force::{add_block_buffers, BlockBuffers, Interaction, Spin, State};
+use crate::force::{add_block_buffers, BlockBuffers, Interaction, Spin, State, Virial};
 use crate::neighbor::VerletList;
 
 /// Hertz–Mindlin contacts between all spheres (see [`super::law`]).
@@ -27,7 +27,7 @@ pub struct GranularContacts {
     /// One (force, torque) buffer per extra block of particles.
     buffers: BlockBuffers,
     contacts: usize,
-    virial: f64,
+    virial: Virial,
 }
 
 impl GranularContacts {
@@ -41,7 +41,7 @@ impl GranularContacts {
             carried_to_build: 0,
             buffers: Vec::new(),
             contacts: 0,
-            virial: 0.0,
+            virial: Virial::default(),
         }
     }
 
@@ -122,7 +122,7 @@ impl GranularContacts {
         }
 
         let this = &*self;
-        let results: Vec<(usize, f64)> = targets
+        let results: Vec<(usize, Virial)> = targets
             .into_par_iter()
             .zip(history_blocks)
             .enumerate()
@@ -162,7 +162,7 @@ impl GranularContacts {
 
     /// The pairs of particles `range` (and their partners j > i), adding
     /// forces and torques into `out` = (base, f, t), f[k] and t[k] those of
-    /// particle base + k; returns (contacts, virial).
+    /// particle base + k; returns (contacts, virial tensor).
     #[allow(clippy::too_many_arguments)]
     fn block(
         &self,
@@ -174,7 +174,7 @@ impl GranularContacts {
         out: (usize, &mut [DVec3], &mut [DVec3]),
         hist: &mut [History],
         touch: &mut [bool],
-    ) -> (usize, f64) {
+    ) -> (usize, Virial) {
         let (base, f, t) = out;
         debug_assert!(base <= range.start);
         let pos = state.position;
@@ -184,7 +184,7 @@ impl GranularContacts {
         let image = state.boundary.image();
         let offset = list.start[range.start] as usize;
         let mut contacts = 0usize;
-        let mut virial = 0.0;
+        let mut virial = Virial::default();
         for i in range {
             let (ri, vi, wi, radi, mi) = (pos[i], vel[i], omega[i], radius[i], mass[i]);
             let (mut fi, mut ti) = (DVec3::ZERO, DVec3::ZERO);
@@ -229,7 +229,7 @@ impl GranularContacts {
                 ti += c.torque_i;
                 t[j - base] += c.torque_j;
                 contacts += 1;
-                virial += d.dot(c.force);
+                virial += Virial::pair(d, c.force);
             }
             f[i - base] += fi;
             t[i - base] += ti;
@@ -306,6 +306,12 @@ impl Interaction for GranularContacts {
     }
 
     fn virial(&self) -> Option<f64> {
+        Some(self.virial.trace())
+    }
+
+    /// The tensor of the last force evaluation (contact forces depend on
+    /// their histories, which only a step advances).
+    fn virial_tensor(&mut self, _: &State) -> Option<Virial> {
         Some(self.virial)
     }
 

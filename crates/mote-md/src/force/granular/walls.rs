@@ -7,7 +7,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::law::{ContactLaw, History};
-use crate::force::{Interaction, Spin, State};
+use crate::force::{Interaction, Spin, State, Virial};
 
 /// The shape of a wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -255,6 +255,10 @@ impl Interaction for GranularWalls {
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
+    }
+
+    fn virial_tensor(&mut self, _: &State) -> Option<Virial> {
+        Some(Virial::default())
     }
 
     fn name(&self) -> &'static str {

@@ -14,7 +14,7 @@
 //! else through the portable loop below; the two agree to a few ulp. Rows are
 //! summed in fixed blocks, so every thread count gives the same bits.
 
-use super::{Interaction, State};
+use super::{Interaction, State, Virial};
 use crate::neighbor::{Copy4, GhostList};
 use glam::DVec3;
 
@@ -227,6 +227,29 @@ impl Interaction for LennardJones {
 
     fn virial(&self) -> Option<f64> {
         Some(self.virial)
+    }
+
+    /// W_αβ = ½ Σ_rows Σ_j (F/r) r_α r_β over the full list, by the
+    /// portable pair law (a measurement, not a step: no SIMD kernel).
+    fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        self.list.refresh(state.position, state.boundary);
+        let (list, c) = (&self.list, self.coefficients());
+        let mut rows = vec![(); list.len()];
+        let w = list.sum_rows(&mut rows, |r| {
+            let xi = list.at(list.owner[r] as usize);
+            let mut w = Virial::default();
+            for &j in list.row(r) {
+                let d = xi - list.at(j as usize);
+                let r2 = d.length_squared();
+                if r2 < c.cutoff2 {
+                    let inv = 1.0 / r2;
+                    let s6 = (c.sigma2 * inv).powi(3);
+                    w += Virial::central(d, inv * s6 * (c.eps48 * s6 - c.eps24));
+                }
+            }
+            ((), w.0)
+        });
+        Some(Virial(w).scaled(0.5))
     }
 
     /// The neighbour list's build (see [`GhostList::carried_state`]): rows
