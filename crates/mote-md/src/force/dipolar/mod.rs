@@ -660,6 +660,39 @@ impl Interaction for DipoleDipole {
         Some(self.virial)
     }
 
+    /// With a cut-off (the only case a periodic box has): ½ Σ_rows Σ_j
+    /// r ⊗ F by the portable pair law, the fused LJ/WCA part included.
+    /// All pairs (open space, no pressure): `None`.
+    fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        if !self.cutoff.is_finite() {
+            return None;
+        }
+        if state.dipole.len() != state.position.len() {
+            return Some(Virial::default());
+        }
+        self.list.refresh(state.position, state.boundary);
+        let list = &self.list;
+        list.gather(state.dipole, &mut self.moment);
+        let (kern, moment) = (self.kernel(), &self.moment);
+        let xyz = |c: &Copy4| DVec3::new(c.0[0], c.0[1], c.0[2]);
+        let mut rows = vec![(); list.len()];
+        let w = list.sum_rows(&mut rows, |r| {
+            let k = list.owner[r] as usize;
+            let (ri, mi) = (list.at(k), xyz(&moment[k]));
+            let mut w = Virial::default();
+            for &j in list.row(r) {
+                let d = ri - list.at(j as usize);
+                let r2 = d.length_squared();
+                if r2 < kern.reach2() {
+                    let (_, f, _, _, _) = kern.pair(d, r2, mi, xyz(&moment[j as usize]));
+                    w += Virial::pair(d, f);
+                }
+            }
+            ((), w.0)
+        });
+        Some(Virial(w).scaled(0.5))
+    }
+
     /// The ghost list's build (see [`GhostList::carried_state`]): rows are
     /// summed eight neighbours at a time, skin pairs included as zeros, so
     /// the bits of a force depend on when the list was built.
