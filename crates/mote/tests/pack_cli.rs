@@ -543,7 +543,7 @@ fn the_soft_method_packs_and_says_what_it_found() {
     for (args, why) in [
         (
             &["--method", "squishy"][..],
-            "--method squishy: use hard or soft",
+            "invalid value 'squishy' for '--method <METHOD>'",
         ),
         (
             &["--method", "soft", "--dim", "2"][..],

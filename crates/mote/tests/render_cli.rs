@@ -100,7 +100,10 @@ fn render_reports_bad_input_without_panicking() {
     write_xyz(&good, 1);
     for (args, msg) in [
         (vec!["--frame", "5"], "has 1 frames"),
-        (vec!["--color-by", "charge"], "unknown quantity 'charge'"),
+        (
+            vec!["--color-by", "charge"],
+            "invalid value 'charge' for '--color-by <Q>'",
+        ),
         (vec!["--color-by", "spin"], "has no column for it"),
         (vec!["--size", "12"], "WIDTHxHEIGHT"),
         (vec!["--view", "0,0,0"], "non-zero direction"),

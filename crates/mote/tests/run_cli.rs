@@ -858,7 +858,8 @@ fn trajectory_format_on_the_command_line() {
     );
     assert!(!o.status.success());
     assert!(
-        stderr(&o).contains("--trajectory-format hdf5: expected one of xyz, dump, gsd, vtk"),
+        stderr(&o).contains("invalid value 'hdf5' for '--trajectory-format <FORMAT>'")
+            && stderr(&o).contains("possible values: xyz, dump, gsd, vtk"),
         "{}",
         stderr(&o)
     );

@@ -2,6 +2,7 @@
 
 use std::process::ExitCode;
 
+pub mod choices;
 pub mod edmd;
 pub mod examples;
 pub mod pack;

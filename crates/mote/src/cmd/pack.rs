@@ -39,11 +39,9 @@ pub struct PackArgs {
     /// fraction of the large), lognormal:SIGMA, or file:PATH (one radius per line).
     #[arg(long, default_value = "mono")]
     dist: String,
-    /// `hard`: grow hard spheres (Lubachevsky–Stillinger, event-driven);
-    /// `soft`: the SP method, Hertzian spheres under a barostat stepped
-    /// down to --min-pressure, φ extrapolated to zero pressure (3-D,
-    /// periodic).
-    #[arg(long, default_value = "hard", value_name = "hard|soft")]
+    /// How to pack (`soft`: the barostat is stepped down to
+    /// --min-pressure and φ extrapolated to zero pressure; 3-D, periodic).
+    #[arg(long, default_value = "hard", value_parser = super::choices::pack_method())]
     method: String,
     /// Soft method: the lowest pressure P/K (K = 4E*/3): the barostat
     /// holds 1e-2 … 1e-4, then the jamming finish (energy minimisation)

@@ -681,7 +681,7 @@ struct OptimizeArgs {
     #[command(flatten)]
     input: DesignInput,
     /// What to vary: `volumes`, `widths` (lognormal σ) or both, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "volumes")]
+    #[arg(long, value_delimiter = ',', default_value = "volumes", value_parser = ["volumes", "widths"])]
     vary: Vec<String>,
     /// Aim at this φ instead of the largest.
     #[arg(long, value_name = "PHI")]

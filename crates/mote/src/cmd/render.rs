@@ -29,12 +29,11 @@ pub struct RenderArgs {
     /// Draw every frame, numbered for a movie.
     #[arg(long)]
     all: bool,
-    /// Colour by `species` or a per-particle quantity: speed, radius, vx, vy, vz, x, y, z,
-    /// mass, spin, wx, wy, wz, moment, mx, my, mz, id, body.
-    #[arg(long, value_name = "Q", default_value = "species")]
+    /// Colour by `species` or a per-particle quantity.
+    #[arg(long, value_name = "Q", default_value = "species", value_parser = super::choices::color_by())]
     color_by: String,
-    /// Colour map for quantities: viridis, coolwarm, heat.
-    #[arg(long, value_name = "NAME", default_value = "viridis")]
+    /// Colour map for quantities.
+    #[arg(long, value_name = "NAME", default_value = "viridis", value_parser = super::choices::colormap())]
     colormap: String,
     /// Fixed colour range LO,HI (default: the frame's range).
     #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]

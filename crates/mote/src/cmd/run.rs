@@ -29,11 +29,11 @@ pub struct RunArgs {
     /// Time step (overrides the scene or the particle file's `dt`).
     #[arg(long, value_name = "DT")]
     pub dt: Option<f64>,
-    /// Model of an MPPphys particle file: nbody (DirectNbody, the default) or springs (MassSpring).
-    #[arg(long, value_name = "MODEL")]
+    /// Model of an MPPphys particle file (default nbody).
+    #[arg(long, value_name = "MODEL", value_parser = super::choices::plist_system())]
     pub system: Option<String>,
-    /// Integrator: euler, symplectic-euler, rk4 (RK4), leapfrog (LF).
-    #[arg(long, value_name = "NAME")]
+    /// Integrator (any case; MPPphys' LF and RK4 too).
+    #[arg(long, value_name = "NAME", ignore_case = true, value_parser = super::choices::solver())]
     pub solver: Option<String>,
     /// Folder for the output files (default: the scene's, or out/NAME).
     #[arg(long, short = 'o', value_name = "DIR")]
@@ -41,9 +41,8 @@ pub struct RunArgs {
     /// Ray-trace the final state into this PNG (1920×1080, shadows, box drawn).
     #[arg(long, value_name = "FILE.png")]
     pub picture: Option<PathBuf>,
-    /// Trajectory format: xyz, dump, gsd or vtk (overrides the scene's
-    /// [output] trajectory_format).
-    #[arg(long, value_name = "FORMAT", conflicts_with = "resume")]
+    /// Trajectory format (overrides the scene's [output] trajectory_format).
+    #[arg(long, value_name = "FORMAT", conflicts_with = "resume", value_parser = super::choices::trajectory_format())]
     pub trajectory_format: Option<String>,
     /// Run even if the run takes more than 10⁹ steps (refused otherwise as
     /// a likely mistyped time step or end time).
