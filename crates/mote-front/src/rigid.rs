@@ -1,8 +1,18 @@
-//! Rigid clumps of spheres moved by the FRBI (`mote_md::rigid::scene`).
+//! Rigid clumps of spheres moved by the FRBI (`mote_md::rigid::scene`):
+//! the run put together here, as every engine's is — the scene built, its
+//! length resolved, the folder claimed, the engine's observers and the
+//! applications' (the toning nip's nip.csv, mote-nip) added to the one
+//! loop, the summary written.
+
+use std::path::Path;
 
 use mote_io::checkpoint::Checkpoint;
-use mote_md::rigid::scene::{run_rigid_scene, RigidRun, RigidScene};
+use mote_io::trajectory::TrajectoryWriter;
+use mote_io::xyz::Frame;
+use mote_md::rigid::run::{RigidCsv, RigidDynamics, SphereTrajectory};
+use mote_md::rigid::scene::RigidScene;
 use mote_md::MdError;
+use mote_run::Driver;
 
 use crate::checkpoints::{restore, trim_outputs};
 use crate::error::FrontError;
@@ -87,18 +97,6 @@ fn run_with(
     if let Some(cp) = resumed {
         trim_outputs(&dir, cp.step, cp.time)?;
     }
-    let run = RigidRun {
-        seed: Some(seed),
-        out_dir: Some(dir.clone()),
-        dt: options.dt,
-        steps: options.steps,
-        until: options.until,
-        force: options.force,
-        checkpoints,
-        resume: resumed.cloned(),
-        trajectory_format: Some(format),
-        live: options.live.clone(),
-    };
     monitor.start(&format!(
         "mote run {}: rigid clumps (FRBI) with dt = {}, {}, {}",
         input.label,
@@ -106,11 +104,18 @@ fn run_with(
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase(),
     ));
-    let result = run_rigid_scene(&input.text, &input.label, &run, |step, steps, time| {
-        if step % 16 == 0 || step == steps {
-            monitor.progress(step, steps, &format!("t = {time:.6e}"));
-        }
-    });
+    let result = drive(
+        input,
+        &scene,
+        options,
+        seed,
+        &dir,
+        &provenance,
+        format,
+        checkpoints,
+        resumed,
+        monitor,
+    );
     let mut outcome = Outcome {
         engine: Engine::Rigid,
         seed,
@@ -152,14 +157,9 @@ fn run_with(
     for (name, f) in &report.wall_forces {
         outcome.summary.push(format!("  force on wall {name}: {f}"));
     }
-    let files: Vec<String> = report
-        .files
-        .iter()
-        .map(|f| f.display().to_string())
-        .collect();
     outcome
         .summary
-        .push(format!("Output: {}", files.join(", ")));
+        .push(format!("Output: {}", report.files.join(", ")));
     if let Some(png) = &options.picture {
         mote_render::frame::picture(&report.final_frame, png, 1920, 1080)?;
         outcome
@@ -167,4 +167,135 @@ fn run_with(
             .push(format!("Picture of the final state: {}.", png.display()));
     }
     Ok(outcome)
+}
+
+/// What a rigid run did, for its summary.
+struct Report {
+    bodies: usize,
+    spheres: usize,
+    steps: u64,
+    time: f64,
+    wall_seconds: f64,
+    kinetic_energy: f64,
+    potential_energy: f64,
+    linear_momentum: glam::DVec3,
+    angular_momentum: glam::DVec3,
+    wall_forces: Vec<(String, glam::DVec3)>,
+    files: Vec<String>,
+    dt: f64,
+    final_frame: Frame,
+}
+
+/// Builds the scene with the options' seed, time step and length, puts
+/// the engine's observers (observables.csv, the spheres' trajectory) and
+/// the nip's (nip.csv, when the scene has `[rigid.nip]`) into the one
+/// loop, and runs it.
+#[allow(clippy::too_many_arguments)]
+fn drive(
+    input: &Input,
+    scene: &RigidScene,
+    options: &RunOptions,
+    seed: u64,
+    dir: &Path,
+    provenance: &mote_io::Provenance,
+    format: mote_io::trajectory::Format,
+    checkpoints: Option<mote_run::Checkpoints>,
+    resumed: Option<&Checkpoint>,
+    monitor: &mut dyn Monitor,
+) -> Result<Report, MdError> {
+    let (text, label) = (&input.text, &input.label);
+    let mut built = scene.build(text, label, Some(seed))?;
+    let nip = mote_nip::probe(scene, text, label)?;
+    let until_steps = |t: f64, dt: f64| {
+        mote_run::steps_until(0.0, t, dt).ok_or_else(|| {
+            MdError::Length(format!(
+                "until {t} with dt = {dt:e}: not a number of steps a run can take"
+            ))
+        })
+    };
+    if let Some(dt) = options.dt {
+        if let Some(t) = scene.run.get_ref().until {
+            built.steps = until_steps(t, dt)?;
+        }
+        built.dt = dt;
+    }
+    if let Some(n) = options.steps {
+        built.steps = n;
+    } else if let Some(t) = options.until {
+        built.steps = until_steps(t, built.dt)?;
+    }
+    if resumed.is_none() {
+        mote_run::check_run_length(built.steps, built.dt, options.force)
+            .map_err(|m| MdError::Length(format!("{label}: {m}")))?;
+    }
+    let walls: Vec<String> = built
+        .contacts
+        .as_ref()
+        .map(|c| c.walls.iter().map(|w| w.name.clone()).collect())
+        .unwrap_or_default();
+    let append = resumed.is_some();
+    let mut driver = Driver::new();
+    driver.live = options.live.clone().take();
+    driver.observers.push(Box::new(RigidCsv::create(
+        &dir.join("observables.csv"),
+        provenance,
+        &walls,
+        scene.output.observables_every.max(1),
+        append,
+    )?));
+    if scene.output.trajectory_every > 0 {
+        let p = dir.join(format!("trajectory.{}", format.extension()));
+        let writer = if append {
+            TrajectoryWriter::append(&p, format, provenance.clone(), false)?
+        } else {
+            TrajectoryWriter::create(&p, format, provenance.clone(), false)?
+        };
+        driver.observers.push(Box::new(SphereTrajectory::new(
+            writer,
+            scene.output.trajectory_every,
+        )));
+    }
+    if let Some((probe, every)) = nip {
+        driver.observers.push(Box::new(mote_nip::NipCsv::create(
+            &dir.join("nip.csv"),
+            provenance,
+            probe,
+            every,
+            append,
+        )?));
+    }
+    driver.checkpoints = checkpoints;
+    driver.sample_at_start = !append;
+    let (dt, last_step) = (built.dt, built.steps);
+    let mut dynamics = RigidDynamics::new(built);
+    if let Some(cp) = resumed {
+        dynamics.resume(cp, label)?;
+    }
+    let report = driver.run(
+        &mut dynamics,
+        |_| last_step,
+        |d| {
+            let step = d.step;
+            if step % 16 == 0 || step == last_step {
+                monitor.progress(step, last_step, &format!("t = {:.6e}", d.bodies.time));
+            }
+        },
+    )?;
+    let b = &dynamics.bodies;
+    let last = report.last;
+    Ok(Report {
+        bodies: b.len(),
+        spheres: (0..b.len()).map(|i| b.template(i).sphere_count()).sum(),
+        steps: last_step,
+        time: b.time,
+        wall_seconds: report.wall.as_secs_f64(),
+        kinetic_energy: last.kinetic_energy(),
+        potential_energy: last.potential_energy,
+        linear_momentum: last.linear_momentum,
+        angular_momentum: last.angular_momentum,
+        wall_forces: last.wall_forces,
+        files: report.files,
+        dt,
+        final_frame: dynamics.sphere_frame(),
+    })
 }

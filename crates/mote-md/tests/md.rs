@@ -19,7 +19,6 @@ mod latent;
 mod lennard_jones;
 mod lj_eos;
 mod magnet;
-mod nip;
 mod oscillator;
 mod plist_twin;
 mod pressure;

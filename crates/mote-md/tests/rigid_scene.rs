@@ -1,11 +1,10 @@
-//! The `[rigid]` scene format: the examples parse and build, the magnet
-//! example runs and keeps its momentum, errors carry `file:line`, and an
-//! ignored test runs any scene named by `MOTE_RIGID_SCENE` (for examples
-//! and benchmarks before `mote run` routes to the runner).
+//! The `[rigid]` scene format: the examples parse and build, errors carry
+//! `file:line`, frames carry bodies. Whole runs are the front's
+//! (mote-front's tests, `rigid_runs`).
 
 use std::path::Path;
 
-use mote_md::rigid::scene::{is_rigid_scene, run_rigid_scene, RigidRun, RigidScene};
+use mote_md::rigid::scene::{is_rigid_scene, RigidScene};
 
 fn example(name: &str) -> String {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -42,40 +41,6 @@ fn examples_build() {
 }
 
 #[test]
-fn magnet_example_runs() {
-    let text = example("magnet-in-field.toml");
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_rigid_scene(
-        &text,
-        "magnet-in-field.toml",
-        &RigidRun {
-            out_dir: Some(dir.path().to_path_buf()),
-            ..RigidRun::default()
-        },
-        |_, _, _| {},
-    )
-    .unwrap();
-    assert_eq!(r.steps, 20000);
-    assert!((r.time - 200.0).abs() < 1e-9);
-    let table = mote_io::csv::read_table(&dir.path().join("observables.csv")).unwrap();
-    let e = table.column("total_energy").unwrap();
-    let px = table.column("px").unwrap();
-    let ly = table.column("Ly").unwrap();
-    let spread = |v: &[f64]| {
-        v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)
-    };
-    println!(
-        "energy spread {:e} px spread {:e} ly spread {:e}",
-        spread(&e),
-        spread(&px),
-        spread(&ly)
-    );
-    assert!(spread(&px) < 1e-13);
-    assert!(spread(&ly) < 1e-10);
-    assert!(spread(&e) < 1e-2 * e[0].abs().max(1.0));
-}
-
-#[test]
 fn errors_name_the_line() {
     let text = "seed = 1\n[rigid]\n[[rigid.template]]\nname = \"a\"\ngenerator = \"sphere\"\nradius = 1.0\ndensity = 1.0\n\n[[rigid.body]]\ntemplate = \"b\"\nposition = [0, 0, 0]\n\n[run]\ndt = 0.1\nsteps = 1\n";
     let e = RigidScene::parse(text, "s.toml")
@@ -100,44 +65,6 @@ fn errors_name_the_line() {
         .err()
         .unwrap();
     assert_eq!(e.line, 13, "{e}");
-}
-
-/// `MOTE_RIGID_SCENE=file [MOTE_RIGID_OUT=dir] cargo test --release --test
-/// rigid_scene run_scene_file -- --ignored --nocapture`
-#[test]
-#[ignore]
-fn run_scene_file() {
-    let Ok(path) = std::env::var("MOTE_RIGID_SCENE") else {
-        return;
-    };
-    let text = std::fs::read_to_string(&path).unwrap();
-    let out = std::env::var("MOTE_RIGID_OUT").ok();
-    let r = run_rigid_scene(
-        &text,
-        &path,
-        &RigidRun {
-            out_dir: out.as_deref().map(std::path::PathBuf::from),
-            ..RigidRun::default()
-        },
-        |_, _, _| {},
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    println!(
-        "{} bodies, {} spheres, {} steps, t = {}, {:.3} s wall, {:.4} µs per body-step\nKE {:e} PE {:e} P {} L {}",
-        r.bodies,
-        r.spheres,
-        r.steps,
-        r.time,
-        r.wall_seconds,
-        r.wall_seconds * 1e6 / (r.bodies as f64 * r.steps as f64),
-        r.kinetic_energy,
-        r.potential_energy,
-        r.linear_momentum,
-        r.angular_momentum
-    );
-    for (name, f) in r.wall_forces {
-        println!("wall {name}: {f}");
-    }
 }
 
 /// Trajectory frames carry each sphere's body and that body's orientation
@@ -170,87 +97,6 @@ fn frames_carry_bodies_and_orientations() {
             (got - want).length() < 1e-12 * (1.0 + want.length()),
             "sphere {i}: {got} vs {want}"
         );
-    }
-}
-
-/// The scene text without its `[[rigid.random]]` tables.
-fn without_random(text: &str) -> String {
-    let mut out = String::new();
-    let mut skip = false;
-    for line in text.lines() {
-        if line.starts_with('[') {
-            skip = line.starts_with("[[rigid.random]]");
-        }
-        if !skip {
-            out.push_str(line);
-            out.push('\n');
-        }
-    }
-    out
-}
-
-/// A rigid run's last frame, in each format that keeps radii and body ids,
-/// starts a new scene: every body comes back as the template it was, with
-/// its spheres where the file has them and their velocities.
-#[test]
-fn bodies_start_from_a_rigid_runs_frame() {
-    let text = example("clumps-settling.toml")
-        .replace("until = 0.5", "steps = 60")
-        .replace("trajectory_every = 400", "trajectory_every = 60");
-    let original = RigidScene::parse(&text, "s.toml")
-        .unwrap()
-        .build(&text, "s.toml", None)
-        .unwrap();
-    for (format, name) in [
-        (mote_io::trajectory::Format::Xyz, "trajectory.xyz"),
-        (mote_io::trajectory::Format::Dump, "trajectory.dump"),
-    ] {
-        let dir = tempfile::tempdir().unwrap();
-        run_rigid_scene(
-            &text,
-            "s.toml",
-            &RigidRun {
-                out_dir: Some(dir.path().to_path_buf()),
-                trajectory_format: Some(format),
-                ..RigidRun::default()
-            },
-            |_, _, _| {},
-        )
-        .unwrap();
-        let file = dir.path().join(name);
-        let frames = mote_io::trajectory::read_frames(&file).unwrap();
-        let last = frames.last().unwrap();
-        assert!(last.time > 0.0);
-        let again = without_random(&text).replace(
-            "[rigid.fields]",
-            &format!(
-                "[[rigid.from_file]]\nfile = {:?}\n\n[rigid.fields]",
-                file.display().to_string()
-            ),
-        );
-        let built = RigidScene::parse(&again, "again.toml")
-            .unwrap()
-            .build(&again, "again.toml", None)
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(built.bodies.kind, original.bodies.kind, "{name}");
-        let frame = mote_md::rigid::run::sphere_frame(&built.bodies);
-        let scale = 40e-3;
-        for (a, b) in frame.positions.iter().zip(&last.positions) {
-            for d in 0..3 {
-                assert!((a[d] - b[d]).abs() < 1e-10 * scale, "{name}: {a:?} {b:?}");
-            }
-        }
-        let speed = last
-            .velocities
-            .iter()
-            .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
-            .fold(0.0, f64::max);
-        assert!(speed > 0.0);
-        for (a, b) in frame.velocities.iter().zip(&last.velocities) {
-            for d in 0..3 {
-                assert!((a[d] - b[d]).abs() < 1e-9 * speed, "{name}: {a:?} {b:?}");
-            }
-        }
     }
 }
 

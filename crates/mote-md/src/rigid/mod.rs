@@ -13,10 +13,10 @@
 //! - [`sources`]: fields, gravity, drag, Coulomb (in open space or between
 //!   conducting planes), dipole–dipole, the latent image;
 //! - [`magnet`]: the magnetic roller and the moments it induces;
-//! - [`nip`]: a toning nip's observables (developed toner, brush, free volume);
 //! - [`contacts`]: Hertz–Mindlin contacts between spheres of different
 //!   bodies and with walls;
-//! - [`scene`]: the `[rigid]` scene format and its runner;
+//! - [`scene`]: the `[rigid]` scene format;
+//! - [`run`]: the FRBI as a propagator of the one loop, its observers and checkpoints;
 //! - [`frbi`]: `freeStep`, `react` and the many-body step.
 //!
 //! The algebra (E, dE, I, exp, log) is the crate `mote-geom`.
@@ -28,7 +28,6 @@ mod free8;
 pub mod from_file;
 pub mod interaction;
 pub mod magnet;
-pub mod nip;
 pub mod run;
 pub mod scene;
 pub mod shapes;

@@ -1,10 +1,10 @@
 //! Rigid runs: the FRBI as a [`Propagator`] of mote's one loop, the
 //! observers that write a rigid run's files (observables.csv with
 //! translational and rotational energy apart and the force on each wall;
-//! the spheres as extended XYZ), checkpoints of bodies and contact
-//! histories, and [`run_rigid_scene`], which puts them together.
+//! the spheres as extended XYZ) and checkpoints of bodies and contact
+//! histories. The run is put together by the front (mote-front's rigid.rs),
+//! as every engine's is.
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::DVec3;
@@ -13,51 +13,12 @@ use mote_io::csv::CsvWriter;
 use mote_io::trajectory::TrajectoryWriter;
 use mote_io::xyz::Frame;
 use mote_io::{ParseError, Provenance};
-use mote_run::{Checkpoints, Driver, Observer, Propagator};
+use mote_run::{Observer, Propagator};
 
 use super::bodies::RigidBodies;
 use super::contacts::RigidContacts;
 use super::frbi::Frbi;
-use super::scene::RigidScene;
 use crate::error::MdError;
-
-/// What a caller changes about a rigid scene's run; `None` keeps the scene's.
-#[derive(Debug, Clone, Default)]
-pub struct RigidRun {
-    /// Replaces the scene's seed (the scene's, else 1, when absent).
-    pub seed: Option<u64>,
-    /// Replaces `[output] dir`.
-    pub out_dir: Option<PathBuf>,
-    /// Replaces `[run] dt`.
-    pub dt: Option<f64>,
-    /// Replaces the run length by a number of steps.
-    pub steps: Option<u64>,
-    /// Replaces the run length by an end time (to the first step at or
-    /// past it, [`mote_run::steps_until`]).
-    pub until: Option<f64>,
-    /// Run even where that is more than [`mote_run::MAX_STEPS`] steps.
-    pub force: bool,
-    /// Write checkpoints on this schedule (the template holds the run's
-    /// input and options; the time step and the run's length are added).
-    pub checkpoints: Option<Checkpoints>,
-    /// Continue this checkpoint's run (its scene, seed, dt and length must
-    /// be those given), appending to the files an earlier run wrote.
-    pub resume: Option<Checkpoint>,
-    /// Replaces `[output] trajectory_format`.
-    pub trajectory_format: Option<mote_io::trajectory::Format>,
-    /// The live viewer's tap, if the run is watched.
-    pub live: mote_run::LiveSlot,
-}
-
-/// Steps from t = 0 to the first step at or past `t` (the rule of every
-/// engine, [`mote_run::steps_until`]).
-pub(crate) fn steps_until(t: f64, dt: f64) -> Result<u64, MdError> {
-    mote_run::steps_until(0.0, t, dt).ok_or_else(|| {
-        MdError::Length(format!(
-            "until {t} with dt = {dt:e}: not a number of steps a run can take"
-        ))
-    })
-}
 
 /// Rigid bodies moved by the FRBI with a fixed step.
 pub struct RigidDynamics {
@@ -333,6 +294,13 @@ pub struct SphereTrajectory {
     every: u64,
 }
 
+impl SphereTrajectory {
+    /// Writes the spheres every `every` steps through `writer`.
+    pub fn new(writer: TrajectoryWriter, every: u64) -> Self {
+        Self { writer, every }
+    }
+}
+
 impl Observer<RigidDynamics> for SphereTrajectory {
     fn every(&self) -> u64 {
         self.every
@@ -447,142 +415,4 @@ pub fn sphere_frame(b: &RigidBodies) -> Frame {
         radii: world.sphere_radius.clone(),
         ..Frame::default()
     }
-}
-
-/// What a rigid run did.
-#[derive(Debug, Clone)]
-pub struct Report {
-    pub bodies: usize,
-    pub spheres: usize,
-    pub steps: u64,
-    pub time: f64,
-    pub wall_seconds: f64,
-    pub kinetic_energy: f64,
-    pub potential_energy: f64,
-    pub linear_momentum: DVec3,
-    pub angular_momentum: DVec3,
-    /// The force on each wall at the last step.
-    pub wall_forces: Vec<(String, DVec3)>,
-    pub files: Vec<PathBuf>,
-    pub seed: u64,
-    pub dt: f64,
-    /// The spheres at the end (for a picture).
-    pub final_frame: Frame,
-}
-
-/// Runs a rigid scene: `text` is the TOML, `file_label` locates errors and
-/// goes into the provenance headers, `options` replace the scene's seed,
-/// output folder, time step or run length. Writes `observables.csv` and,
-/// with `trajectory_every` > 0, `trajectory.xyz` (the spheres). Calls
-/// `progress(step, last step, time)` after every step.
-pub fn run_rigid_scene(
-    text: &str,
-    file_label: &str,
-    options: &RigidRun,
-    mut progress: impl FnMut(u64, u64, f64),
-) -> Result<Report, MdError> {
-    let scene = RigidScene::parse(text, file_label)?;
-    let mut built = scene.build(text, file_label, options.seed)?;
-    if let Some(dt) = options.dt {
-        if !(dt > 0.0 && dt.is_finite()) {
-            return Err(
-                ParseError::new(file_label, 0, format!("time step {dt}: must be > 0")).into(),
-            );
-        }
-        if let Some(t) = scene.run.get_ref().until {
-            built.steps = steps_until(t, dt)?;
-        }
-        built.dt = dt;
-    }
-    if let Some(n) = options.steps {
-        built.steps = n;
-    } else if let Some(t) = options.until {
-        built.steps = steps_until(t, built.dt)?;
-    }
-    if options.resume.is_none() {
-        mote_run::check_run_length(built.steps, built.dt, options.force)
-            .map_err(|m| MdError::Length(format!("{file_label}: {m}")))?;
-    }
-    let dir = options
-        .out_dir
-        .clone()
-        .or_else(|| scene.output.dir.as_ref().map(PathBuf::from))
-        .unwrap_or_else(|| PathBuf::from("out"));
-    std::fs::create_dir_all(&dir).map_err(|e| mote_io::IoError::os(&dir, e))?;
-    let provenance = Provenance {
-        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
-        scene: file_label.to_string(),
-        seed: built.seed,
-    };
-    let walls: Vec<String> = built
-        .contacts
-        .as_ref()
-        .map(|c| c.walls.iter().map(|w| w.name.clone()).collect())
-        .unwrap_or_default();
-    let append = options.resume.is_some();
-    let mut driver = Driver::new();
-    driver.live = options.live.take();
-    driver.observers.push(Box::new(RigidCsv::create(
-        &dir.join("observables.csv"),
-        &provenance,
-        &walls,
-        scene.output.observables_every.max(1),
-        append,
-    )?));
-    if scene.output.trajectory_every > 0 {
-        let format = match options.trajectory_format {
-            Some(f) => f,
-            None => scene
-                .output
-                .trajectory_format(mote_io::Source::new(file_label, text))?,
-        };
-        let p = dir.join(format!("trajectory.{}", format.extension()));
-        driver.observers.push(Box::new(SphereTrajectory {
-            writer: if append {
-                TrajectoryWriter::append(&p, format, provenance.clone(), false)?
-            } else {
-                TrajectoryWriter::create(&p, format, provenance.clone(), false)?
-            },
-            every: scene.output.trajectory_every,
-        }));
-    }
-    if let Some((probe, every)) = built.nip.take() {
-        driver.observers.push(Box::new(super::nip::NipCsv::create(
-            &dir.join("nip.csv"),
-            &provenance,
-            probe,
-            every,
-            append,
-        )?));
-    }
-    driver.checkpoints = options.checkpoints.clone();
-    driver.sample_at_start = !append;
-    let (seed, dt, last_step) = (built.seed, built.dt, built.steps);
-    let mut dynamics = RigidDynamics::new(built);
-    if let Some(cp) = &options.resume {
-        dynamics.resume(cp, file_label)?;
-    }
-    let report = driver.run(
-        &mut dynamics,
-        |_| last_step,
-        |d| progress(d.step, last_step, d.bodies.time),
-    )?;
-    let b = &dynamics.bodies;
-    let last = report.last;
-    Ok(Report {
-        bodies: b.len(),
-        spheres: (0..b.len()).map(|i| b.template(i).sphere_count()).sum(),
-        steps: last_step,
-        time: b.time,
-        wall_seconds: report.wall.as_secs_f64(),
-        kinetic_energy: last.kinetic_energy(),
-        potential_energy: last.potential_energy,
-        linear_momentum: last.linear_momentum,
-        angular_momentum: last.angular_momentum,
-        wall_forces: last.wall_forces,
-        files: report.files.iter().map(PathBuf::from).collect(),
-        seed,
-        dt,
-        final_frame: dynamics.sphere_frame(),
-    })
 }

@@ -79,7 +79,7 @@
 //! iterations = 2               # passes of mutual induction
 //! magnetic = [{ template = "carrier", permeability = 6.0, saturation = 3.3e5 }]
 //!
-//! [rigid.nip]                  # toning-nip observables in nip.csv (rigid/nip.rs)
+//! [rigid.nip]                  # toning-nip observables in nip.csv (the crate mote-nip)
 //! toner = "toner"
 //! carrier = "carrier"
 //! every = 500                  # default: [output] observables_every
@@ -113,7 +113,6 @@ use super::bodies::RigidBodies;
 use super::contacts::RigidContacts;
 use super::frbi::{Frbi, FreeFlight, SpinUpdate};
 use super::magnet::{InducedDipoles, MagneticRoller};
-use super::nip::NipProbe;
 use super::shapes::{dumbbell, linear_trimer, IrregularClump};
 use super::sources::{
     AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity, LatentField, PlaneCoulomb,
@@ -175,19 +174,11 @@ pub struct RigidSettings {
     /// `[rigid.roller]`: the magnetic roller above the upper plane.
     #[serde(default)]
     pub roller: Option<Spanned<RollerSettings>>,
-    /// `[rigid.nip]`: the toning nip's observables.
+    /// `[rigid.nip]`: the toning nip's observables, an application's
+    /// table: the crate mote-nip reads it from the scene text; the engine
+    /// only lets it through.
     #[serde(default)]
-    pub nip: Option<Spanned<NipSettings>>,
-}
-
-/// `[rigid.nip]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct NipSettings {
-    pub toner: String,
-    pub carrier: String,
-    #[serde(default)]
-    pub every: Option<u64>,
+    pub nip: Option<serde::de::IgnoredAny>,
 }
 
 /// `[rigid.roller]`.
@@ -455,8 +446,6 @@ pub struct BuiltRigid {
     pub frbi: Frbi,
     /// The contact model (shared with the integrator), if any.
     pub contacts: Option<Arc<RigidContacts>>,
-    /// `[rigid.nip]`: the probe and its interval in steps.
-    pub nip: Option<(NipProbe, u64)>,
     pub dt: f64,
     pub steps: u64,
     pub seed: u64,
@@ -834,48 +823,6 @@ impl RigidScene {
             image.check().map_err(|m| err(l.span(), m))?;
             frbi.push(Box::new(LatentField { image, z0: *z0 }));
         }
-        let mut nip = None;
-        if let Some(n) = &rigid.nip {
-            let ns = n.get_ref();
-            let kind = |name: &str| {
-                names
-                    .iter()
-                    .find(|(t, _)| t == name)
-                    .map(|(_, k)| *k)
-                    .ok_or_else(|| {
-                        err(
-                            n.span(),
-                            format!("[rigid.nip] names unknown template '{name}'"),
-                        )
-                    })
-            };
-            let Some((lo, hi, _)) = contact_box(&rigid.contacts) else {
-                return Err(err(
-                    n.span(),
-                    "[rigid.nip] needs the box of [rigid.contacts] (box_lo, box_hi)".into(),
-                ));
-            };
-            let latent = rigid.latent_image.as_ref().map(|l| l.get_ref());
-            let contrast = latent
-                .map(|l| l.patches.first().map_or(0.0, |p| p[2] - l.background))
-                .unwrap_or(0.0);
-            nip = Some((
-                NipProbe {
-                    toner: kind(&ns.toner)?,
-                    carrier: kind(&ns.carrier)?,
-                    belt: lo.z + latent.map_or(0.0, |l| l.height),
-                    shell: hi.z,
-                    lo,
-                    hi,
-                    patches: latent
-                        .map(|l| l.patches.iter().map(|p| [p[0], p[1]]).collect())
-                        .unwrap_or_default(),
-                    speed: latent.map_or(0.0, |l| l.speed),
-                    contrast,
-                },
-                ns.every.unwrap_or(self.output.observables_every.max(1)),
-            ));
-        }
         if let Some(r) = &rigid.roller {
             let model = induced_dipoles(r.get_ref(), &rigid.contacts, &names, &bodies)
                 .map_err(|m| err(r.span(), m))?;
@@ -918,11 +865,28 @@ impl RigidScene {
             bodies,
             frbi,
             contacts,
-            nip,
             dt: run.dt,
             steps,
             seed,
         })
+    }
+}
+
+impl RigidScene {
+    /// The body kind (template index) of the template named `name`:
+    /// templates are numbered in the order `[[rigid.template]]` lists them.
+    pub fn template_kind(&self, name: &str) -> Option<u32> {
+        let templates = &self.rigid.get_ref().template;
+        templates
+            .iter()
+            .position(|t| t.get_ref().name == name)
+            .map(|k| k as u32)
+    }
+
+    /// The box of `[rigid.contacts]` (lower and upper corner, periodic
+    /// axes), if it names one.
+    pub fn contact_box(&self) -> Option<(DVec3, DVec3, [bool; 3])> {
+        contact_box(&self.rigid.get_ref().contacts)
     }
 }
 
@@ -1262,4 +1226,4 @@ fn random_sites(
     Ok(taken[first..].iter().map(|(x, _)| *x).collect())
 }
 
-pub use super::run::{run_rigid_scene, sphere_frame, Report, RigidRun};
+pub use super::run::sphere_frame;

@@ -24,10 +24,9 @@ use mote_io::csv::CsvWriter;
 use mote_io::Provenance;
 use mote_run::Observer;
 
-use super::bodies::RigidBodies;
-use super::interaction::WorldFrame;
-use super::run::{RigidDynamics, RigidSample};
-use crate::error::MdError;
+use mote_md::rigid::run::{RigidDynamics, RigidSample};
+use mote_md::rigid::{RigidBodies, WorldFrame};
+use mote_md::MdError;
 
 /// The nip's geometry and the templates it tells apart.
 #[derive(Clone, Debug, PartialEq)]
@@ -259,5 +258,82 @@ impl Observer<RigidDynamics> for NipCsv {
 
     fn files(&self) -> Vec<String> {
         vec![self.writer.path().display().to_string()]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::PI;
+
+    use glam::DVec3;
+    use mote_geom::{DE, E};
+    use mote_md::rigid::{BodyTemplate, RigidBodies};
+
+    use super::NipProbe;
+
+    /// A one-sphere template ([`BodyTemplate::sphere`]) with a charge.
+    fn sphere(radius: f64, density: f64, charge: f64) -> std::sync::Arc<BodyTemplate> {
+        let mut t = BodyTemplate::sphere(radius, density).unwrap();
+        std::sync::Arc::get_mut(&mut t).unwrap().charge = charge;
+        t
+    }
+
+    #[test]
+    fn probe_counts_developed_toner_and_the_brush() {
+        let mut b = RigidBodies::new();
+        let carrier = b.add_template(sphere(2.0, 1.0, 0.0));
+        let toner = b.add_template(sphere(0.5, 3.0, -0.1));
+        let at = |x: f64, y: f64, z: f64| E::new(DVec3::ZERO, DVec3::new(x, y, z));
+        // Box 20 × 10, belt at z = 1, shell at z = 15; image [2, 8) moving at 1.
+        // Toner touching the belt: two on the image (x = 3, 7.5 at t = 0.5,
+        // i.e. 2.5 and 7 in the belt's frame), one on the background; one
+        // floating.
+        for (x, z) in [(3.0, 1.5), (7.5, 1.52), (15.0, 1.5), (5.0, 6.0)] {
+            b.push(toner, at(x, 5.0, z), DE::ZERO);
+        }
+        // A chain of three carriers hanging from the shell across the periodic
+        // boundary in x (touching only through it), a bridge of four reaching
+        // the belt at x = 12, and a lone carrier in the middle.
+        for (x, z) in [(0.5, 13.0), (19.6, 9.1), (0.5, 5.2)] {
+            b.push(carrier, at(x, 5.0, z), DE::ZERO);
+        }
+        for z in [13.0, 9.0, 5.0, 2.0] {
+            b.push(carrier, at(12.0, 5.0, z), DE::ZERO);
+        }
+        b.push(carrier, at(5.5, 5.0, 9.0), DE::ZERO);
+        b.time = 0.5;
+        let probe = NipProbe {
+            toner,
+            carrier,
+            belt: 1.0,
+            shell: 15.0,
+            lo: DVec3::ZERO,
+            hi: DVec3::new(20.0, 10.0, 15.0),
+            patches: vec![[2.0, 8.0]],
+            speed: 1.0,
+            contrast: 0.02,
+        };
+        let s = probe.measure(&b);
+        assert_eq!(s.developed, 3);
+        let m = 3.0 * 4.0 / 3.0 * PI * 0.125;
+        let (a_image, a_back) = (6.0 * 10.0, 14.0 * 10.0);
+        assert!((s.mass_image - 2.0 * m / a_image).abs() < 1e-3 * s.mass_image);
+        assert!((s.mass_background - m / a_back).abs() < 1e-3 * s.mass_background);
+        assert!((s.charge_image + 0.2 / a_image).abs() < 1e-12);
+        assert!((s.neutralised - 0.2 / a_image / 0.02).abs() < 1e-12);
+        // Clusters: the chain, the bridge, the lone carrier.
+        assert_eq!(s.chains, 3, "{s:?}");
+        assert_eq!(s.bridges, 1, "{s:?}");
+        // Reach of the two clusters at the shell: the chain's lowest sphere
+        // bottom is 5.2 − 2, the bridge's 2 − 2.
+        let expected = ((15.0 - 3.2) + (15.0 - 0.0)) / 2.0;
+        assert!((s.brush_height - expected).abs() < 1e-12, "{s:?}");
+        let solids = 4.0 * 4.0 / 3.0 * PI * 0.125 + 8.0 * 4.0 / 3.0 * PI * 8.0;
+        let free = 1.0 - solids / (200.0 * 14.0);
+        assert!(
+            (s.free_volume - free).abs() < 1e-3,
+            "{} against {free}",
+            s.free_volume
+        );
     }
 }

@@ -1,0 +1,4 @@
+//! The integration tests of mote-front, one binary (`cargo test -p mote-front --test front MODULE::`).
+
+mod live;
+mod rigid_runs;
