@@ -229,8 +229,7 @@ fn drive(
             .map_err(|m| MdError::Length(format!("{label}: {m}")))?;
     }
     let walls: Vec<String> = built
-        .contacts
-        .as_ref()
+        .contacts()
         .map(|c| c.walls.iter().map(|w| w.name.clone()).collect())
         .unwrap_or_default();
     let append = resumed.is_some();

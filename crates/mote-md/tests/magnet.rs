@@ -102,7 +102,7 @@ fn bodies_at(points: &[DVec3]) -> RigidBodies {
     b
 }
 
-fn forces(model: &InducedDipoles, b: &RigidBodies, t: f64) -> Vec<DVec3> {
+fn forces(model: &mut InducedDipoles, b: &RigidBodies, t: f64) -> Vec<DVec3> {
     let mut world = WorldFrame::default();
     world.update(b);
     let view = BodyView {
@@ -134,7 +134,7 @@ fn one_bead_is_pulled_up_the_field_gradient() {
     };
     let p = DVec3::new(0.0021, 0.0, 0.0003);
     let b = bodies_at(&[p]);
-    let f = forces(&model, &b, 0.0)[0];
+    let f = forces(&mut model, &b, 0.0)[0];
     // F = (α/2)∇|B|² = −α(n + 1)|B|²/r r̂ (towards the axis).
     let w = DVec3::new(p.x - model.roller.axis[0], 0.0, p.z - model.roller.axis[1]);
     let b2 = model.roller.at(p, 0.0).length_squared();
@@ -146,7 +146,7 @@ fn one_bead_is_pulled_up_the_field_gradient() {
     // Saturated: the moment is M_s V along B, the force (m·∇)B with it.
     let cap = 0.1 * alpha * b2.sqrt();
     model.saturation = vec![cap];
-    let f = forces(&model, &b, 0.0)[0];
+    let f = forces(&mut model, &b, 0.0)[0];
     let bhat = model.roller.at(p, 0.0).normalize();
     let (_, grad) = model.roller.with_gradient(p, cap * bhat, 0.0);
     assert!((f - grad).length() < 1e-12 * grad.length());
@@ -170,7 +170,7 @@ fn two_beads_along_the_field_induce_each_other() {
     let alpha = InducedDipoles::polarisability(volume(a), 8.0);
     let k = 1e-7;
     let d = 45e-6;
-    let model = InducedDipoles {
+    let mut model = InducedDipoles {
         roller: big,
         polarisability: vec![alpha],
         saturation: vec![f64::INFINITY],
@@ -185,7 +185,7 @@ fn two_beads_along_the_field_induce_each_other() {
     let field = big.at(DVec3::ZERO, 0.0);
     assert!(field.z.abs() < 1e-12 * field.length());
     let m = alpha * field.x / (1.0 - 2.0 * k * alpha / d.powi(3));
-    let f = forces(&model, &b, 0.0);
+    let f = forces(&mut model, &b, 0.0);
     let expected = 6.0 * k * m * m / d.powi(4);
     assert!(
         (f[0].x - expected).abs() < 1e-6 * expected,
@@ -194,18 +194,18 @@ fn two_beads_along_the_field_induce_each_other() {
     );
     assert!((f[0] + f[1]).length() < 1e-9 * expected);
     // Without mutual induction the moments are αB: a weaker attraction.
-    let first = InducedDipoles {
+    let mut first = InducedDipoles {
         iterations: 0,
         ..model.clone()
     };
-    let f0 = forces(&first, &b, 0.0);
+    let f0 = forces(&mut first, &b, 0.0);
     let m0 = alpha * field.x;
     assert!((f0[0].x - 6.0 * k * m0 * m0 / d.powi(4)).abs() < 1e-6 * expected);
 }
 
 #[test]
 fn pair_forces_cancel_and_periodic_images_are_nearest() {
-    let model = InducedDipoles {
+    let mut model = InducedDipoles {
         roller: roller(),
         polarisability: vec![InducedDipoles::polarisability(volume(20e-6), 5.0)],
         saturation: vec![f64::INFINITY],
@@ -221,7 +221,7 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
     ];
     let b = bodies_at(&points);
     let t = 0.004;
-    let f = forces(&model, &b, t);
+    let f = forces(&mut model, &b, t);
     let (_, _, m) = model.moments(
         &BodyView {
             bodies: &b,
@@ -246,7 +246,7 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
     // Beads 0 and 1 are 3e-5 apart along x through the boundary: with the
     // periods they act as bead 1 moved by −L_x would without (in a field
     // uniform over the box: the roller's is not periodic along x).
-    let model = InducedDipoles {
+    let mut model = InducedDipoles {
         roller: MagneticRoller {
             field: 0.05,
             poles: 2,
@@ -258,11 +258,11 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
     };
     let pair = bodies_at(&points[..2]);
     let moved = bodies_at(&[points[0], points[1] - DVec3::new(4e-4, 0.0, 0.0)]);
-    let open = InducedDipoles {
+    let mut open = InducedDipoles {
         period: [0.0, 0.0],
         ..model.clone()
     };
-    let (a, b) = (forces(&model, &pair, t), forces(&open, &moved, t));
+    let (a, b) = (forces(&mut model, &pair, t), forces(&mut open, &moved, t));
     for i in 0..2 {
         assert!(
             (a[i] - b[i]).length() < 1e-6 * b[i].length(),

@@ -3,8 +3,6 @@
 //! of restitution of a sphere on a plane, and clumps at rest in a box
 //! carrying their weight on the walls.
 
-use std::sync::Arc;
-
 use glam::DVec3;
 use mote_geom::{from_axis_angle, DE, E};
 use mote_md::force::granular::{ContactLaw, Damping, Material, Wall};
@@ -65,13 +63,8 @@ fn collision() -> RigidBodies {
 #[test]
 fn elastic_collision_conserves_momenta_and_energy() {
     let mut b = collision();
-    let contacts = Arc::new(RigidContacts::new(
-        law(1.0, 0.0),
-        law(1.0, 0.0),
-        vec![],
-        0.3,
-    ));
-    let mut f = Frbi::new().with(contacts.clone());
+    let contacts = RigidContacts::new(law(1.0, 0.0), law(1.0, 0.0), vec![], 0.3);
+    let mut f = Frbi::new().with(contacts);
     let o0 = b.observables();
     let e0 = f.energies(&b).total();
     let dt = 1e-4;
@@ -81,11 +74,11 @@ fn elastic_collision_conserves_momenta_and_energy() {
         f.step(&mut b, dt);
         let e = f.energies(&b).total();
         max_dev = max_dev.max((e - e0).abs() / e0);
-        touched = touched.max(contacts.contact_counts().0);
+        touched = touched.max(f.find::<RigidContacts>().unwrap().contact_counts().0);
     }
     assert!(touched > 0, "the bodies never touched");
     assert_eq!(
-        contacts.contact_counts().0,
+        f.find::<RigidContacts>().unwrap().contact_counts().0,
         0,
         "still in contact at the end"
     );
@@ -117,18 +110,13 @@ fn sphere_body_bounces_with_restitution() {
             DE::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0)),
         );
         let wall = Wall::plane("floor", DVec3::ZERO, DVec3::Z);
-        let contacts = Arc::new(RigidContacts::new(
-            law(e, 0.5),
-            law(e, 0.5),
-            vec![wall],
-            0.2,
-        ));
-        let mut f = Frbi::new().with(contacts.clone());
+        let contacts = RigidContacts::new(law(e, 0.5), law(e, 0.5), vec![wall], 0.2);
+        let mut f = Frbi::new().with(contacts);
         let dt = 2e-5;
         while b.time < 0.5 {
             f.step(&mut b, dt);
         }
-        assert_eq!(contacts.contact_counts().1, 0);
+        assert_eq!(f.find::<RigidContacts>().unwrap().contact_counts().1, 0);
         let back = b.velocity[0].z;
         println!("e {e}: {back}");
         assert!((back / e - 1.0).abs() < 0.01, "e {e}: rebound {back}");
@@ -188,12 +176,12 @@ fn settled_clumps_rest_on_the_walls() {
     // No rolling resistance: with rolling_friction = 0.1 the pile keeps a
     // residual motion (KE ~ 1e-5 M g d, not decaying; see docs/rigid.md).
     let cl = law(0.3, 0.5);
-    let contacts = Arc::new(RigidContacts::new(cl, cl, walls, 0.3));
+    let contacts = RigidContacts::new(cl, cl, walls, 0.3);
     let mut f = Frbi::new()
         .with(Gravity {
             g: DVec3::new(0.0, 0.0, -g),
         })
-        .with(contacts.clone());
+        .with(contacts);
     let dt = 5e-4;
     let weight = b.total_mass() * g;
     let mut steps = 0;
@@ -208,7 +196,7 @@ fn settled_clumps_rest_on_the_walls() {
     let m = 10000;
     for _ in 0..m {
         f.step(&mut b, dt);
-        let wf = contacts.wall_forces();
+        let wf = f.find::<RigidContacts>().unwrap().wall_forces();
         sum += wf.iter().map(|(_, w)| *w).sum::<DVec3>();
         floor += wf[4].1.z;
     }

@@ -26,8 +26,6 @@
 //!   mean of two steps), and the tangential history advances by the time
 //!   since the previous evaluation, which is stored.
 
-use std::sync::{Arc, Mutex};
-
 use glam::DVec3;
 use mote_geom::DE;
 
@@ -50,7 +48,7 @@ pub struct RigidContacts {
     /// Periodic axes (with their box) for the sphere–sphere search; bodies
     /// are not wrapped, their spheres are wrapped for the search only.
     pub boundary: Boundary,
-    state: Arc<Mutex<ContactState>>,
+    state: ContactState,
 }
 
 /// The mutable part: neighbour list, histories, wall forces.
@@ -85,11 +83,11 @@ impl RigidContacts {
             wall_law,
             walls,
             boundary: Boundary::open(),
-            state: Arc::new(Mutex::new(ContactState {
+            state: ContactState {
                 skin,
                 wall_force: vec![DVec3::ZERO; n_walls],
                 ..Default::default()
-            })),
+            },
         }
     }
 
@@ -101,7 +99,7 @@ impl RigidContacts {
 
     /// The force the spheres exert on each wall at the last evaluation.
     pub fn wall_forces(&self) -> Vec<(String, DVec3)> {
-        let s = self.state.lock().unwrap();
+        let s = &self.state;
         self.walls
             .iter()
             .zip(&s.wall_force)
@@ -111,18 +109,18 @@ impl RigidContacts {
 
     /// Touching sphere pairs and sphere–wall contacts at the last evaluation.
     pub fn contact_counts(&self) -> (usize, usize) {
-        let s = self.state.lock().unwrap();
+        let s = &self.state;
         (s.contacts, s.wall_contacts)
     }
 
     /// Number of neighbour-list builds so far.
     pub fn list_builds(&self) -> u64 {
-        self.state.lock().unwrap().list.builds
+        self.state.list.builds
     }
 
     /// The contact history of spheres (a, b) of different bodies, if listed.
     pub fn history(&self, a: usize, b: usize) -> Option<History> {
-        self.state.lock().unwrap().pairs.get(a, b)
+        self.state.pairs.get(a, b)
     }
 }
 
@@ -164,7 +162,7 @@ impl BodyInteraction for RigidContacts {
         "contacts"
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
         let world = view.world;
         let bodies = view.bodies;
         let centres = &world.sphere_centre;
@@ -172,8 +170,7 @@ impl BodyInteraction for RigidContacts {
         let body = &world.sphere_body;
         let n = centres.len();
         let r_max = radius.iter().cloned().fold(0.0, f64::max);
-        let mut guard = self.state.lock().unwrap();
-        let st = &mut *guard;
+        let st = &mut self.state;
         st.refresh(centres, body, r_max, &self.boundary);
         let dt = view.dt;
         let image = self.boundary.image();
@@ -320,7 +317,7 @@ impl BodyInteraction for RigidContacts {
     /// (slot, shear, roll) of touching sphere–wall contacts]. Pairs that
     /// do not touch carry the zero history, so these rows are the whole state.
     fn carried_state(&self) -> Vec<f64> {
-        let s = self.state.lock().unwrap();
+        let s = &self.state;
         let mut pairs = Vec::new();
         s.pairs.write_rows(&mut pairs);
         let mut out = vec![f64::NAN, (pairs.len() / PAIR_ROW) as f64];
@@ -335,7 +332,7 @@ impl BodyInteraction for RigidContacts {
         out
     }
 
-    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
         let bad = || "rigid contact history: malformed carried state".to_string();
         let [_, pairs, rows @ ..] = state else {
             return if state.is_empty() { Ok(()) } else { Err(bad()) };
@@ -347,7 +344,7 @@ impl BodyInteraction for RigidContacts {
             return Err(bad());
         }
         let (pair_rows, wall_rows) = rows.split_at(n_pairs * PAIR_ROW);
-        let mut s = self.state.lock().unwrap();
+        let s = &mut self.state;
         // The sphere count is known at the next evaluation; rows naming
         // spheres beyond it are never listed, so never placed.
         s.pairs
@@ -364,13 +361,12 @@ impl BodyInteraction for RigidContacts {
     /// of different bodies and sphere–wall contacts at the view's placement
     /// (pairs taken from the list of the last force evaluation, whose skin
     /// covers the half step since).
-    fn potential_energy(&self, view: &BodyView<'_>, t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>, t: f64) -> f64 {
         let world = view.world;
         let centres = &world.sphere_centre;
         let radius = &world.sphere_radius;
         let n = centres.len();
-        let mut guard = self.state.lock().unwrap();
-        let st = &mut *guard;
+        let st = &mut self.state;
         let r_max = radius.iter().cloned().fold(0.0, f64::max);
         st.refresh(centres, &world.sphere_body, r_max, &self.boundary);
         let image = self.boundary.image();
@@ -401,29 +397,5 @@ impl BodyInteraction for RigidContacts {
             }
         }
         u
-    }
-}
-
-/// A shared interaction (keep an `Arc` to read wall forces while the
-/// integrator owns a clone).
-impl<T: BodyInteraction> BodyInteraction for Arc<T> {
-    fn name(&self) -> &str {
-        (**self).name()
-    }
-
-    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
-        (**self).add_wrenches(view, t, wrench)
-    }
-
-    fn potential_energy(&self, view: &BodyView<'_>, t: f64) -> f64 {
-        (**self).potential_energy(view, t)
-    }
-
-    fn carried_state(&self) -> Vec<f64> {
-        (**self).carried_state()
-    }
-
-    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
-        (**self).restore_carried_state(state)
     }
 }

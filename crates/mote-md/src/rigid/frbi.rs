@@ -221,6 +221,14 @@ impl Frbi {
         &self.wrench
     }
 
+    /// The first interaction of type `T` (the contact model, say), to
+    /// read what it measured.
+    pub fn find<T: BodyInteraction + 'static>(&self) -> Option<&T> {
+        self.interactions
+            .iter()
+            .find_map(|it| (**it).as_any().downcast_ref::<T>())
+    }
+
     /// The interactions, to change their settings between steps.
     pub fn interactions_mut(&mut self) -> &mut [Box<dyn BodyInteraction>] {
         &mut self.interactions
@@ -295,7 +303,7 @@ impl Frbi {
             world: &self.world,
             dt,
         };
-        for it in &self.interactions {
+        for it in &mut self.interactions {
             it.add_wrenches(&view, t, &mut self.wrench);
         }
         &self.wrench
@@ -365,14 +373,13 @@ impl Frbi {
     }
 
     /// Gives each interaction back what [`Frbi::carried_state`] took.
-    pub fn restore_carried_state(&self, carried: &[(usize, Vec<f64>)]) -> Result<(), String> {
+    pub fn restore_carried_state(&mut self, carried: &[(usize, Vec<f64>)]) -> Result<(), String> {
+        let count = self.interactions.len();
         for (k, values) in carried {
-            let it = self.interactions.get(*k).ok_or_else(|| {
-                format!(
-                    "state for interaction {k}, but there are {}",
-                    self.interactions.len()
-                )
-            })?;
+            let it = self
+                .interactions
+                .get_mut(*k)
+                .ok_or_else(|| format!("state for interaction {k}, but there are {count}"))?;
             it.restore_carried_state(values)?;
         }
         Ok(())
@@ -388,7 +395,7 @@ impl Frbi {
         };
         let potential = self
             .interactions
-            .iter()
+            .iter_mut()
             .map(|it| it.potential_energy(&view, b.time))
             .sum();
         BodyEnergies {

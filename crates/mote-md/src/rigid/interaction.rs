@@ -17,16 +17,20 @@ use super::bodies::RigidBodies;
 use super::free8::{world8, LANES};
 
 /// A source of forces and torques on bodies; one virtual call per step.
-pub trait BodyInteraction: Send + Sync {
+/// Interactions that carry state from step to step (contact histories,
+/// held long-range forces, neighbour lists) change it through `&mut self`:
+/// the integrator owns them, and callers read them back by type
+/// ([`crate::rigid::Frbi::find`]).
+pub trait BodyInteraction: AsAny + Send + Sync {
     /// A short name for reports.
     fn name(&self) -> &str;
 
     /// Adds to `wrench[i]` the torque (about the centre of mass, in `omega`)
     /// and force (in `v`) on body i at time `t`.
-    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]);
+    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]);
 
     /// The potential energy at time `t` (zero for dissipative forces).
-    fn potential_energy(&self, _view: &BodyView<'_>, _t: f64) -> f64 {
+    fn potential_energy(&mut self, _view: &BodyView<'_>, _t: f64) -> f64 {
         0.0
     }
     /// Applies a change asked for from the live viewer when this
@@ -44,12 +48,24 @@ pub trait BodyInteraction: Send + Sync {
 
     /// Restores what [`BodyInteraction::carried_state`] gave, before the
     /// first evaluation of a resumed run.
-    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
         if state.is_empty() {
             Ok(())
         } else {
             Err(format!("{} carries no state", self.name()))
         }
+    }
+}
+
+/// A body interaction as `Any`, so that its owner can be asked for one of
+/// a given type (the contact model's wall forces, say).
+pub trait AsAny {
+    fn as_any(&self) -> &dyn std::any::Any;
+}
+
+impl<T: std::any::Any> AsAny for T {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }
 

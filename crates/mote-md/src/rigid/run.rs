@@ -5,8 +5,6 @@
 //! histories. The run is put together by the front (mote-front's rigid.rs),
 //! as every engine's is.
 
-use std::sync::Arc;
-
 use glam::DVec3;
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
@@ -24,8 +22,6 @@ use crate::error::MdError;
 pub struct RigidDynamics {
     pub bodies: RigidBodies,
     pub frbi: Frbi,
-    /// The contact model (shared with the integrator), for the wall forces.
-    pub contacts: Option<Arc<RigidContacts>>,
     pub dt: f64,
     /// Steps taken since the bodies were placed.
     pub step: u64,
@@ -34,12 +30,17 @@ pub struct RigidDynamics {
 }
 
 impl RigidDynamics {
+    /// The contact model the integrator owns, if any (wall forces, the
+    /// periodic box).
+    pub fn contacts(&self) -> Option<&RigidContacts> {
+        self.frbi.find()
+    }
+
     /// The bodies and integrator a scene built, before their first step.
     pub fn new(built: super::scene::BuiltRigid) -> Self {
         RigidDynamics {
             bodies: built.bodies,
             frbi: built.frbi,
-            contacts: built.contacts,
             dt: built.dt,
             step: 0,
             last_step: built.steps,
@@ -112,11 +113,7 @@ impl Propagator for RigidDynamics {
             potential_energy: e.potential,
             linear_momentum: o.linear_momentum,
             angular_momentum: o.angular_momentum,
-            wall_forces: self
-                .contacts
-                .as_ref()
-                .map(|c| c.wall_forces())
-                .unwrap_or_default(),
+            wall_forces: self.contacts().map(|c| c.wall_forces()).unwrap_or_default(),
         }
     }
 
@@ -142,7 +139,7 @@ impl Propagator for RigidDynamics {
 
     fn walls(&self) -> Vec<mote_run::WallGeometry> {
         let t = self.bodies.time;
-        self.contacts
+        self.contacts()
             .iter()
             .flat_map(|c| c.walls.iter().map(move |w| w.geometry(t)))
             .collect()
@@ -337,7 +334,7 @@ impl RigidDynamics {
     /// The spheres as a frame: in the periodic box of the contacts, if
     /// any, each body moved whole into it ([`sphere_frame_in`]).
     pub fn sphere_frame(&self) -> Frame {
-        match &self.contacts {
+        match self.contacts() {
             Some(c) if c.boundary.is_periodic() => sphere_frame_in(&self.bodies, &c.boundary),
             _ => sphere_frame(&self.bodies),
         }

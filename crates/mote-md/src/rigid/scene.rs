@@ -99,8 +99,6 @@
 //! trajectory_every = 1000
 //! ```
 
-use std::sync::Arc;
-
 use glam::DVec3;
 use mote_geom::{from_axis_angle, DE, E};
 use mote_io::{ParseError, Source};
@@ -444,11 +442,16 @@ pub struct RunSettings {
 pub struct BuiltRigid {
     pub bodies: RigidBodies,
     pub frbi: Frbi,
-    /// The contact model (shared with the integrator), if any.
-    pub contacts: Option<Arc<RigidContacts>>,
     pub dt: f64,
     pub steps: u64,
     pub seed: u64,
+}
+
+impl BuiltRigid {
+    /// The contact model, if the scene has `[rigid.contacts]`.
+    pub fn contacts(&self) -> Option<&RigidContacts> {
+        self.frbi.find()
+    }
 }
 
 /// Whether a scene text is a rigid-body scene (has a `[rigid]` table).
@@ -724,7 +727,6 @@ impl RigidScene {
         for (k, w) in rigid.wall.iter().enumerate() {
             walls.extend(w.get_ref().walls(k).map_err(|m| err(w.span(), m))?);
         }
-        let mut contacts = None;
         match contact {
             Some(c) => {
                 let (span, cs) = (c.span(), c.get_ref());
@@ -774,9 +776,7 @@ impl RigidScene {
                         periodic: p,
                     });
                 }
-                let model = Arc::new(model);
-                frbi.push(Box::new(model.clone()));
-                contacts = Some(model);
+                frbi.push(Box::new(model));
             }
             None if !walls.is_empty() => {
                 return Err(err(
@@ -864,7 +864,6 @@ impl RigidScene {
         Ok(BuiltRigid {
             bodies,
             frbi,
-            contacts,
             dt: run.dt,
             steps,
             seed,

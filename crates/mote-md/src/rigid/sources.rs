@@ -119,7 +119,7 @@ impl BodyInteraction for ExternalFields {
         )))
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
         let (e, b) = (self.electric.at(t), self.magnetic.at(t));
         let bodies = view.bodies;
         for (i, w) in wrench.iter_mut().enumerate() {
@@ -129,7 +129,7 @@ impl BodyInteraction for ExternalFields {
         }
     }
 
-    fn potential_energy(&self, view: &BodyView<'_>, t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>, t: f64) -> f64 {
         let (e, b) = (self.electric.at(t), self.magnetic.at(t));
         let bodies = view.bodies;
         (0..bodies.len())
@@ -169,13 +169,13 @@ impl BodyInteraction for Gravity {
         Some(Ok(text))
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
         for (i, w) in wrench.iter_mut().enumerate() {
             w.v += view.bodies.template(i).mass() * self.g;
         }
     }
 
-    fn potential_energy(&self, view: &BodyView<'_>, _t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
         let b = view.bodies;
         (0..b.len())
             .map(|i| -b.template(i).mass() * self.g.dot(b.position[i]))
@@ -214,7 +214,7 @@ impl BodyInteraction for AirDrag {
         Some(Ok(text))
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
         let b = view.bodies;
         for (i, w) in wrench.iter_mut().enumerate() {
             let r = b.template(i).equivalent_radius;
@@ -281,7 +281,7 @@ impl BodyInteraction for Coulomb {
         "Coulomb"
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
         let b = view.bodies;
         let n = b.len();
         for_each_body(n, wrench, |i| {
@@ -304,7 +304,7 @@ impl BodyInteraction for Coulomb {
         });
     }
 
-    fn potential_energy(&self, view: &BodyView<'_>, _t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
         let b = view.bodies;
         let mut u = 0.0;
         for i in 0..b.len() {
@@ -322,7 +322,7 @@ impl BodyInteraction for DipoleDipole {
         "dipole-dipole"
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
         let b = view.bodies;
         let m = &view.world.dipole;
         let n = b.len();
@@ -345,7 +345,7 @@ impl BodyInteraction for DipoleDipole {
         });
     }
 
-    fn potential_energy(&self, view: &BodyView<'_>, _t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
         let b = view.bodies;
         let m = &view.world.dipole;
         let mut u = 0.0;
@@ -376,7 +376,7 @@ pub struct PlaneCoulomb {
     /// The height z₀ of the first plane.
     pub z0: f64,
     pub every: u64,
-    held: std::sync::Mutex<HeldForces>,
+    held: HeldForces,
 }
 
 /// The last sum of the charges' forces on one another, per body.
@@ -424,9 +424,9 @@ impl BodyInteraction for PlaneCoulomb {
         "Coulomb between conducting planes"
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
-        let mut held = self.held.lock().unwrap_or_else(|e| e.into_inner());
+    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
         let (index, position, charge) = self.charged(view);
+        let held = &mut self.held;
         if held.calls.is_multiple_of(self.every) || held.force.len() != index.len() {
             let mut force = vec![DVec3::ZERO; index.len()];
             self.planes.evaluate(&position, &charge, Some(&mut force));
@@ -445,7 +445,7 @@ impl BodyInteraction for PlaneCoulomb {
         }
     }
 
-    fn potential_energy(&self, view: &BodyView<'_>, _t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
         let (_, position, charge) = self.charged(view);
         self.planes.evaluate(&position, &charge, None).total()
     }
@@ -456,7 +456,7 @@ impl BodyInteraction for PlaneCoulomb {
         if self.every == 1 {
             return Vec::new();
         }
-        let held = self.held.lock().unwrap_or_else(|e| e.into_inner());
+        let held = &self.held;
         let mut out = vec![held.calls as f64];
         for (i, f) in &held.force {
             out.extend([*i as f64, f.x, f.y, f.z]);
@@ -464,7 +464,7 @@ impl BodyInteraction for PlaneCoulomb {
         out
     }
 
-    fn restore_carried_state(&self, state: &[f64]) -> Result<(), String> {
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
         if state.is_empty() {
             return Ok(());
         }
@@ -475,7 +475,7 @@ impl BodyInteraction for PlaneCoulomb {
                 state.len()
             ));
         }
-        let mut held = self.held.lock().unwrap_or_else(|e| e.into_inner());
+        let held = &mut self.held;
         held.calls = state[0] as u64;
         held.force = state[1..]
             .chunks(4)
@@ -501,7 +501,7 @@ impl BodyInteraction for LatentField {
         "latent image"
     }
 
-    fn add_wrenches(&self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
         let b = view.bodies;
         for_each_body(b.len(), wrench, |i| {
             let q = b.template(i).charge;
