@@ -95,7 +95,7 @@ fn bench_dipolar(c: &mut Criterion) {
     let n = 1000;
     let mut b = clumps(n);
     let mut f = fields()
-        .with(Coulomb { k: 8.9875517923e9 })
+        .with(Coulomb::new(8.9875517923e9))
         .with(DipoleDipole { k: 1e-7 });
     g.throughput(Throughput::Elements(n as u64));
     g.bench_with_input(BenchmarkId::from_parameter(n), &n, |bench, _| {

@@ -47,7 +47,7 @@ fn pair() -> RigidBodies {
 
 fn frbi(spin: SpinUpdate) -> Frbi {
     let mut f = Frbi::new()
-        .with(Coulomb { k: 1.0 })
+        .with(Coulomb::new(1.0))
         .with(DipoleDipole { k: 1.0 });
     f.spin = spin;
     f

@@ -383,7 +383,7 @@ impl BodyInteraction for RigidContacts {
                 let r = image.apply(pos[s] - pos[o]).length();
                 if r < reach {
                     let r_eff = radius[s] * radius[o] / reach;
-                    u += 8.0 / 15.0 * self.law.e_star * r_eff.sqrt() * (reach - r).powf(2.5);
+                    u += self.law.elastic_energy(reach - r, r_eff);
                 }
             }
         }
@@ -392,7 +392,7 @@ impl BodyInteraction for RigidContacts {
                 let r = radius[s];
                 let (gap, _) = wall.gap(centres[s], t);
                 if gap < r && gap > -r {
-                    u += 8.0 / 15.0 * self.wall_law.e_star * r.sqrt() * (r - gap).powf(2.5);
+                    u += self.wall_law.elastic_energy(r - gap, r);
                 }
             }
         }

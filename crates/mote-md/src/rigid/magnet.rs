@@ -21,7 +21,7 @@
 //! moments see each other's dipole fields too (mutual induction by fixed
 //! point, m_i = α(B(x_i) + Σ_j B_j(x_i))). Each moment feels
 //! F = (m·∇)B of the roller and the dipole–dipole forces of the others
-//! ([`super::sources::dipole_pair`], as between permanent dipoles)
+//! ([`crate::force::dipolar::dipole_pair`], as between permanent dipoles)
 //! (minimum image along the periodic axes); the moments are taken as
 //! isotropic, along the local field, so they exert no torque.
 
@@ -32,7 +32,7 @@ use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
-use super::sources::dipole_pair;
+use crate::force::dipolar::{dipole_field, dipole_pair};
 
 /// μ₀ in SI.
 pub const MU0: f64 = 4.0e-7 * PI;
@@ -175,7 +175,8 @@ impl InducedDipoles {
     /// k [3 d(m·d)/d⁵ − m/d³].
     #[inline]
     fn dipole_field(&self, d: DVec3, m: DVec3) -> DVec3 {
-        self.dipole_dipole * dipole_pair(DVec3::ZERO, m, self.separation(d)).1
+        let d = self.separation(d);
+        dipole_field(self.dipole_dipole, m, d, 1.0 / d.length_squared())
     }
 }
 
@@ -197,7 +198,8 @@ impl BodyInteraction for InducedDipoles {
                         if j == i {
                             continue;
                         }
-                        f += k * dipole_pair(mi, m[j], self.separation(x[i] - x[j])).0;
+                        let d = self.separation(x[i] - x[j]);
+                        f += dipole_pair(k, d, 1.0 / d.length_squared(), mi, m[j]).1;
                     }
                 }
                 f

@@ -707,7 +707,7 @@ impl RigidScene {
                 frbi.push(Box::new(ExternalFields { electric, magnetic }));
             }
             if let Some(k) = fs.coulomb {
-                frbi.push(Box::new(Coulomb { k }));
+                frbi.push(Box::new(Coulomb::new(k)));
             }
             if let Some(k) = fs.dipole_dipole {
                 frbi.push(Box::new(DipoleDipole { k }));

@@ -14,8 +14,10 @@ use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
+use crate::force::dipolar::dipole_pair;
 use crate::force::latent::LatentImage;
 use crate::force::slab::ConductingPlanes;
+use crate::force::DirectGravity;
 
 /// A homogeneous field as a function of time.
 #[derive(Clone)]
@@ -229,10 +231,27 @@ impl BodyInteraction for AirDrag {
 
 /// Coulomb forces between the bodies' point charges (all pairs):
 /// `Fᵢ = k Σⱼ qᵢqⱼ (xᵢ − xⱼ)/|xᵢ − xⱼ|³`, k = 1/(4πε₀) in SI. No torque:
-/// the charges sit at the centres of mass.
-#[derive(Clone, Copy, Debug)]
+/// the charges sit at the centres of mass. The pair sums are the point
+/// particles' (`DirectCoulomb`): the tiled inverse-square kernel gravity
+/// uses, unsoftened.
+#[derive(Clone, Debug)]
 pub struct Coulomb {
     pub k: f64,
+    kernel: DirectGravity,
+    charge: Vec<f64>,
+    field: Vec<DVec3>,
+}
+
+impl Coulomb {
+    /// Coulomb's law with constant `k`.
+    pub fn new(k: f64) -> Self {
+        Self {
+            k,
+            kernel: DirectGravity::new(1.0, 0.0),
+            charge: Vec::new(),
+            field: Vec::new(),
+        }
+    }
 }
 
 /// Magnetic dipole–dipole interaction between the bodies' dipoles (all
@@ -244,20 +263,6 @@ pub struct Coulomb {
 #[derive(Clone, Copy, Debug)]
 pub struct DipoleDipole {
     pub k: f64,
-}
-
-/// One pair of point dipoles at separation r = xᵢ − xⱼ (k = 1): the force
-/// on i, 3/r⁵ [(mᵢ·mⱼ) r + mᵢ(mⱼ·r) + mⱼ(mᵢ·r) − 5(mᵢ·r)(mⱼ·r) r/r²], and
-/// the field of j at i, 3 r(mⱼ·r)/r⁵ − mⱼ/r³.
-#[inline]
-pub(crate) fn dipole_pair(mi: DVec3, mj: DVec3, r: DVec3) -> (DVec3, DVec3) {
-    let r2 = r.length_squared();
-    let inv_r2 = 1.0 / r2;
-    let inv_r3 = inv_r2 * inv_r2.sqrt();
-    let inv_r5 = inv_r3 * inv_r2;
-    let (mir, mjr) = (mi.dot(r), mj.dot(r));
-    let f = (3.0 * inv_r5) * (mi.dot(mj) * r + mjr * mi + mir * mj - 5.0 * mir * mjr * inv_r2 * r);
-    (f, (3.0 * mjr * inv_r5) * r - inv_r3 * mj)
 }
 
 /// Bodies at or above this count use rayon for the all-pairs sums.
@@ -283,37 +288,25 @@ impl BodyInteraction for Coulomb {
 
     fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
         let b = view.bodies;
-        let n = b.len();
-        for_each_body(n, wrench, |i| {
-            let qi = b.template(i).charge;
-            if qi == 0.0 {
-                return DE::ZERO;
-            }
-            let xi = b.position[i];
-            let mut f = DVec3::ZERO;
-            for j in 0..n {
-                if j == i {
-                    continue;
-                }
-                let qj = b.template(j).charge;
-                let r = xi - b.position[j];
-                let r2 = r.length_squared();
-                f += (qj / (r2 * r2.sqrt())) * r;
-            }
-            DE::new(DVec3::ZERO, self.k * qi * f)
-        });
+        self.charge.clear();
+        self.charge
+            .extend((0..b.len()).map(|i| b.template(i).charge));
+        self.field.clear();
+        self.field.resize(b.len(), DVec3::ZERO);
+        // The kernel gives Σ_j q_j (x_j − x_i)/r³: like charges repel.
+        self.kernel
+            .inverse_square_field(&b.position, &self.charge, &mut self.field);
+        for ((w, e), q) in wrench.iter_mut().zip(&self.field).zip(&self.charge) {
+            w.v -= *e * (self.k * q);
+        }
     }
 
     fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
         let b = view.bodies;
-        let mut u = 0.0;
-        for i in 0..b.len() {
-            for j in 0..i {
-                let qq = b.template(i).charge * b.template(j).charge;
-                u += qq / (b.position[i] - b.position[j]).length();
-            }
-        }
-        self.k * u
+        self.charge.clear();
+        self.charge
+            .extend((0..b.len()).map(|i| b.template(i).charge));
+        0.5 * self.k * self.kernel.pair_potential_sum(&b.position, &self.charge)
     }
 }
 
@@ -332,16 +325,17 @@ impl BodyInteraction for DipoleDipole {
                 return DE::ZERO;
             }
             let xi = b.position[i];
-            let (mut f, mut field) = (DVec3::ZERO, DVec3::ZERO);
+            let (mut f, mut torque) = (DVec3::ZERO, DVec3::ZERO);
             for j in 0..n {
                 if j == i {
                     continue;
                 }
-                let (fij, bj) = dipole_pair(mi, m[j], xi - b.position[j]);
+                let d = xi - b.position[j];
+                let (_, fij, ti, _) = dipole_pair(self.k, d, 1.0 / d.length_squared(), mi, m[j]);
                 f += fij;
-                field += bj;
+                torque += ti;
             }
-            DE::new(self.k * mi.cross(field), self.k * f)
+            DE::new(torque, f)
         });
     }
 
@@ -351,13 +345,11 @@ impl BodyInteraction for DipoleDipole {
         let mut u = 0.0;
         for i in 0..b.len() {
             for j in 0..i {
-                let r = b.position[i] - b.position[j];
-                let r2 = r.length_squared();
-                let r3 = r2 * r2.sqrt();
-                u += m[i].dot(m[j]) / r3 - 3.0 * m[i].dot(r) * m[j].dot(r) / (r3 * r2);
+                let d = b.position[i] - b.position[j];
+                u += dipole_pair(self.k, d, 1.0 / d.length_squared(), m[i], m[j]).0;
             }
         }
-        self.k * u
+        u
     }
 }
 

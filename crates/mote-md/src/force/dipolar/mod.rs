@@ -93,8 +93,21 @@ pub enum DipolarError {
     NotPositive { what: &'static str, value: f64 },
 }
 
+/// The field k [3 d (m·d)/r⁵ − m/r³] of a point dipole m at separation
+/// d = r − r_m from it, with 1/r² = `inv_r2` (the field a torque
+/// τ = μ × B and an induced moment see; its gradient gives the force of
+/// [`dipole_pair`]).
+#[inline(always)]
+pub fn dipole_field(k: f64, m: DVec3, d: DVec3, inv_r2: f64) -> DVec3 {
+    let inv_r3 = k * inv_r2 * inv_r2.sqrt();
+    d * (3.0 * m.dot(d) * inv_r3 * inv_r2) - m * inv_r3
+}
+
 /// Energy, force on i, torque on i and torque on j of one dipole pair at
-/// separation d = r_i − r_j with 1/r² = `inv_r2`, for prefactor k = μ₀/4π.
+/// separation d = r_i − r_j with 1/r² = `inv_r2`, for prefactor k = μ₀/4π
+/// (004 Eq. 8): the one dipole pair law of mote, used by point particles
+/// (all pairs, cut-off, the magnetisation) and rigid bodies (permanent and
+/// induced moments) alike.
 #[inline(always)]
 pub fn dipole_pair(
     k: f64,

@@ -298,7 +298,7 @@ impl Interaction for GranularContacts {
                 if r < reach {
                     let delta = reach - r;
                     let r_eff = radius[i] * radius[j] / reach;
-                    u += 8.0 / 15.0 * self.law.e_star * r_eff.sqrt() * delta.powf(2.5);
+                    u += self.law.elastic_energy(delta, r_eff);
                 }
             }
         }

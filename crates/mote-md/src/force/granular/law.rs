@@ -127,6 +127,16 @@ impl ContactLaw {
         }
     }
 
+    /// The Hertz elastic energy (8/15) E* √R* δ^{5/2} stored in a contact
+    /// of overlap `delta` ≥ 0 and effective radius `r_eff` (the integral of
+    /// the elastic force (4/3) E* √R* δ^{3/2}; Johnson, Contact Mechanics,
+    /// Eq. 4.23). Every contact of mote (spheres, clumps, walls) stores
+    /// its energy by this.
+    #[inline]
+    pub fn elastic_energy(&self, delta: f64, r_eff: f64) -> f64 {
+        8.0 / 15.0 * self.e_star * r_eff.sqrt() * delta.powf(2.5)
+    }
+
     /// The contact force for overlap `delta` > 0 along the unit normal `n`
     /// (pointing from the second body to the first), the velocity of the
     /// first body's surface relative to the second's at the contact point

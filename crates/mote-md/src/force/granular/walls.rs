@@ -344,7 +344,7 @@ impl Interaction for GranularWalls {
                 let r = state.radius[i];
                 let (gap, _) = wall.gap(x, state.time);
                 if gap < r && gap > -r {
-                    u += 8.0 / 15.0 * self.law.e_star * r.sqrt() * (r - gap).powf(2.5);
+                    u += self.law.elastic_energy(r - gap, r);
                 }
             }
         }
