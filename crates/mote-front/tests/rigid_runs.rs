@@ -226,14 +226,16 @@ potential = [0.0, {volts}]
 accuracy = 1.0e-13
 r_cut = 4.0e-5
 
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [1.0e-4, 1.0e-4, 2.5e-4]
+periodic = [true, true, false]
+
 [rigid.contacts]
 young = 5.0e6
 restitution = 0.3
 friction = 0.3
 adhesion = 5.0e-4
-periodic = [true, true, false]
-box_lo = [0.0, 0.0, 0.0]
-box_hi = [1.0e-4, 1.0e-4, 2.5e-4]
 
 [[rigid.wall]]
 kind = "plane"

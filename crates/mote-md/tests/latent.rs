@@ -241,12 +241,14 @@ position = [0.3, 0.2, 1.15]
 template = "toner"
 position = [1.1, 0.3, 1.6]
 
+[box]
+lo = [0.0, 0.0, 1.0]
+hi = [1.5, 0.5, 2.0]
+periodic = [true, true, false]
+
 [rigid.contacts]
 young = 1e5
 restitution = 0.5
-periodic = [true, true, false]
-box_lo = [0.0, 0.0, 1.0]
-box_hi = [1.5, 0.5, 2.0]
 
 [rigid.planes]
 coulomb = 1.0

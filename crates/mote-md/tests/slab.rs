@@ -264,12 +264,14 @@ charge = 0.8
 template = "toner"
 position = [4.0, 5.0, 2.3]
 
+[box]
+lo = [0.0, 0.0, 2.0]
+hi = [10.0, 10.0, 3.0]
+periodic = [true, true, false]
+
 [rigid.contacts]
 young = 1e5
 restitution = 0.5
-periodic = [true, true, false]
-box_lo = [0.0, 0.0, 2.0]
-box_hi = [10.0, 10.0, 3.0]
 
 [rigid.planes]
 coulomb = 1.0
@@ -305,5 +307,24 @@ steps = 1
         .err()
         .unwrap();
     assert!(e.to_string().contains("remove coulomb"), "{e}");
-    assert_eq!(e.line, 24, "{e}");
+    let planes_line = twice.lines().position(|l| l == "[rigid.planes]").unwrap() + 1;
+    assert_eq!(e.line, planes_line, "{e}");
+    // The box's first spelling, inside [rigid.contacts], is refused with
+    // the one every engine uses.
+    let old = text
+        .replace("[box]\nlo = [0.0, 0.0, 2.0]\nhi = [10.0, 10.0, 3.0]\nperiodic = [true, true, false]\n\n", "")
+        .replace("[rigid.contacts]\n", "[rigid.contacts]\nbox_lo = [0.0, 0.0, 2.0]\n");
+    assert_ne!(old, text);
+    let e = RigidScene::parse(&old, "old.toml")
+        .unwrap()
+        .build(&old, "old.toml", None)
+        .err()
+        .unwrap();
+    let line = old.lines().position(|l| l.starts_with("box_lo")).unwrap() + 1;
+    assert_eq!(e.line, line, "{e}");
+    assert!(
+        e.to_string()
+            .contains("[box] lo = [...], hi = [...], periodic = [...]"),
+        "{e}"
+    );
 }

@@ -76,10 +76,10 @@ pub fn probe(
             )
         })
     };
-    let Some((lo, hi, _)) = scene.contact_box() else {
+    let Some((lo, hi, _)) = scene.box_faces() else {
         return Err(src.error(
             span.clone(),
-            "[rigid.nip] needs the box of [rigid.contacts] (box_lo, box_hi)",
+            "[rigid.nip] needs the scene's [box] (the shell and the belt are its faces)",
         ));
     };
     let latent = scene

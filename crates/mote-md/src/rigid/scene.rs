@@ -54,9 +54,13 @@
 //! friction = 0.5
 //! rolling_friction = 0.0
 //! skin = 0.2                   # Verlet skin (default 0.2 × the largest sphere diameter)
-//! periodic = [true, true, false]  # with box_lo, box_hi: periodic axes
 //!
-//! [rigid.planes]               # conducting planes z = box_lo.z and z = box_hi.z
+//! [box]                        # as every engine spells it; contacts search across
+//! lo = [0.0, 0.0, 0.0]         # its periodic faces, planes and roller take its faces
+//! hi = [1e-3, 1e-3, 2.5e-4]
+//! periodic = [true, true, false]  # default: all axes
+//!
+//! [rigid.planes]               # conducting planes z = lo.z and z = hi.z of [box]
 //! coulomb = 8.99e9             # k: Coulomb forces between charges with all their images
 //! potential = [0.0, -300.0]    # volts on the lower and the upper plane
 //! accuracy = 1e-12             # RMS force error of the Ewald sum (newtons)
@@ -132,6 +136,11 @@ pub struct RigidScene {
     pub title: Option<String>,
     pub rigid: Spanned<RigidSettings>,
     pub run: Spanned<RunSettings>,
+    /// `[box]`, spelled as every engine spells it: `lo`, `hi` and the
+    /// periodic axes (default all). The contacts search across its
+    /// periodic faces; the planes, the roller and the nip take its faces.
+    #[serde(rename = "box", default)]
+    pub bounds: Option<Spanned<crate::scene::BoxSettings>>,
     /// The `[output]` of every time-stepped engine (`inspect`, which names
     /// point particles, is refused).
     #[serde(default)]
@@ -415,12 +424,13 @@ pub struct ContactSettings {
     pub limit_damping: bool,
     #[serde(default)]
     pub skin: Option<f64>,
+    /// The box's old spellings, read only to be refused with the new one.
     #[serde(default)]
-    pub periodic: Option<[bool; 3]>,
+    periodic: Option<Spanned<toml::Value>>,
     #[serde(default)]
-    pub box_lo: Option<[f64; 3]>,
+    box_lo: Option<Spanned<toml::Value>>,
     #[serde(default)]
-    pub box_hi: Option<[f64; 3]>,
+    box_hi: Option<Spanned<toml::Value>>,
 }
 
 fn default_poisson() -> f64 {
@@ -518,6 +528,22 @@ impl RigidScene {
             };
         }
         let contact = rigid.contacts.as_ref();
+        if let Some(c) = contact {
+            let c = c.get_ref();
+            for (key, value) in [
+                ("box_lo", &c.box_lo),
+                ("box_hi", &c.box_hi),
+                ("periodic", &c.periodic),
+            ] {
+                if let Some(v) = value {
+                    return Err(err(
+                        v.span(),
+                        format!("[rigid.contacts] {key}: the box is a table of its own, spelled as every engine spells it: [box] lo = [...], hi = [...], periodic = [...]"),
+                    ));
+                }
+            }
+        }
+        let scene_box = self.scene_box(src)?;
         let material = contact.map(|c| Material {
             young: c.get_ref().young,
             poisson: c.get_ref().poisson,
@@ -760,21 +786,13 @@ impl RigidScene {
                     .fold(0.0, f64::max);
                 let skin = cs.skin.unwrap_or(0.4 * r_max);
                 let mut model = RigidContacts::new(law, law, walls, skin);
-                if let Some(p) = cs.periodic {
-                    let (Some(lo), Some(hi)) = (cs.box_lo, cs.box_hi) else {
-                        return Err(err(span, "periodic axes need box_lo and box_hi".into()));
-                    };
-                    let (lo, hi) = (DVec3::from(lo), DVec3::from(hi));
+                if let Some((b, span)) = scene_box.as_ref().filter(|(b, _)| b.is_periodic()) {
                     for d in 0..3 {
-                        if p[d] && (hi[d] - lo[d]) < 3.0 * (2.0 * r_max + skin) {
-                            return Err(err(span, "a periodic axis must be at least three sphere diameters plus skins long".into()));
+                        if b.periodic[d] && (b.hi[d] - b.lo[d]) < 3.0 * (2.0 * r_max + skin) {
+                            return Err(err(span.clone(), "a periodic axis of [box] must be at least three sphere diameters plus skins long".into()));
                         }
                     }
-                    model = model.with_boundary(Boundary {
-                        lo,
-                        hi,
-                        periodic: p,
-                    });
+                    model = model.with_boundary(*b);
                 }
                 frbi.push(Box::new(model));
             }
@@ -789,7 +807,7 @@ impl RigidScene {
 
         let mut planes = None;
         if let Some(p) = &rigid.planes {
-            let built = plane_coulomb(p, &rigid.contacts, &rigid.fields, &bodies)
+            let built = plane_coulomb(p, self.box_faces(), &rigid.fields, &bodies)
                 .map_err(|m| err(p.span(), m))?;
             planes = Some((built.planes.clone(), built.z0));
             frbi.push(Box::new(built));
@@ -824,7 +842,7 @@ impl RigidScene {
             frbi.push(Box::new(LatentField { image, z0: *z0 }));
         }
         if let Some(r) = &rigid.roller {
-            let model = induced_dipoles(r.get_ref(), &rigid.contacts, &names, &bodies)
+            let model = induced_dipoles(r.get_ref(), self.box_faces(), &names, &bodies)
                 .map_err(|m| err(r.span(), m))?;
             frbi.push(Box::new(model));
         }
@@ -882,33 +900,40 @@ impl RigidScene {
             .map(|k| k as u32)
     }
 
-    /// The box of `[rigid.contacts]` (lower and upper corner, periodic
-    /// axes), if it names one.
-    pub fn contact_box(&self) -> Option<(DVec3, DVec3, [bool; 3])> {
-        contact_box(&self.rigid.get_ref().contacts)
+    /// The scene's `[box]` (lower and upper corner, periodic axes), if it
+    /// has one.
+    pub fn box_faces(&self) -> Option<(DVec3, DVec3, [bool; 3])> {
+        let b = self.bounds.as_ref()?.get_ref();
+        Some((DVec3::from(b.lo), DVec3::from(b.hi), b.periodic))
+    }
+
+    /// `[box]` checked (lo < hi on every axis), with its span.
+    fn scene_box(
+        &self,
+        src: Source,
+    ) -> Result<Option<(Boundary, std::ops::Range<usize>)>, ParseError> {
+        match &self.bounds {
+            None => Ok(None),
+            Some(b) => Ok(Some((
+                crate::scene::run::boundary(&self.bounds, None, src)?,
+                b.span(),
+            ))),
+        }
     }
 }
 
-/// The box of `[rigid.contacts]` (box_lo, box_hi) and its periodic axes,
-/// if it names one.
-fn contact_box(contacts: &Option<Spanned<ContactSettings>>) -> Option<(DVec3, DVec3, [bool; 3])> {
-    let c = contacts.as_ref()?.get_ref();
-    Some((
-        DVec3::from(c.box_lo?),
-        DVec3::from(c.box_hi?),
-        c.periodic.unwrap_or([false; 3]),
-    ))
-}
-
-/// `[rigid.roller]` above the box of `[rigid.contacts]`.
+/// `[rigid.roller]` above the scene's `[box]`.
 fn induced_dipoles(
     rs: &RollerSettings,
-    contacts: &Option<Spanned<ContactSettings>>,
+    scene_box: Option<(DVec3, DVec3, [bool; 3])>,
     names: &[(String, u32)],
     bodies: &RigidBodies,
 ) -> Result<InducedDipoles, String> {
-    let Some((lo, hi, [true, true, _])) = contact_box(contacts) else {
-        return Err("[rigid.roller] needs [rigid.contacts] periodic along x and y with box_lo and box_hi (the shell is z = box_hi.z)".into());
+    let Some((lo, hi, [true, true, _])) = scene_box else {
+        return Err(
+            "[rigid.roller] needs a [box] periodic along x and y (the shell is its face z = hi.z)"
+                .into(),
+        );
     };
     if !positive(rs.field) || !positive(rs.radius) || rs.poles < 2 || !rs.poles.is_multiple_of(2) {
         return Err(
@@ -956,10 +981,10 @@ fn induced_dipoles(
     })
 }
 
-/// `[rigid.planes]` on the box of `[rigid.contacts]`.
+/// `[rigid.planes]` on the faces of the scene's `[box]`.
 fn plane_coulomb(
     p: &Spanned<PlaneSettings>,
-    contacts: &Option<Spanned<ContactSettings>>,
+    scene_box: Option<(DVec3, DVec3, [bool; 3])>,
     fields: &Option<Spanned<FieldSettings>>,
     bodies: &RigidBodies,
 ) -> Result<PlaneCoulomb, String> {
@@ -970,8 +995,8 @@ fn plane_coulomb(
     {
         return Err("[rigid.planes] sums the Coulomb forces with their images: remove coulomb from [rigid.fields]".into());
     }
-    let Some((lo, hi, [true, true, false])) = contact_box(contacts) else {
-        return Err("[rigid.planes] needs [rigid.contacts] with periodic = [true, true, false], box_lo and box_hi (the planes are z = box_lo.z and z = box_hi.z)".into());
+    let Some((lo, hi, [true, true, false])) = scene_box else {
+        return Err("[rigid.planes] needs a [box] with periodic = [true, true, false] (the planes are its faces z = lo.z and z = hi.z)".into());
     };
     if !positive(ps.coulomb) || !positive(ps.accuracy) {
         return Err("[rigid.planes] needs coulomb > 0 and accuracy > 0".into());
