@@ -241,6 +241,144 @@ pub const EVENT_DRIVEN_KEYS: &[&str] = &[
     "check_overlaps",
 ];
 
+/// `[box]` as every engine spells it: `hi` (and `lo`, which must be the
+/// origin: hard spheres live in [0, L); without `hi`, `packing_fraction`
+/// sets a cube), `periodic` per axis (default all; a non-periodic axis has
+/// hard walls), each with the line it is on.
+struct BoxTable {
+    lo: Option<(Vec<f64>, usize)>,
+    hi: Option<(Vec<f64>, usize)>,
+    periodic: Option<(Vec<bool>, usize)>,
+}
+
+impl BoxTable {
+    /// Sets the scene's box lengths and walls from the table, checked
+    /// against its dimension.
+    fn apply(self, scene: &mut Scene, source: &mote_io::Source) -> Result<(), EdmdError> {
+        let d = scene.dimension;
+        let at = |line: usize, message: String| EdmdError::Scene {
+            file: source.file.to_string(),
+            line,
+            message,
+        };
+        if let Some((hi, line)) = &self.hi {
+            if hi.len() != d || hi.iter().any(|x| !(*x > 0.0 && x.is_finite())) {
+                return Err(at(
+                    *line,
+                    format!("[box] hi must list {d} positive lengths (dimension = {d})"),
+                ));
+            }
+        }
+        if let Some((lo, line)) = self.lo {
+            if lo.len() != d || lo.iter().any(|x| *x != 0.0) {
+                return Err(at(
+                    line,
+                    format!("[box] lo: hard spheres live in a box from the origin: lo = {:?} (or leave it out)", vec![0.0; d]),
+                ));
+            }
+        }
+        let periodic = match self.periodic {
+            Some((p, line)) if p.len() != d => {
+                return Err(at(line, format!("[box] periodic must list {d} entries")))
+            }
+            Some((p, _)) => p,
+            None => vec![true; d],
+        };
+        scene.box_size = self.hi.map(|(hi, _)| hi);
+        scene.boundary = BoundarySpec::PerAxis(
+            periodic
+                .iter()
+                .map(|p| {
+                    if *p {
+                        Boundary::Periodic
+                    } else {
+                        Boundary::Wall
+                    }
+                })
+                .collect(),
+        );
+        Ok(())
+    }
+}
+
+/// Takes the `[box]` table out of the scene (before the hard-sphere keys
+/// are lifted to the top level, where the first format had a `box` list).
+fn take_box_table(
+    root: &mut toml_edit::Table,
+    source: &mote_io::Source,
+) -> Result<Option<BoxTable>, EdmdError> {
+    if !root.get("box").is_some_and(|b| b.is_table()) {
+        return Ok(None);
+    }
+    let item = root.remove("box").expect("checked");
+    let table = item.as_table().expect("checked");
+    let line_of =
+        |span: Option<std::ops::Range<usize>>| span.map_or(1, |s| source.line_of(s.start));
+    let at = |line: usize, message: String| EdmdError::Scene {
+        file: source.file.to_string(),
+        line,
+        message,
+    };
+    let numbers = |key: &str| -> Result<Option<(Vec<f64>, usize)>, EdmdError> {
+        let Some(v) = table.get(key) else {
+            return Ok(None);
+        };
+        let line = line_of(v.span());
+        let list = v
+            .as_array()
+            .and_then(|a| {
+                a.iter()
+                    .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                    .collect::<Option<Vec<f64>>>()
+            })
+            .ok_or_else(|| at(line, format!("[box] {key} must be a list of numbers")))?;
+        Ok(Some((list, line)))
+    };
+    for (key, v) in table.iter() {
+        if !["lo", "hi", "periodic"].contains(&key) {
+            return Err(at(
+                line_of(v.span()),
+                format!("unknown key `{key}` in [box]; it takes lo, hi, periodic"),
+            ));
+        }
+    }
+    let hi = numbers("hi")?;
+    let periodic = match table.get("periodic") {
+        None => None,
+        Some(v) => {
+            let line = line_of(v.span());
+            let list = v
+                .as_array()
+                .and_then(|a| a.iter().map(|x| x.as_bool()).collect::<Option<Vec<bool>>>())
+                .ok_or_else(|| at(line, "[box] periodic must be a list of true/false".into()))?;
+            Some((list, line))
+        }
+    };
+    Ok(Some(BoxTable {
+        lo: numbers("lo")?,
+        hi,
+        periodic,
+    }))
+}
+
+/// The first spellings of the box, `box = [lengths]` and `boundary`, are
+/// refused with the one every engine uses.
+fn refuse_old_box(root: &toml_edit::Table, source: &mote_io::Source) -> Result<(), EdmdError> {
+    for key in ["box", "boundary"] {
+        if let Some((k, item)) = root.get_key_value(key) {
+            let span = k.span().or_else(|| item.span());
+            return Err(EdmdError::Scene {
+                file: source.file.to_string(),
+                line: span.map_or(1, |s| source.line_of(s.start)),
+                message: format!(
+                    "`{key}`: the box is a table of its own, spelled as every engine spells it: [box] hi = [lengths], periodic = [true/false per axis] (false: hard walls)"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Where a scene gave its hard-sphere keys.
 enum Hoisted {
     /// In `[event_driven]` (or nowhere).
@@ -372,9 +510,14 @@ impl Scene {
         })?;
         let document = toml_edit::ImDocument::parse(text).map_err(|e| at(e.span(), e.message()))?;
         let mut root = document.into_table();
+        let shared_box = take_box_table(&mut root, &source)?;
         let hoisted = hoist_event_driven(&mut root, &source)?;
+        refuse_old_box(&root, &source)?;
         let mut scene: Scene = toml_edit::de::from_document(toml_edit::DocumentMut::from(root))
             .map_err(|e| at(e.span(), e.message()))?;
+        if let Some(b) = shared_box {
+            b.apply(&mut scene, &source)?;
+        }
         if let Hoisted::TopLevel(keys) = hoisted {
             scene.notes.push(format!(
                 "note: the hard-sphere keys at the top level (`{}`) are deprecated and go in one release: move them into [event_driven] (see docs/edmd.md)",

@@ -53,7 +53,7 @@ fn spheres_conserve_energy_and_momentum_over_a_million_collisions() {
 #[test]
 fn disks_with_walls_conserve_energy_and_periodic_momentum() {
     let scene = Scene::parse(
-        "dimension = 2\nn = 2000\npacking_fraction = 0.6\nboundary = [\"periodic\", \"wall\"]\nplacement = \"cubic\"\nlarge_fraction = 0.3\nsize_ratio = 1.2\n",
+        "dimension = 2\nn = 2000\npacking_fraction = 0.6\nplacement = \"cubic\"\nlarge_fraction = 0.3\nsize_ratio = 1.2\n[box]\nperiodic = [true, false]\n",
         "test",
     )
     .unwrap();

@@ -54,21 +54,33 @@ fn errors_name_the_line() {
     let (line, msg) = scene_error("dimension = 3\nn = 10\npacking_fraction = 0.9\n");
     assert_eq!(line, 3);
     assert!(msg.contains("packing_fraction"), "{msg}");
-    let (line, msg) =
-        scene_error("dimension = 3\nn = 10\npacking_fraction = 0.1\nboundary = \"sticky\"\n");
-    assert_eq!(line, 4);
-    assert!(
-        msg.contains("boundary") || msg.contains("variant") || msg.contains("did not match"),
-        "{msg}"
+    let (line, msg) = scene_error(
+        "dimension = 3\nn = 10\npacking_fraction = 0.1\n[box]\nperiodic = [true, \"sticky\", true]\n",
     );
+    assert_eq!(line, 5);
+    assert!(msg.contains("[box] periodic"), "{msg}");
     let (line, msg) = scene_error("dimension = 4\nn = 10\npacking_fraction = 0.1\n");
     assert_eq!(line, 1);
     assert!(msg.contains("2 (disks) or 3"), "{msg}");
     let (line, msg) = scene_error("n = 10\npacking_fraction = 0.1\ntemprature = 1.0\n");
     assert_eq!(line, 3);
     assert!(msg.contains("temprature"), "{msg}");
-    let (line, _) = scene_error("n = 10\nbox = [1.0, 2.0]\n");
-    assert_eq!(line, 2);
+    let (line, msg) = scene_error("n = 10\n[box]\nhi = [1.0, 2.0]\n");
+    assert_eq!(line, 3);
+    assert!(msg.contains("3 positive lengths"), "{msg}");
+    let (line, msg) = scene_error("n = 10\n[box]\nlo = [1.0, 0.0, 0.0]\nhi = [3.0, 3.0, 3.0]\n");
+    assert_eq!(line, 3);
+    assert!(msg.contains("from the origin"), "{msg}");
+    // The first spellings are refused with the one every engine uses,
+    // in [event_driven] and at the top level alike.
+    for (text, line) in [
+        ("[event_driven]\nn = 10\nbox = [3.0, 3.0, 3.0]\n", 3),
+        ("n = 10\npacking_fraction = 0.1\nboundary = \"wall\"\n", 3),
+    ] {
+        let (at, msg) = scene_error(text);
+        assert_eq!(at, line, "{text}: {msg}");
+        assert!(msg.contains("[box] hi = [lengths]"), "{msg}");
+    }
     let e = Scene::parse("n = 10\npacking_fraction = 0.1\ntime = -1.0\n", "bad.toml").unwrap_err();
     assert!(e.to_string().starts_with("bad.toml:3: "), "{e}");
 }
