@@ -138,11 +138,12 @@ pub struct Scene {
     pub notes: Vec<String>,
     /// Explicit particles.
     pub particles: Option<Vec<ParticleSpec>>,
-    /// Initial state from the last frame of a trajectory file (.xyz, .dump,
-    /// .gsd, .vtu/.vtp/.pvd), relative to the scene file.
+    /// Initial state from a frame of a trajectory file (.xyz, .dump,
+    /// .gsd, .vtu/.vtp/.pvd), relative to the scene file: `[[from_file]]`.
+    #[serde(skip)]
     pub file: Option<String>,
-    /// `[[from_file]]`, the key time-stepped scenes use: one file, and
-    /// `frame` to pick one (negative counts from the end).
+    /// `[[from_file]]`, as every engine spells it: one file, and `frame`
+    /// to pick one (negative counts from the end).
     #[serde(default)]
     from_file: Vec<FileStart>,
     /// The frame of `file` (default the last).
@@ -361,18 +362,23 @@ fn take_box_table(
     }))
 }
 
-/// The first spellings of the box, `box = [lengths]` and `boundary`, are
-/// refused with the one every engine uses.
-fn refuse_old_box(root: &toml_edit::Table, source: &mote_io::Source) -> Result<(), EdmdError> {
-    for key in ["box", "boundary"] {
+/// The first spellings of the box (`box = [lengths]`, `boundary`) and of
+/// the initial file (`file`) are refused with the ones every engine uses.
+fn refuse_old_spellings(
+    root: &toml_edit::Table,
+    source: &mote_io::Source,
+) -> Result<(), EdmdError> {
+    for (key, spelling) in [
+        ("box", "the box is a table of its own, spelled as every engine spells it: [box] hi = [lengths], periodic = [true/false per axis] (false: hard walls)"),
+        ("boundary", "the box is a table of its own, spelled as every engine spells it: [box] hi = [lengths], periodic = [true/false per axis] (false: hard walls)"),
+        ("file", "a scene starts from a file as every engine spells it: [[from_file]] file = \"...\" (frame = N picks a frame)"),
+    ] {
         if let Some((k, item)) = root.get_key_value(key) {
             let span = k.span().or_else(|| item.span());
             return Err(EdmdError::Scene {
                 file: source.file.to_string(),
                 line: span.map_or(1, |s| source.line_of(s.start)),
-                message: format!(
-                    "`{key}`: the box is a table of its own, spelled as every engine spells it: [box] hi = [lengths], periodic = [true/false per axis] (false: hard walls)"
-                ),
+                message: format!("`{key}`: {spelling}"),
             });
         }
     }
@@ -512,7 +518,7 @@ impl Scene {
         let mut root = document.into_table();
         let shared_box = take_box_table(&mut root, &source)?;
         let hoisted = hoist_event_driven(&mut root, &source)?;
-        refuse_old_box(&root, &source)?;
+        refuse_old_spellings(&root, &source)?;
         let mut scene: Scene = toml_edit::de::from_document(toml_edit::DocumentMut::from(root))
             .map_err(|e| at(e.span(), e.message()))?;
         if let Some(b) = shared_box {
@@ -542,24 +548,12 @@ impl Scene {
             line: key_line(text, key),
             message,
         };
-        let key = if self.from_file.is_empty() {
-            "file"
-        } else {
-            "from_file"
-        };
-        self.file_named_at = Some((file.to_string(), key_line(text, key)));
+        self.file_named_at = Some((file.to_string(), key_line(text, "from_file")));
         match self.from_file.as_slice() {
             [] => {}
-            [start] if self.file.is_none() => {
+            [start] => {
                 self.file = Some(start.file.clone());
                 self.file_frame = start.frame;
-            }
-            [_] => {
-                return Err(err(
-                    "from_file",
-                    "give the initial file once: [[from_file]] or [event_driven] file, not both"
-                        .into(),
-                ))
             }
             _ => {
                 return Err(err(

@@ -73,13 +73,26 @@ fn errors_name_the_line() {
     assert!(msg.contains("from the origin"), "{msg}");
     // The first spellings are refused with the one every engine uses,
     // in [event_driven] and at the top level alike.
-    for (text, line) in [
-        ("[event_driven]\nn = 10\nbox = [3.0, 3.0, 3.0]\n", 3),
-        ("n = 10\npacking_fraction = 0.1\nboundary = \"wall\"\n", 3),
+    for (text, line, spelling) in [
+        (
+            "[event_driven]\nn = 10\nbox = [3.0, 3.0, 3.0]\n",
+            3,
+            "[box] hi = [lengths]",
+        ),
+        (
+            "n = 10\npacking_fraction = 0.1\nboundary = \"wall\"\n",
+            3,
+            "[box] hi = [lengths]",
+        ),
+        (
+            "[event_driven]\nfile = \"start.xyz\"\n",
+            2,
+            "[[from_file]] file = ",
+        ),
     ] {
         let (at, msg) = scene_error(text);
         assert_eq!(at, line, "{text}: {msg}");
-        assert!(msg.contains("[box] hi = [lengths]"), "{msg}");
+        assert!(msg.contains(spelling), "{msg}");
     }
     let e = Scene::parse("n = 10\npacking_fraction = 0.1\ntime = -1.0\n", "bad.toml").unwrap_err();
     assert!(e.to_string().starts_with("bad.toml:3: "), "{e}");

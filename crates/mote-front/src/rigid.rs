@@ -55,11 +55,7 @@ fn run_with(
     )?;
     let scene = RigidScene::parse(&input.text, &input.label)?;
     let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
-    let dir = options
-        .output
-        .clone()
-        .or_else(|| scene.output.dir.as_ref().map(std::path::PathBuf::from))
-        .unwrap_or_else(|| std::path::Path::new("out").join(&input.name));
+    let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
     let folder = crate::lock::RunFolder::claim(
         &dir,
         &input.label,

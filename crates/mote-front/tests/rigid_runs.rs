@@ -110,7 +110,7 @@ fn bodies_start_from_a_rigid_runs_frame() {
         let again = without_random(&text).replace(
             "[rigid.fields]",
             &format!(
-                "[[rigid.from_file]]\nfile = {:?}\n\n[rigid.fields]",
+                "[[from_file]]\nfile = {:?}\n\n[rigid.fields]",
                 file.display().to_string()
             ),
         );

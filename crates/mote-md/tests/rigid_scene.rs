@@ -110,7 +110,7 @@ fn a_file_whose_bodies_fit_no_template_names_the_scene_line() {
     )
     .unwrap();
     let text = format!(
-        "[rigid]\n[[rigid.template]]\nname = \"a\"\ngenerator = \"dumbbell\"\nradius = 1.0\ndistance = 1.5\ndensity = 1.0\n\n[[rigid.from_file]]\nfile = {:?}\n\n[run]\ndt = 0.1\nsteps = 1\n",
+        "[rigid]\n[[rigid.template]]\nname = \"a\"\ngenerator = \"dumbbell\"\nradius = 1.0\ndistance = 1.5\ndensity = 1.0\n\n[[from_file]]\nfile = {:?}\n\n[run]\ndt = 0.1\nsteps = 1\n",
         file.display().to_string()
     );
     let e = RigidScene::parse(&text, "s.toml")
@@ -134,6 +134,16 @@ fn a_file_whose_bodies_fit_no_template_names_the_scene_line() {
         .build(&text, "s.toml", None)
         .unwrap();
     assert_eq!(built.bodies.len(), 1);
+    // The first spelling, inside [rigid], is refused with the one every
+    // engine uses, at its line.
+    let old = text.replace("[[from_file]]", "[[rigid.from_file]]");
+    let e = RigidScene::parse(&old, "s.toml")
+        .unwrap()
+        .build(&old, "s.toml", None)
+        .err()
+        .unwrap();
+    assert_eq!(e.line, 9, "{e}");
+    assert!(e.to_string().contains("[[from_file]] file = "), "{e}");
     // (To the error of the template's integrated centre of mass.)
     let x = built.bodies.position[0];
     assert!(

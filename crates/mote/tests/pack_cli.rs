@@ -330,17 +330,10 @@ fn a_jammed_packing_in_every_format_starts_an_event_driven_run() {
         let scene = dir.path().join(format!("from_{ext}.toml"));
         std::fs::write(
             &scene,
-            // Both keys of an initial file: `[event_driven] file` and the
-            // `[[from_file]]` time-stepped scenes use too.
-            if matches!(ext, "xyz" | "dump") {
-                format!(
-                    "[event_driven]\nfile = \"jammed.{ext}\"\ntemperature = 1.0\n[run]\nuntil = 0.01\n[output]\ntrajectory = false\nhistogram = false\n"
-                )
-            } else {
-                format!(
-                    "[[from_file]]\nfile = \"jammed.{ext}\"\n\n[event_driven]\ntemperature = 1.0\n[run]\nuntil = 0.01\n[output]\ntrajectory = false\nhistogram = false\n"
-                )
-            },
+            // The initial file as every engine spells it.
+            format!(
+                "[[from_file]]\nfile = \"jammed.{ext}\"\n\n[event_driven]\ntemperature = 1.0\n[run]\nuntil = 0.01\n[output]\ntrajectory = false\nhistogram = false\n"
+            ),
         )
         .unwrap();
         let out = mote()

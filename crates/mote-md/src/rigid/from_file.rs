@@ -1,4 +1,4 @@
-//! Bodies from a frame of spheres (`[[rigid.from_file]]`): the spheres of
+//! Bodies from a frame of spheres (`[[from_file]]` of a rigid scene): the spheres of
 //! each body (grouped by the frame's body column) are matched to one of the
 //! scene's templates, and the body's placement g = E(r, x) and velocity
 //! h = dE(ω, v) are recovered from them.

@@ -136,6 +136,11 @@ pub struct RigidScene {
     pub title: Option<String>,
     pub rigid: Spanned<RigidSettings>,
     pub run: Spanned<RunSettings>,
+    /// `[[from_file]]`: bodies from a frame of their spheres (the key every
+    /// engine starts from a file with; `templates` and `tolerance` are
+    /// this engine's own).
+    #[serde(default)]
+    pub from_file: Vec<Spanned<FileSpec>>,
     /// `[box]`, spelled as every engine spells it: `lo`, `hi` and the
     /// periodic axes (default all). The contacts search across its
     /// periodic faces; the planes, the roller and the nip take its faces.
@@ -162,9 +167,10 @@ pub struct RigidSettings {
     pub lattice: Vec<Spanned<PlacementSpec>>,
     #[serde(default)]
     pub random: Vec<Spanned<PlacementSpec>>,
-    /// `[[rigid.from_file]]`: bodies from a frame of their spheres.
+    /// `[[rigid.from_file]]`, the first spelling of `[[from_file]]`, read
+    /// only to be refused with the one every engine uses.
     #[serde(default)]
-    pub from_file: Vec<Spanned<FileSpec>>,
+    from_file: Vec<Spanned<toml::Value>>,
     #[serde(default)]
     pub fields: Option<Spanned<FieldSettings>>,
     #[serde(default)]
@@ -307,7 +313,7 @@ pub struct BodySpec {
     pub omega: [f64; 3],
 }
 
-/// `[[rigid.from_file]]`: the bodies of a trajectory frame (`.xyz`,
+/// `[[from_file]]` of a rigid scene: the bodies of a trajectory frame (`.xyz`,
 /// `.dump`, `.gsd`, `.vtp`/`.vtu`/`.pvd`; path relative to the scene file;
 /// the last frame unless `frame` says which, negative counting from the
 /// end), as a rigid run writes them: one row per sphere with its radius and
@@ -612,7 +618,13 @@ impl RigidScene {
                 DE::new(DVec3::from(bs.omega), DVec3::from(bs.velocity)),
             );
         }
-        for f in &rigid.from_file {
+        if let Some(f) = rigid.from_file.first() {
+            return Err(err(
+                f.span(),
+                "[[rigid.from_file]]: a scene starts from a file as every engine spells it: [[from_file]] file = \"...\" (with frame, templates, tolerance)".into(),
+            ));
+        }
+        for f in &self.from_file {
             let (span, fs) = (f.span(), f.get_ref());
             let at = |m: String| err(span.clone(), m);
             let candidates: Vec<(String, u32)> = match &fs.templates {
@@ -688,7 +700,7 @@ impl RigidScene {
         if bodies.is_empty() {
             return Err(src.error(
                 self.rigid.span(),
-                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]] or [[rigid.from_file]]",
+                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]] or [[from_file]]",
             ));
         }
 
