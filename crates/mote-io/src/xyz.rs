@@ -8,7 +8,8 @@
 //! mote writes `species:S:1:pos:R:3:velo:R:3:radius:R:1:id:I:1`, then
 //! `masses:R:1:momenta:R:3` where masses are known (ASE takes velocities
 //! from momenta and masses, not from `velo`, which OVITO reads), then
-//! `omega`, `dipole`, `orientation` (w, x, y, z) and `body` where present. A periodic box whose lower
+//! `omega`, `dipole`, `orientation` (x, y, z, w, OVITO's order, with
+//! `quaternion_order="xyzw"` on the comment line) and `body` where present. A periodic box whose lower
 //! corner is not the origin is written shifted to it (ASE ignores
 //! `Origin=`), with the shift in `Shift="x y z"`; mote adds it back on
 //! reading. Open boxes, and exact files (whose numbers must read back bit
@@ -227,10 +228,17 @@ pub fn write_frame_as(
             frame.origin[0], frame.origin[1], frame.origin[2]
         ),
     };
+    // Quaternions in OVITO's order (its Orientation.X, .Y, .Z, .W), said
+    // on the line so no reader has to guess.
+    let order = if has(frame.orientations.len()) {
+        " quaternion_order=\"xyzw\""
+    } else {
+        ""
+    };
     writeln!(out, "{n}")?;
     writeln!(
         out,
-        "Lattice=\"{} {} {} {} {} {} {} {} {}\" {corner} Properties={properties} Time={} pbc=\"{} {} {}\" {}",
+        "Lattice=\"{} {} {} {} {} {} {} {} {}\" {corner} Properties={properties} Time={} pbc=\"{} {} {}\"{order} {}",
         c[0][0],
         c[0][1],
         c[0][2],
@@ -292,8 +300,9 @@ pub fn write_frame_as(
             }
         }
         if has(frame.orientations.len()) {
-            for x in frame.orientations[i] {
-                number(&mut line, x, exact, 11);
+            let [w, x, y, z] = frame.orientations[i];
+            for q in [x, y, z, w] {
+                number(&mut line, q, exact, 11);
             }
         }
         if has(frame.bodies.len()) {
@@ -437,6 +446,35 @@ fn triple(comment: &str, key: &str) -> Option<[f64; 3]> {
 }
 
 /// The frame whose count line is line k (0-based) of `lines`.
+/// The order of an `orientation` column's four numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum QuaternionOrder {
+    /// (x, y, z, w): OVITO's Orientation.X, .Y, .Z, .W, what mote writes
+    /// (saying so with `quaternion_order="xyzw"`).
+    Xyzw,
+    /// (w, x, y, z): scalar first, as mote wrote before it said which.
+    Wxyz,
+}
+
+impl QuaternionOrder {
+    /// `quaternion_order` on the comment line if given; else a file mote
+    /// wrote (`program="mote ..."`) before it gave one is scalar first,
+    /// and any other is OVITO's order.
+    fn of(comment: &str) -> Result<Self, String> {
+        match key_value(comment, "quaternion_order") {
+            Some("xyzw") => Ok(Self::Xyzw),
+            Some("wxyz") => Ok(Self::Wxyz),
+            Some(other) => Err(format!(
+                "quaternion_order=\"{other}\": expected \"xyzw\" or \"wxyz\""
+            )),
+            None if key_value(comment, "program").is_some_and(|p| p.starts_with("mote ")) => {
+                Ok(Self::Wxyz)
+            }
+            None => Ok(Self::Xyzw),
+        }
+    }
+}
+
 fn parse_frame(
     lines: &[&str],
     k: usize,
@@ -485,6 +523,7 @@ fn parse_frame(
         None => columns("species:S:1:pos:R:3").unwrap_or_default(),
     };
     let plain = key_value(comment, "Properties").is_none();
+    let order = QuaternionOrder::of(comment).map_err(|m| ParseError::new(name, k + 2, m))?;
     let roles: Vec<Role> = cols.iter().map(Column::role).collect();
     if !roles.contains(&Role::Position) {
         return Err(ParseError::new(
@@ -602,9 +641,11 @@ fn parse_frame(
                 Role::Omega => frame.angular_velocities.push(vec3(v)?),
                 Role::Dipole => frame.dipoles.push(vec3(v)?),
                 Role::Orientation => {
-                    frame
-                        .orientations
-                        .push([num(v[0])?, num(v[1])?, num(v[2])?, num(v[3])?])
+                    let q = [num(v[0])?, num(v[1])?, num(v[2])?, num(v[3])?];
+                    frame.orientations.push(match order {
+                        QuaternionOrder::Xyzw => [q[3], q[0], q[1], q[2]],
+                        QuaternionOrder::Wxyz => q,
+                    })
                 }
                 Role::Body => {
                     let b = int(v[0])?;

@@ -3,6 +3,7 @@
 mod formats;
 mod gsd_others;
 mod ovito_others;
+mod quaternions;
 mod strict_readers;
 mod vtu_others;
 mod xyz_others;
