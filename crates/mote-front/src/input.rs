@@ -19,9 +19,70 @@ pub struct Input {
     pub plist: bool,
 }
 
+/// What a file given to `mote run` is when it is a frame or trajectory of
+/// particles rather than something to run: by its extension, or by its
+/// first lines (an extended-XYZ header, a LAMMPS dump's `ITEM:` lines, a
+/// LAMMPS data file's header).
+fn trajectory_kind(extension: Option<&str>, text: Option<&str>) -> Option<&'static str> {
+    if let Some(e) = extension {
+        return match e.to_ascii_lowercase().as_str() {
+            "xyz" | "extxyz" => Some("an extended XYZ trajectory"),
+            "dump" | "lammpstrj" => Some("a LAMMPS dump"),
+            "data" | "lmp" => Some("a LAMMPS data file"),
+            "gsd" => Some("a GSD trajectory"),
+            "vtu" | "vtp" | "pvd" => Some("a VTK file"),
+            _ => None,
+        };
+    }
+    let mut lines = text?.lines();
+    let first = lines.next()?.trim();
+    let second = lines.next().unwrap_or("");
+    if first.starts_with("ITEM: TIMESTEP") {
+        Some("a LAMMPS dump")
+    } else if first.parse::<u64>().is_ok() && second.contains("Properties=") {
+        Some("an extended XYZ trajectory")
+    } else if text?
+        .lines()
+        .take(20)
+        .any(|l| l.trim_end().ends_with("atoms"))
+        && text?
+            .lines()
+            .take(40)
+            .any(|l| l.trim_end().ends_with("xlo xhi"))
+    {
+        Some("a LAMMPS data file")
+    } else {
+        None
+    }
+}
+
+/// A particle file given to `mote run` as if it were a scene is refused
+/// with what to do instead (it was read as an MPPphys file, whose first
+/// keyword then failed on line 1).
+fn refuse_trajectory(
+    spec: &str,
+    extension: Option<&str>,
+    text: Option<&str>,
+) -> Result<(), FrontError> {
+    if let Some(kind) = trajectory_kind(extension, text) {
+        let look = if kind == "a LAMMPS data file" {
+            String::new()
+        } else {
+            format!(
+                ", or look at it with `mote view {spec}` or `mote render {spec} -o picture.png`"
+            )
+        };
+        refuse!(
+            "{spec}: this is {kind}, not something to run: start a scene from it with [[from_file]] file = \"{spec}\" (docs/scene-format.md){look}"
+        );
+    }
+    Ok(())
+}
+
 impl Input {
     /// Reads `spec`: `example:NAME`, a `.toml` scene file, or any other file
-    /// as an MPPphys particle file.
+    /// as an MPPphys particle file (trajectories and data files of other
+    /// formats are refused with what to do).
     pub fn read(spec: &str) -> Result<Input, FrontError> {
         if let Some(name) = spec.strip_prefix("example:") {
             let Some(e) = examples::find(name) else {
@@ -39,7 +100,9 @@ impl Input {
             });
         }
         let path = Path::new(spec);
+        refuse_trajectory(spec, path.extension().and_then(|e| e.to_str()), None)?;
         let text = std::fs::read_to_string(path).map_err(|e| mote_io::IoError::os(path, e))?;
+        refuse_trajectory(spec, None, Some(&text))?;
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())

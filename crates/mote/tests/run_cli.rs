@@ -887,3 +887,45 @@ fn trajectory_format_on_the_command_line() {
     let frames = mote_io::trajectory::read_frames(&dir.path().join("cp/trajectory.gsd")).unwrap();
     assert_eq!(frames.len(), 4, "steps 0, 20, 40, 60");
 }
+
+/// A trajectory or data file given to `mote run` is said to be one, with
+/// what to do instead (it was read as an MPPphys particle file and failed
+/// on its first line): by its extension, or by its first lines when the
+/// name says nothing.
+#[test]
+fn a_trajectory_given_to_run_is_named_with_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let xyz =
+        "1\nLattice=\"5 0 0 0 5 0 0 0 5\" Properties=species:S:1:pos:R:3 pbc=\"T T T\"\nX 1 1 1\n";
+    let dump = "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp pp\n0 5\n0 5\n0 5\nITEM: ATOMS id type x y z\n1 1 1 1 1\n";
+    let data = "LAMMPS data file\n\n1 atoms\n1 atom types\n\n0 5 xlo xhi\n0 5 ylo yhi\n0 5 zlo zhi\n\nAtoms # atomic\n\n1 1 1 1 1\n";
+    for (name, text, kind) in [
+        ("frames.xyz", xyz, "an extended XYZ trajectory"),
+        ("frames", xyz, "an extended XYZ trajectory"),
+        ("last", dump, "a LAMMPS dump"),
+        ("bed.data", data, "a LAMMPS data file"),
+        ("bed", data, "a LAMMPS data file"),
+    ] {
+        std::fs::write(dir.path().join(name), text).unwrap();
+        let o = mote(&["run", name], dir.path());
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        assert!(
+            err.contains(&format!("{name}: this is {kind}")) && err.contains("[[from_file]]"),
+            "{name}: {err}"
+        );
+        assert_eq!(
+            err.contains("mote view"),
+            kind != "a LAMMPS data file",
+            "{name}: {err}"
+        );
+    }
+    // An MPPphys particle file of any name still runs.
+    std::fs::write(
+        dir.path().join("two.txt"),
+        "pos 0 0.0 0.0 0.0 1.0 0.0 0.1 1.0 1.0 0.0\npos 1 1.0 0.0 0.0 3e-6 0.0 0.03 0.3 0.3 1.0\nvel 1 0.0 0.0172 0.0\nk2 2.9584e-4\ndt 0.03\n",
+    )
+    .unwrap();
+    let o = mote(&["run", "two.txt", "--steps", "2", "-o", "p"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+}
