@@ -313,3 +313,61 @@ fn lj_rows_agree_across_kernels_and_threads() {
     assert!((u1 - up).abs() < 1e-12 * up.abs());
     assert!((w1 - wp).abs() < 1e-12 * wp.abs());
 }
+
+/// `[lennard_jones]` beside a cut-off `[dipolar]` runs in the dipolar pair
+/// loop (one interaction, one pass over the pairs, as LAMMPS's
+/// `lj/cut/dipole/cut`): its forces, torques and energy are the sums of the
+/// two laws run apart, to round-off.
+#[test]
+fn lennard_jones_beside_dipoles_runs_in_their_pair_loop() {
+    let scene = |tables: &str| {
+        format!(
+            "units = \"lj\"\nseed = 9\n[run]\ndt = 0.002\n{tables}\
+             [[fcc]]\ncells = [4, 4, 4]\ndensity = 0.8\nkt = 1.0\ndipole = [0.0, 0.0, 1.2]\n"
+        )
+    };
+    let lj = "[lennard_jones]\ncutoff = 2.5\nshifted = false\nrebuild_every = 20\n";
+    let dipolar = "[dipolar]\ncutoff = 2.5\nrandom_orientation = true\n";
+    let measure = |text: &str| {
+        let mut built = common::build(text);
+        let sim = &mut built.simulation;
+        let n = sim.system.particles.len();
+        // Off the lattice (where LJ forces cancel by symmetry), the same
+        // way in every build.
+        for (i, x) in sim.system.particles.position.iter_mut().enumerate() {
+            let k = i as f64;
+            *x += 0.08 * DVec3::new((1.3 * k).sin(), (2.1 * k).cos(), (0.7 * k).sin());
+        }
+        let p = &sim.system.particles;
+        let state = mote_md::force::State::of(&sim.system, &p.position, &p.velocity, 0.0, 0.0);
+        let spin = mote_md::force::Spin {
+            angular_velocity: &p.angular_velocity,
+        };
+        let (mut f, mut t) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        sim.forces
+            .add_forces_and_torques(&state, &spin, &mut f, &mut t);
+        let count = sim.forces.interactions.len();
+        let u = Observables::measure(&sim.system, &mut sim.forces).potential;
+        (f, t, u, count)
+    };
+    let (f, t, u, count) = measure(&scene(&format!("{lj}{dipolar}")));
+    let (f_lj, _, u_lj, _) = measure(&scene(lj));
+    let (f_d, t_d, u_d, _) = measure(&scene(dipolar));
+    assert_eq!(count, 1, "one interaction for both laws");
+    let scale = f_lj.iter().map(|x| x.length()).fold(0.0, f64::max);
+    assert!(scale > 1.0, "LJ forces off the lattice: {scale}");
+    for i in 0..f.len() {
+        assert!(
+            (f[i] - f_lj[i] - f_d[i]).length() < 1e-11 * scale,
+            "force {i}: {} against {} + {}",
+            f[i],
+            f_lj[i],
+            f_d[i]
+        );
+        assert!((t[i] - t_d[i]).length() < 1e-11 * scale, "torque {i}");
+    }
+    assert!(
+        (u - u_lj - u_d).abs() < 1e-11 * u.abs(),
+        "{u} against {u_lj} + {u_d}"
+    );
+}

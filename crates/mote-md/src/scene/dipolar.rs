@@ -173,9 +173,39 @@ impl Section for DipolarSettings {
                 .with_repulsion(PairRepulsion::wca(w.epsilon, w.sigma))
                 .map_err(|e| err(span.clone(), format!("[dipolar] {e}")))?;
         }
+        if let Some((lj, every)) = fused_lennard_jones(scene) {
+            pair = pair
+                .with_repulsion(lj)
+                .map_err(|e| err(span.clone(), format!("[dipolar] with [lennard_jones]: {e}")))?;
+            pair.list.every = every;
+        }
         b.forces.push(pair);
         Ok(())
     }
+}
+
+/// The `[lennard_jones]` a cut-off `[dipolar]` takes into its own pair
+/// loop (004 Eq. 9: one pass over the pairs for both laws, LAMMPS's
+/// `lj/cut/dipole/cut`), with the list's rebuild interval; `None` where the
+/// two stay apart (all pairs, Ewald, a `wca` already in `[dipolar]`, no
+/// `[lennard_jones]`). The forces are the two laws' sum either way.
+pub(crate) fn fused_lennard_jones(scene: &Scene) -> Option<(PairRepulsion, u64)> {
+    let d = scene.dipolar.as_ref()?.get_ref();
+    let lj = scene.lennard_jones.as_ref()?.get_ref();
+    if d.method != "direct" || d.cutoff.is_none() || d.wca.is_some() {
+        return None;
+    }
+    let repulsion = if lj.wca {
+        PairRepulsion::wca(lj.epsilon, lj.sigma)
+    } else {
+        PairRepulsion {
+            epsilon: lj.epsilon,
+            sigma: lj.sigma,
+            cutoff: lj.cutoff.unwrap_or(2.5 * lj.sigma),
+            shifted: lj.shifted,
+        }
+    };
+    Some((repulsion, lj.rebuild_every))
 }
 
 impl Section for MagneticFieldSettings {

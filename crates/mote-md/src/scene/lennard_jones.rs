@@ -1,5 +1,6 @@
 //! `[lennard_jones]`: Lennard-Jones or WCA between all particles within
-//! a cut-off, through a Verlet list on a ghost list (periodic boxes).
+//! a cut-off, through a Verlet list on a ghost list (periodic boxes);
+//! beside a cut-off `[dipolar]`, in the dipolar pair loop.
 
 use std::ops::Range;
 
@@ -34,7 +35,7 @@ pub struct LennardJonesSettings {
 }
 
 impl Section for LennardJonesSettings {
-    fn add_to(&self, span: Range<usize>, _: &Scene, b: &mut Build) -> Result<(), ParseError> {
+    fn add_to(&self, span: Range<usize>, scene: &Scene, b: &mut Build) -> Result<(), ParseError> {
         let src = b.src;
         let boundary = b.boundary;
         let err = |span: Range<usize>, msg: String| src.error(span, msg);
@@ -67,7 +68,11 @@ impl Section for LennardJonesSettings {
             ));
         }
         pair.list.every = v.rebuild_every;
-        b.forces.push(pair);
+        // Beside a cut-off [dipolar], both laws run in the dipolar pair
+        // loop (one pass over the pairs; see `dipolar::fused_lennard_jones`).
+        if super::dipolar::fused_lennard_jones(scene).is_none() {
+            b.forces.push(pair);
+        }
         Ok(())
     }
 }
