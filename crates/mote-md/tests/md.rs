@@ -29,6 +29,7 @@ mod rigid_mass;
 mod rigid_pair;
 mod rigid_scene;
 mod rigid_top;
+mod scene_values;
 mod shared_neighbours;
 mod slab;
 mod soft_pack;

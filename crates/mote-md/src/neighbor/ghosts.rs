@@ -485,7 +485,14 @@ impl Grid {
             let len = (b - a).max(reach);
             dims[k] = ((len / reach).floor() as u32).clamp(1, 1 << 10);
             lo[k] = a;
-            inverse_edge[k] = dims[k] as f64 / len;
+            inverse_edge[k] = len;
+        }
+        // At most a few cells per particle (ghosts included, roughly).
+        let mut wide = dims.map(|d| d as usize);
+        super::cap_cells(&mut wide, 8 * wrapped.len().max(8));
+        for k in 0..3 {
+            dims[k] = wide[k] as u32;
+            inverse_edge[k] = dims[k] as f64 / inverse_edge[k];
         }
         Self {
             lo,

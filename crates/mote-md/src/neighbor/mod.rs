@@ -114,6 +114,18 @@ impl VerletList {
     }
 }
 
+/// Shrinks a cell grid's `dims` (cells per axis) until it has at most
+/// `limit` cells, keeping every edge at least as long as before: cells past
+/// a few per particle only cost memory and time (a cut-off of 1e-300 asked
+/// for 10⁹ cells and 20 s per build).
+pub(crate) fn cap_cells(dims: &mut [usize; 3], limit: usize) {
+    let count = |d: &[usize; 3]| d.iter().fold(1usize, |a, &x| a.saturating_mul(x));
+    while count(dims) > limit.max(1) {
+        let widest = (0..3).max_by_key(|&k| dims[k]).expect("three axes");
+        dims[widest] = (dims[widest] / 2).max(1);
+    }
+}
+
 /// Particles binned into cells of edge ≥ `reach`.
 pub struct CellGrid {
     lo: DVec3,
@@ -135,11 +147,7 @@ impl CellGrid {
             if boundary.periodic[k] {
                 lo[k] = boundary.lo[k];
                 len[k] = boundary.hi[k] - boundary.lo[k];
-                dims[k] = ((len[k] / reach).floor() as usize).max(1);
-                // Fewer than 3 cells would visit the same cell twice.
-                if dims[k] < 3 {
-                    dims[k] = 1;
-                }
+                dims[k] = ((len[k] / reach).floor() as usize).clamp(1, 1 << 10);
             } else {
                 let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
                 for r in pos {
@@ -152,6 +160,14 @@ impl CellGrid {
                 lo[k] = a;
                 len[k] = (b - a).max(reach);
                 dims[k] = ((len[k] / reach).floor() as usize).clamp(1, 1 << 10);
+            }
+        }
+        cap_cells(&mut dims, 8 * pos.len().max(8));
+        for k in 0..3 {
+            // Fewer than 3 cells along a periodic axis would visit the
+            // same cell twice.
+            if boundary.periodic[k] && dims[k] < 3 {
+                dims[k] = 1;
             }
         }
         let edge = DVec3::new(
