@@ -153,6 +153,11 @@ pub struct Scene {
     /// about the file that are not about one of its own lines.
     #[serde(skip)]
     file_named_at: Option<(String, usize)>,
+    /// Where the scene sets the box and the particles (`[box] hi`, else
+    /// `packing_fraction`, else `n`), for messages about the state they
+    /// make (a box too small for the spheres, say).
+    #[serde(skip)]
+    state_named_at: Option<(String, usize)>,
     /// Check for overlaps at every output (exact, O(N)); default true.
     #[serde(default = "yes")]
     pub check_overlaps: bool,
@@ -549,6 +554,18 @@ impl Scene {
             message,
         };
         self.file_named_at = Some((file.to_string(), key_line(text, "from_file")));
+        let said = |key: &str| {
+            text.lines().any(|l| {
+                l.trim_start()
+                    .strip_prefix(key)
+                    .is_some_and(|r| r.trim_start().starts_with('='))
+            })
+        };
+        let state_key = ["hi", "packing_fraction", "n"]
+            .into_iter()
+            .find(|k| said(k))
+            .unwrap_or("n");
+        self.state_named_at = Some((file.to_string(), key_line(text, state_key)));
         match self.from_file.as_slice() {
             [] => {}
             [start] => {
@@ -1013,7 +1030,16 @@ impl Scene {
                 }
             }
         };
-        System::new(SimBox { size, boundary }, pos, vel, radii, masses)
+        System::new(SimBox { size, boundary }, pos, vel, radii, masses).map_err(|e| {
+            match (e, &self.state_named_at) {
+                (EdmdError::Invalid(message), Some((file, line))) => EdmdError::Scene {
+                    file: file.clone(),
+                    line: *line,
+                    message,
+                },
+                (e, _) => e,
+            }
+        })
     }
 }
 

@@ -6,4 +6,5 @@ mod pack;
 mod polydisperse;
 mod robust;
 mod scene;
+mod scene_values;
 mod statistics;

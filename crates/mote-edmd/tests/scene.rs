@@ -94,6 +94,24 @@ fn errors_name_the_line() {
         assert_eq!(at, line, "{text}: {msg}");
         assert!(msg.contains(spelling), "{msg}");
     }
+    // A box too small for the spheres is refused at the key that set it.
+    let text = "[event_driven]\nn = 20\npacking_fraction = 0.2876\nradius = 0.2\nsize_ratio = 1.25\nlarge_fraction = 0.25\nplacement = \"random\"\n";
+    let e = Scene::parse(text, "small.toml")
+        .unwrap()
+        .build::<3>(5, std::path::Path::new("."))
+        .unwrap_err();
+    assert!(
+        e.to_string().starts_with("small.toml:3: periodic box"),
+        "{e}"
+    );
+    // Twenty spheres at a packing fraction of 1e-300 are placed at once
+    // (the placement grid asked for 24 GB of empty cells).
+    let t0 = std::time::Instant::now();
+    let text = "[event_driven]\nn = 20\npacking_fraction = 1e-300\nplacement = \"random\"\n";
+    let system = Scene::parse(text, "sparse.toml")
+        .unwrap()
+        .build::<3>(5, std::path::Path::new("."));
+    assert!(system.is_ok() && t0.elapsed().as_secs_f64() < 2.0);
     let e = Scene::parse("n = 10\npacking_fraction = 0.1\ntime = -1.0\n", "bad.toml").unwrap_err();
     assert!(e.to_string().starts_with("bad.toml:3: "), "{e}");
 }
