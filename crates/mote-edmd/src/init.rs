@@ -112,14 +112,7 @@ pub fn random_placement<const D: usize, R: Rng>(
     for d in 0..D {
         m[d] = ((size[d] / (2.0 * rmax)).floor() as usize).clamp(1, 1 << 10);
     }
-    // At most eight cells per sphere (bigger cells still hold every
-    // neighbour within one cell): tiny spheres in a big box asked for
-    // 24 GB of empty cells.
-    let limit = (8 * radii.len()).max(64);
-    while m.iter().fold(1usize, |a, &x| a.saturating_mul(x)) > limit {
-        let widest = (0..D).max_by_key(|&d| m[d]).expect("an axis");
-        m[widest] = (m[widest] / 2).max(1);
-    }
+    mote_geom::grids::cap_cells(&mut m, (8 * radii.len()).max(64));
     let total: usize = m.iter().product();
     let mut grid: Vec<Vec<u32>> = vec![Vec::new(); total];
     let mut out: Vec<[f64; D]> = vec![[0.0; D]; radii.len()];

@@ -17,6 +17,20 @@
 //! Only the geometry lives here (which cell, which cells are near); the
 //! users keep the cells' contents in whatever layout their loops want.
 
+/// Shrinks a cell grid's cells per axis (`dims`) until it has at most
+/// `limit` cells, halving the axis with the most each time: every cell only
+/// grows, so a cell at least a reach wide stays so. Cells past a few per
+/// particle cost memory and time and find nothing (a cut-off of 1e-300
+/// asked a neighbour list for 10⁹ cells, and 24 GB went to empty placement
+/// cells of a sparse start). Used by every uniform cell grid of mote.
+pub fn cap_cells<const D: usize>(dims: &mut [usize; D], limit: usize) {
+    let count = |d: &[usize; D]| d.iter().fold(1usize, |a, &x| a.saturating_mul(x));
+    while count(dims) > limit.max(1) {
+        let widest = (0..D).max_by_key(|&k| dims[k]).expect("an axis");
+        dims[widest] = (dims[widest] / 2).max(1);
+    }
+}
+
 /// One grid of the hierarchy.
 #[derive(Debug, Clone)]
 struct Level<const D: usize> {
@@ -222,6 +236,21 @@ impl<const D: usize> Level<D> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn capped_grids_hold_at_most_the_limit_and_never_shrink_a_cell() {
+        let mut dims = [1024usize, 1024, 1024];
+        cap_cells(&mut dims, 160);
+        assert!(dims.iter().product::<usize>() <= 160, "{dims:?}");
+        assert!(dims.iter().all(|&d| (1..=1024).contains(&d)), "{dims:?}");
+        let mut small = [4usize, 3, 2];
+        cap_cells(&mut small, 64);
+        assert_eq!(small, [4, 3, 2]);
+        let mut flat = [usize::MAX, 7];
+        cap_cells(&mut flat, 1);
+        assert_eq!(flat, [1, 1]);
+    }
+
     use super::*;
     use rand::{Rng, SeedableRng};
 

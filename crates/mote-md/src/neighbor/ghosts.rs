@@ -466,7 +466,8 @@ impl Grid {
     fn new(wrapped: &[DVec3], boundary: &Boundary, reach: f64) -> Self {
         let mut lo = DVec3::ZERO;
         let mut inverse_edge = DVec3::ZERO;
-        let mut dims = [1u32; 3];
+        let mut dims = [1usize; 3];
+        let mut len = [0.0; 3];
         for k in 0..3 {
             let (a, b) = if boundary.periodic[k] {
                 (boundary.lo[k] - reach, boundary.hi[k] + reach)
@@ -482,22 +483,18 @@ impl Grid {
                     (0.0, 1.0)
                 }
             };
-            let len = (b - a).max(reach);
-            dims[k] = ((len / reach).floor() as u32).clamp(1, 1 << 10);
+            len[k] = (b - a).max(reach);
+            dims[k] = ((len[k] / reach).floor() as usize).clamp(1, 1 << 10);
             lo[k] = a;
-            inverse_edge[k] = len;
         }
-        // At most a few cells per particle (ghosts included, roughly).
-        let mut wide = dims.map(|d| d as usize);
-        super::cap_cells(&mut wide, 8 * wrapped.len().max(8));
+        mote_geom::grids::cap_cells(&mut dims, 8 * wrapped.len().max(8));
         for k in 0..3 {
-            dims[k] = wide[k] as u32;
-            inverse_edge[k] = dims[k] as f64 / inverse_edge[k];
+            inverse_edge[k] = dims[k] as f64 / len[k];
         }
         Self {
             lo,
             inverse_edge,
-            dims,
+            dims: dims.map(|d| d as u32),
         }
     }
 

@@ -114,18 +114,6 @@ impl VerletList {
     }
 }
 
-/// Shrinks a cell grid's `dims` (cells per axis) until it has at most
-/// `limit` cells, keeping every edge at least as long as before: cells past
-/// a few per particle only cost memory and time (a cut-off of 1e-300 asked
-/// for 10⁹ cells and 20 s per build).
-pub(crate) fn cap_cells(dims: &mut [usize; 3], limit: usize) {
-    let count = |d: &[usize; 3]| d.iter().fold(1usize, |a, &x| a.saturating_mul(x));
-    while count(dims) > limit.max(1) {
-        let widest = (0..3).max_by_key(|&k| dims[k]).expect("three axes");
-        dims[widest] = (dims[widest] / 2).max(1);
-    }
-}
-
 /// Particles binned into cells of edge ≥ `reach`.
 pub struct CellGrid {
     lo: DVec3,
@@ -162,7 +150,7 @@ impl CellGrid {
                 dims[k] = ((len[k] / reach).floor() as usize).clamp(1, 1 << 10);
             }
         }
-        cap_cells(&mut dims, 8 * pos.len().max(8));
+        mote_geom::grids::cap_cells(&mut dims, 8 * pos.len().max(8));
         for k in 0..3 {
             // Fewer than 3 cells along a periodic axis would visit the
             // same cell twice.
