@@ -70,6 +70,9 @@ pub struct Outputs {
     pub resume: Option<Checkpoint>,
     /// The live viewer's tap, if the run is watched.
     pub live: mote_run::LiveSlot,
+    /// Run even if the run is expected to take more than
+    /// [`mote_run::MAX_STEPS`] events ([`Scene::check_run_length`]).
+    pub force: bool,
 }
 
 /// What a checkpoint of an event-driven run carries beside positions and
@@ -415,6 +418,7 @@ pub fn run_scene<const D: usize>(
     let (sys, t_offset, k, ledger) = match &out.resume {
         Some(cp) => resumed(cp, *built.simbox())?,
         None => {
+            scene.check_run_length(&built, out.force)?;
             let pscale: f64 = built
                 .velocities()
                 .iter()

@@ -158,6 +158,10 @@ pub struct Scene {
     /// make (a box too small for the spheres, say).
     #[serde(skip)]
     state_named_at: Option<(String, usize)>,
+    /// Where the scene sets the run's end (`until`, else the state's line),
+    /// for a run too long to start without `--force`.
+    #[serde(skip)]
+    until_named_at: Option<(String, usize)>,
     /// Check for overlaps at every output (exact, O(N)); default true.
     #[serde(default = "yes")]
     pub check_overlaps: bool,
@@ -566,6 +570,11 @@ impl Scene {
             .find(|k| said(k))
             .unwrap_or("n");
         self.state_named_at = Some((file.to_string(), key_line(text, state_key)));
+        let end_key = ["until", "time"]
+            .into_iter()
+            .find(|k| said(k))
+            .unwrap_or(state_key);
+        self.until_named_at = Some((file.to_string(), key_line(text, end_key)));
         match self.from_file.as_slice() {
             [] => {}
             [start] => {
@@ -852,6 +861,38 @@ impl Scene {
                 o
             }
         }
+    }
+
+    /// Refuses, unless `force`d, a run whose events the system expects
+    /// ([`System::expected_events`]) over the scene's equilibration and
+    /// measured time exceed [`mote_run::MAX_STEPS`]: an event is the
+    /// event-driven engine's step, and so many are most likely a mass,
+    /// temperature, size ratio or end time mistyped (a mass of 10⁻³⁰⁰
+    /// asks for 10¹⁵⁰ events and would never end).
+    pub fn check_run_length<const D: usize>(
+        &self,
+        system: &System<D>,
+        force: bool,
+    ) -> Result<(), EdmdError> {
+        let events = system.expected_events(self.equilibrate + self.time);
+        if force || events <= mote_run::MAX_STEPS as f64 {
+            return Ok(());
+        }
+        let message = format!(
+            "the run to t = {} would take about {events:.1e} events (collisions and neighbour-list \
+             renewals at the speeds and sizes the scene gives): more than {}, which is most likely \
+             a mass, temperature, size ratio or end time mistyped; give --force to run them",
+            self.equilibrate + self.time,
+            mote_run::MAX_STEPS
+        );
+        Err(match &self.until_named_at {
+            Some((file, line)) => EdmdError::Scene {
+                file: file.clone(),
+                line: *line,
+                message,
+            },
+            None => EdmdError::Invalid(message),
+        })
     }
 
     /// Builds the initial system with the given seed. `base` is the folder

@@ -126,3 +126,37 @@ fn too_dense_random_placement_is_an_error_not_a_panic() {
     let e = scene.build::<3>(1, Path::new(".")).unwrap_err();
     assert!(e.to_string().contains("random placement"), "{e}");
 }
+
+/// A run expected to take more than 10⁹ events is refused at its `until`
+/// line unless forced (a mass of 10⁻³⁰⁰ asks for 10¹⁵² and never ended);
+/// an ordinary run passes, and its estimate is within a few times the
+/// events it takes.
+#[test]
+fn runs_of_more_than_a_billion_events_need_force() {
+    let text = |mass: &str| {
+        format!(
+            "seed = 5\n[event_driven]\ndimension = 3\nn = 200\npacking_fraction = 0.3\nmass = {mass}\n\
+             placement = \"random\"\n[run]\nuntil = 0.5\n"
+        )
+    };
+    let scene = Scene::parse(&text("1e-300"), "s.toml").unwrap();
+    let system = scene.build::<3>(5, Path::new(".")).unwrap();
+    let e = scene.check_run_length(&system, false).unwrap_err();
+    let message = e.to_string();
+    assert!(message.starts_with("s.toml:9:"), "{message}");
+    assert!(
+        message.contains("--force") && message.contains("e152 events"),
+        "{message}"
+    );
+    assert!(scene.check_run_length(&system, true).is_ok());
+
+    let scene = Scene::parse(&text("1.0"), "s.toml").unwrap();
+    let mut system = scene.build::<3>(5, Path::new(".")).unwrap();
+    scene.check_run_length(&system, false).unwrap();
+    let expected = system.expected_events(0.5);
+    let events = system.run_until(0.5) as f64;
+    assert!(
+        events > expected / 3.0 && events < 3.0 * expected,
+        "{events} events, {expected:.0} expected"
+    );
+}

@@ -196,6 +196,7 @@ fn run_events(
         checkpoints,
         resume: resumed.cloned(),
         live: options.live.clone(),
+        force: options.force,
     };
     let cpu0 = crate::cpu::cpu_seconds();
     let progress = |f: f64| monitor.progress((f * 1000.0) as u64, 1000, "");
@@ -217,6 +218,8 @@ fn run_events(
                 },
             })
         }
+        // refused before it started, at a line of the scene
+        Err(e @ mote_edmd::EdmdError::Scene { .. }) => return Err(e.into()),
         Err(e) => {
             return Err(FrontError::request(format!(
                 "{}: run stopped: {e}",
