@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
 use mote_io::trajectory::{Format, TrajectoryWriter};
-use mote_run::{Checkpoints, Driver, Observer, Propagator, Stopped};
+use mote_run::{Checkpoints, Columns, Driver, Observer, Propagator, Stopped};
 
 use crate::scene::Scene;
 use crate::system::{Boundary, SimBox, System};
@@ -197,7 +197,96 @@ pub struct EventSample {
     pub wall_pressure: f64,
 }
 
+impl Columns for EventSample {
+    const COLUMNS: &'static [(&'static str, &'static str)] = &[
+        ("time", "t"),
+        ("collisions", "1"),
+        ("collision_rate", "1/t"),
+        ("mean_free_time", "t"),
+        ("temperature", "kT"),
+        ("kinetic_energy", "E"),
+        ("energy_drift", "1"),
+        ("compressibility", "1"),
+        ("pressure", "E/V"),
+        ("wall_pressure", "E/V"),
+    ];
+
+    fn values(&self) -> Vec<f64> {
+        vec![
+            self.time,
+            self.collisions as f64,
+            self.collision_rate,
+            self.mean_free_time,
+            self.temperature,
+            self.kinetic_energy,
+            self.energy_drift,
+            self.compressibility,
+            self.pressure,
+            self.wall_pressure,
+        ]
+    }
+}
+
 impl<const D: usize> EventDriven<D> {
+    /// A fresh run of `scene` with `seed` (relative files under
+    /// `scene_dir`), refused if it expects more than 10⁹ events unless
+    /// `force`d ([`Scene::check_run_length`]): what `mote run` steps.
+    pub fn new(
+        scene: &Scene,
+        seed: u64,
+        scene_dir: &std::path::Path,
+        force: bool,
+    ) -> Result<Self, EdmdError> {
+        let built = scene.build::<D>(seed, scene_dir)?;
+        scene.check_run_length(&built, force)?;
+        let pscale: f64 = built
+            .velocities()
+            .iter()
+            .zip(built.masses())
+            .map(|(v, m)| m * crate::vecd::dot(v, v).sqrt())
+            .sum::<f64>()
+            .max(f64::MIN_POSITIVE);
+        let ledger = Ledger {
+            e0: built.kinetic_energy(),
+            p0: built.momentum(),
+            pscale,
+            drift: 0.0,
+            events: 0,
+            t0: 0.0,
+        };
+        Ok(Self::with_state(scene, built, 0.0, 0, ledger, false))
+    }
+
+    fn with_state(
+        scene: &Scene,
+        sys: System<D>,
+        t_offset: f64,
+        k: u64,
+        ledger: Ledger<D>,
+        resuming: bool,
+    ) -> Self {
+        EventDriven {
+            sys,
+            t_offset,
+            k,
+            interval: scene
+                .output_interval
+                .unwrap_or(scene.time / 100.0)
+                .max(1e-300),
+            time: scene.time,
+            equilibrate: scene.equilibrate,
+            resuming,
+            check_overlaps: scene.check_overlaps,
+            ledger,
+        }
+    }
+
+    /// The system as it is (each particle at its own time: see
+    /// [`System::position`]).
+    pub fn system(&self) -> &System<D> {
+        &self.sys
+    }
+
     /// The global time now.
     fn now(&self) -> f64 {
         self.t_offset + self.sys.time()
@@ -205,7 +294,7 @@ impl<const D: usize> EventDriven<D> {
 
     /// The first output index k at which t0 + k·interval reaches the end
     /// (at least 1: a run of zero length still writes its one row).
-    fn last_step(&self) -> u64 {
+    pub fn last_step(&self) -> u64 {
         let (t0, iv) = (self.ledger.t0, self.interval);
         let end = t0 + self.time;
         let mut k = ((self.time / iv).ceil() as u64).max(1);
@@ -372,18 +461,7 @@ impl<const D: usize> Observer<EventDriven<D>> for EventCsv {
     }
 
     fn observe(&mut self, _: &EventDriven<D>, s: &EventSample) -> Result<(), EdmdError> {
-        Ok(self.0.row(&[
-            s.time,
-            s.collisions as f64,
-            s.collision_rate,
-            s.mean_free_time,
-            s.temperature,
-            s.kinetic_energy,
-            s.energy_drift,
-            s.compressibility,
-            s.pressure,
-            s.wall_pressure,
-        ])?)
+        Ok(self.0.row(&s.values())?)
     }
 }
 
@@ -412,46 +490,17 @@ pub fn run_scene<const D: usize>(
     out: &Outputs,
     mut progress: impl FnMut(f64),
 ) -> Result<Run, EdmdError> {
-    let built = scene.build::<D>(seed, &out.scene_dir)?;
-    // A resumed run starts from its checkpoint's (rebuilt) system, clock
-    // offset, output index and ledger; a fresh one from the scene.
-    let (sys, t_offset, k, ledger) = match &out.resume {
-        Some(cp) => resumed(cp, *built.simbox())?,
-        None => {
-            scene.check_run_length(&built, out.force)?;
-            let pscale: f64 = built
-                .velocities()
-                .iter()
-                .zip(built.masses())
-                .map(|(v, m)| m * crate::vecd::dot(v, v).sqrt())
-                .sum::<f64>()
-                .max(f64::MIN_POSITIVE);
-            let ledger = Ledger {
-                e0: built.kinetic_energy(),
-                p0: built.momentum(),
-                pscale,
-                drift: 0.0,
-                events: 0,
-                t0: 0.0,
-            };
-            (built, 0.0, 0, ledger)
+    let mut p = match &out.resume {
+        // A resumed run starts from its checkpoint's (rebuilt) system, clock
+        // offset, output index and ledger; a fresh one from the scene.
+        Some(cp) => {
+            let built = scene.build::<D>(seed, &out.scene_dir)?;
+            let (sys, t_offset, k, ledger) = resumed(cp, *built.simbox())?;
+            EventDriven::with_state(scene, sys, t_offset, k, ledger, true)
         }
+        None => EventDriven::new(scene, seed, &out.scene_dir, out.force)?,
     };
     let resuming = out.resume.is_some();
-    let mut p = EventDriven {
-        sys,
-        t_offset,
-        k,
-        interval: scene
-            .output_interval
-            .unwrap_or(scene.time / 100.0)
-            .max(1e-300),
-        time: scene.time,
-        equilibrate: scene.equilibrate,
-        resuming,
-        check_overlaps: scene.check_overlaps,
-        ledger,
-    };
     let mut driver = Driver::new();
     driver.sample_at_start = !resuming;
     driver.live = out.live.take();
@@ -467,25 +516,8 @@ pub fn run_scene<const D: usize>(
     }
     if let Some(f) = &scene.observables {
         let path = out.base.join(f);
-        let cols: Vec<String> = [
-            "time",
-            "collisions",
-            "collision_rate",
-            "mean_free_time",
-            "temperature",
-            "kinetic_energy",
-            "energy_drift",
-            "compressibility",
-            "pressure",
-            "wall_pressure",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let units: Vec<String> = ["t", "1", "1/t", "t", "kT", "E", "1", "1", "E/V", "E/V"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let cols: Vec<String> = EventSample::COLUMNS.iter().map(|c| c.0.into()).collect();
+        let units: Vec<String> = EventSample::COLUMNS.iter().map(|c| c.1.into()).collect();
         driver.observers.push(Box::new(EventCsv(if resuming {
             CsvWriter::append(&path, cols.len())?
         } else {

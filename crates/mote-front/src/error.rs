@@ -24,6 +24,17 @@ impl FrontError {
     pub fn request(message: impl Into<String>) -> Self {
         FrontError::Request(message.into())
     }
+
+    /// Whether the input is at fault (a scene's `file:line: message`, a
+    /// request that cannot be served), not the run.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            FrontError::Parse(_)
+                | FrontError::Request(_)
+                | FrontError::Edmd(mote_edmd::EdmdError::Scene { .. })
+        )
+    }
 }
 
 /// `return Err(FrontError::Request(format!(...)))`.

@@ -19,6 +19,7 @@ pub mod packing;
 mod particles;
 mod rigid;
 pub mod seed;
+pub mod stepper;
 pub mod terminal;
 
 use std::path::PathBuf;

@@ -73,8 +73,7 @@ pub fn dict_to_toml(d: &Bound<'_, PyDict>) -> PyResult<String> {
 pub fn front_error(e: mote_front::FrontError) -> PyErr {
     use mote_front::FrontError as F;
     match e {
-        F::Parse(p) => PyValueError::new_err(p.to_string()),
-        F::Request(m) => PyValueError::new_err(m),
+        e if e.is_bad_input() => PyValueError::new_err(e.to_string()),
         F::Io(e) => PyOSError::new_err(e.to_string()),
         other => MoteError::new_err(other.to_string()),
     }

@@ -7,7 +7,7 @@ use std::sync::{Mutex, MutexGuard};
 
 use mote_md::rigid::run::{sphere_frame, RigidDynamics, RigidSample};
 use mote_md::rigid::scene::RigidScene;
-use mote_md::{DVec3, MdError, RunLength};
+use mote_md::DVec3;
 use numpy::ndarray::ArrayView2;
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2};
@@ -16,10 +16,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{dict_to_toml, front_error, md_error, parse_error};
-use crate::stepping::{run_loop, HasEngine, Stepped, Stepping};
+use crate::stepping::{run_loop, time_steps, HasEngine, Stepped};
+use mote_front::stepper::Stepper;
 
 pub struct RigidEngine {
-    stepping: Stepping<RigidDynamics>,
+    stepping: Stepper<RigidDynamics>,
     label: String,
     /// The scene text and seed, for checkpoints.
     text: String,
@@ -33,7 +34,7 @@ impl RigidEngine {
         let every = scene.output.observables_every.max(1);
         let seed = built.seed;
         Ok(RigidEngine {
-            stepping: Stepping::new(RigidDynamics::new(built), every),
+            stepping: Stepper::new(RigidDynamics::new(built), every),
             label: label.into(),
             text: text.into(),
             seed,
@@ -51,22 +52,31 @@ impl Stepped for RigidEngine {
         n: u64,
         end_sample: bool,
         progress: &mut (dyn FnMut(u64, f64) + Send),
-    ) -> Result<(), MdError> {
-        self.stepping.advance(n, end_sample, progress)
+    ) -> PyResult<()> {
+        self.stepping
+            .advance_every_16(n, end_sample, progress)
+            .map_err(md_error)
     }
 
-    fn clock(&self) -> (u64, f64, f64) {
+    fn step(&self) -> u64 {
+        self.dynamics().step
+    }
+
+    fn steps_for(&self, steps: Option<u64>, until: Option<f64>) -> PyResult<u64> {
         let d = self.dynamics();
-        (d.step, d.bodies.time, d.dt)
-    }
-
-    fn scene_length(&self) -> PyResult<Option<RunLength>> {
         // A rigid scene always gives its length (steps or until).
-        Ok(Some(RunLength::Steps(self.dynamics().last_step)))
+        time_steps(steps, until, d.bodies.time, d.dt, || {
+            Ok(Some(d.last_step.saturating_sub(d.step)))
+        })
     }
 
     fn describe(&self) -> String {
-        format!("{}: {} bodies", self.label, self.dynamics().bodies.len())
+        format!(
+            "{}: {} bodies, dt = {}",
+            self.label,
+            self.dynamics().bodies.len(),
+            self.dynamics().dt
+        )
     }
 }
 
@@ -151,7 +161,7 @@ impl RigidSimulation {
         }
         state.resume(&cp, &cp.input_label).map_err(md_error)?;
         // The checkpoint's run already measured its start.
-        engine.stepping.primed = true;
+        engine.stepping.mark_started();
         Ok(RigidSimulation {
             engine: Mutex::new(engine),
         })
@@ -184,7 +194,6 @@ impl RigidSimulation {
         let mut guard = self.engine()?;
         let engine = &mut *guard;
         py.detach(|| engine.advance(n, false, &mut |_, _| {}))
-            .map_err(md_error)
     }
 
     /// Runs `steps` steps or until time `until` (the scene's length when
@@ -309,7 +318,7 @@ impl RigidSimulation {
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let guard = self.engine()?;
-        let s = &guard.stepping.samples;
+        let s = &*guard.stepping.samples();
         let d = PyDict::new(py);
         let col = |f: fn(&RigidSample) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
         let vec3 = |f: fn(&RigidSample) -> DVec3| {

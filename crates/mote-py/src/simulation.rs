@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use mote_io::checkpoint::Checkpoint;
 use mote_md::observe::Observables;
 use mote_md::scene::Scene;
-use mote_md::{DVec3, RunLength};
+use mote_md::DVec3;
 use mote_run::Propagator;
 use numpy::ndarray::{ArrayView1, ArrayView2};
 use numpy::prelude::*;
@@ -24,12 +24,13 @@ use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
 
 use crate::convert::{dict_to_toml, md_error, parse_error};
-use crate::stepping::{run_loop, HasEngine, Stepped, Stepping};
+use crate::stepping::{run_loop, time_steps, HasEngine, Stepped};
+use mote_front::stepper::Stepper;
 
 /// The stepping state behind a Python `Simulation` (no Python types: it
 /// runs with the GIL released).
 pub struct Engine {
-    stepping: Stepping<mote_md::Simulation>,
+    stepping: Stepper<mote_md::Simulation>,
     /// Scene label and text, kept for checkpoints.
     label: String,
     text: String,
@@ -49,7 +50,7 @@ impl Engine {
             )));
         }
         Ok(Engine {
-            stepping: Stepping::new(built.simulation, scene.output.observables_every),
+            stepping: Stepper::new(built.simulation, scene.output.observables_every),
             label: label.to_string(),
             text: text.to_string(),
             seen: Vec::new(),
@@ -66,17 +67,25 @@ impl Engine {
 
     /// Primes on the first call, and again after Python moved particles.
     fn prepare(&mut self) -> Result<(), mote_md::MdError> {
-        if self.stepping.primed && self.seen != self.sim().system.particles.position {
+        if !self.seen.is_empty() && self.seen != self.sim().system.particles.position {
             let sys = &mut self.sim_mut().system;
             sys.carried_acceleration.clear();
             sys.carried_angular_acceleration.clear();
+            // primed again: the first forces of the moved particles
+            self.stepping.state.prime(&mut |_| {})?;
         }
         self.stepping.prepare()
     }
 
-    /// Advances `n` steps (see [`Stepping::advance`]).
+    /// Advances `n` steps (see [`Stepper::advance`]).
     fn advance(&mut self, n: u64, end_sample: bool) -> Result<(), mote_md::MdError> {
-        Stepped::advance(self, n, end_sample, &mut |_, _| {})
+        self.prepare()?;
+        let result = self
+            .stepping
+            .advance_every_16(n, end_sample, &mut |_, _| {});
+        self.seen
+            .clone_from(&self.stepping.state.system.particles.position);
+        result
     }
 }
 
@@ -86,30 +95,37 @@ impl Stepped for Engine {
         n: u64,
         end_sample: bool,
         progress: &mut (dyn FnMut(u64, f64) + Send),
-    ) -> Result<(), mote_md::MdError> {
-        self.prepare()?;
-        let result = self.stepping.advance(n, end_sample, progress);
+    ) -> PyResult<()> {
+        self.prepare().map_err(md_error)?;
+        let result = self.stepping.advance_every_16(n, end_sample, progress);
         self.seen
             .clone_from(&self.stepping.state.system.particles.position);
-        result
+        result.map_err(md_error)
     }
 
-    fn clock(&self) -> (u64, f64, f64) {
+    fn step(&self) -> u64 {
+        self.sim().system.step
+    }
+
+    fn steps_for(&self, steps: Option<u64>, until: Option<f64>) -> PyResult<u64> {
         let sim = self.sim();
-        (sim.system.step, sim.system.time, sim.dt)
-    }
-
-    fn scene_length(&self) -> PyResult<Option<RunLength>> {
-        let scene = Scene::parse(&self.text, &self.label).map_err(parse_error)?;
-        let src = mote_io::Source::new(&self.label, &self.text);
-        Ok(scene.run.schedule(src).map_err(parse_error)?.2)
+        time_steps(steps, until, sim.system.time, sim.dt, || {
+            let scene = Scene::parse(&self.text, &self.label).map_err(parse_error)?;
+            let src = mote_io::Source::new(&self.label, &self.text);
+            let length = scene.run.schedule(src).map_err(parse_error)?.2;
+            length
+                .map(|l| l.steps_from(sim.system.time, sim.dt))
+                .transpose()
+                .map_err(|e| PyValueError::new_err(e.to_string()))
+        })
     }
 
     fn describe(&self) -> String {
         format!(
-            "{}: {} particles",
+            "{}: {} particles, dt = {}",
             self.label,
-            self.sim().system.particles.len()
+            self.sim().system.particles.len(),
+            self.sim().dt
         )
     }
 }
@@ -266,7 +282,7 @@ impl Simulation {
         mote_front::resume_state(&cp, engine.sim_mut(), &cp.input_label)
             .map_err(crate::convert::front_error)?;
         // The checkpoint's run already measured its start.
-        engine.stepping.primed = true;
+        engine.stepping.mark_started();
         engine
             .seen
             .clone_from(&engine.stepping.state.system.particles.position);
@@ -441,7 +457,7 @@ impl Simulation {
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let guard = self.engine()?;
-        let s = &guard.stepping.samples;
+        let s = &*guard.stepping.samples();
         let d = PyDict::new(py);
         let col = |f: fn(&Observables) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
         let vec3 = |f: fn(&Observables) -> DVec3| {

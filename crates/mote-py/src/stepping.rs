@@ -1,100 +1,61 @@
-//! The stepping both Python simulations share, on `mote run`'s schedule:
-//! the first call primes the propagator and measures the start; then the
-//! observables are measured at multiples of `observables_every` (absolute
-//! steps) and at the end of each `run`, as `mote run` does at its last
-//! step, never at other chunk ends. So `run(steps=N)` gives the bits of
-//! `mote run --steps N`, and chunks or callbacks change nothing.
+//! What every Python simulation class shares. Each steps `mote run`'s
+//! propagator through the front's [`mote_front::stepper::Stepper`], that
+//! is through mote's one run loop (`mote_run::Driver`): the first call
+//! primes the propagator and measures the start; then the observables are
+//! measured on the scene's schedule (absolute steps) and at the end of each
+//! `run`, as `mote run` does at its last step, never at other chunk ends.
+//! So `run()` gives the bits of `mote run`, and chunks or callbacks change
+//! nothing.
 
 use std::sync::{Mutex, MutexGuard};
 
-use mote_md::{MdError, RunLength};
-use mote_run::{Propagator, Stopped};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::convert::md_error;
-
-/// A propagator with its measured samples.
-pub struct Stepping<P: Propagator> {
-    pub state: P,
-    pub observables_every: u64,
-    pub primed: bool,
-    pub samples: Vec<P::Sample>,
-}
-
-impl<P: Propagator<Error = MdError>> Stepping<P> {
-    pub fn new(state: P, observables_every: u64) -> Self {
-        Stepping {
-            state,
-            observables_every,
-            primed: false,
-            samples: Vec::new(),
-        }
-    }
-
-    /// Primes (a no-op once primed, unless the state asks again) and
-    /// measures the start on the first call.
-    pub fn prepare(&mut self) -> Result<(), MdError> {
-        self.state.prime(&mut |_| {})?;
-        if !self.primed {
-            let s = self.state.measure();
-            self.samples.push(s);
-            self.primed = true;
-        }
-        Ok(())
-    }
-
-    /// Advances `n` steps, measuring on the schedule and, with
-    /// `end_sample`, after the last; `progress(step, time)` every 16 steps.
-    pub fn advance(
-        &mut self,
-        n: u64,
-        end_sample: bool,
-        progress: &mut (dyn FnMut(u64, f64) + Send),
-    ) -> Result<(), MdError> {
-        self.prepare()?;
-        let last = self.state.step() + n;
-        let every = self.observables_every;
-        while self.state.step() < last {
-            self.state.advance()?;
-            let step = self.state.step();
-            if let Some((particle, what)) = self.state.unstable() {
-                return Err(Stopped::Unstable {
-                    step,
-                    time: self.state.time(),
-                    particle,
-                    what,
-                }
-                .into());
-            }
-            let end = end_sample && step == last;
-            if end || (every > 0 && step.is_multiple_of(every)) {
-                let s = self.state.measure();
-                self.samples.push(s);
-            }
-            if step.is_multiple_of(16) {
-                progress(step, self.state.time());
-            }
-        }
-        Ok(())
-    }
-}
-
 /// What the shared `run` loop needs of a simulation's engine.
 pub trait Stepped: Send {
-    /// Advances as [`Stepping::advance`].
+    /// Advances `n` steps, measuring on the schedule and, with
+    /// `end_sample`, after the last; `progress(step, time)` now and then.
     fn advance(
         &mut self,
         n: u64,
         end_sample: bool,
         progress: &mut (dyn FnMut(u64, f64) + Send),
-    ) -> Result<(), MdError>;
-    /// Step, time, time step.
-    fn clock(&self) -> (u64, f64, f64);
-    /// The scene's own run length, if it gives one.
-    fn scene_length(&self) -> PyResult<Option<RunLength>>;
-    /// The opening line's description (label, size).
+    ) -> PyResult<()>;
+    /// The step now.
+    fn step(&self) -> u64;
+    /// The steps a `run(steps, until)` takes from now: `steps`, to the
+    /// first step at or past `until`, or to the scene's own end.
+    fn steps_for(&self, steps: Option<u64>, until: Option<f64>) -> PyResult<u64>;
+    /// The opening line's description (label, size, step).
     fn describe(&self) -> String;
+}
+
+/// The steps of a time-stepped run from `time` with steps of `dt`: `steps`,
+/// or to the first step at or past `until` (`mote run --until`'s rule), or
+/// to `scene_end`, the scene's own.
+pub fn time_steps(
+    steps: Option<u64>,
+    until: Option<f64>,
+    time: f64,
+    dt: f64,
+    scene_end: impl FnOnce() -> PyResult<Option<u64>>,
+) -> PyResult<u64> {
+    match (steps, until) {
+        (Some(_), Some(_)) => Err(PyValueError::new_err("give steps or until, not both")),
+        (Some(n), None) => Ok(n),
+        (None, Some(t)) if t.is_finite() => mote_run::steps_until(time, t, dt).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "until = {t} with dt = {dt}: not a number of steps a run can take"
+            ))
+        }),
+        (None, Some(t)) => Err(PyValueError::new_err(format!(
+            "until = {t}: must be a finite time"
+        ))),
+        (None, None) => scene_end()?.ok_or_else(|| {
+            PyValueError::new_err("the scene gives no run length: give steps= or until=")
+        }),
+    }
 }
 
 /// A Python class that holds a [`Stepped`] engine behind a lock.
@@ -118,29 +79,11 @@ pub fn run_loop<T: HasEngine + pyo3::PyClass<Frozen = pyo3::pyclass::boolean_str
     let (first, total, line) = {
         let s = slf.borrow();
         let e = s.engine()?;
-        let (step, time, dt) = e.clock();
-        let length = match (steps, until) {
-            (Some(_), Some(_)) => {
-                return Err(PyValueError::new_err("give steps or until, not both"))
-            }
-            (Some(n), None) => RunLength::Steps(n),
-            (None, Some(t)) if t.is_finite() => RunLength::Until(t),
-            (None, Some(t)) => {
-                return Err(PyValueError::new_err(format!(
-                    "until = {t}: must be a finite time"
-                )))
-            }
-            (None, None) => e.scene_length()?.ok_or_else(|| {
-                PyValueError::new_err("the scene gives no run length: give steps= or until=")
-            })?,
-        };
-        let total = length
-            .steps_from(time, dt)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let total = e.steps_for(steps, until)?;
         (
-            step,
+            e.step(),
             total,
-            format!("mote (Python) {}, dt = {dt}, {total} steps", e.describe()),
+            format!("mote (Python) {}, {total} steps", e.describe()),
         )
     };
     if every == 0 {
@@ -167,8 +110,7 @@ pub fn run_loop<T: HasEngine + pyo3::PyClass<Frozen = pyo3::pyclass::boolean_str
                     let note = format!("t = {t:.6e}");
                     mote_front::Monitor::progress(terminal, step - first, total, &note)
                 })
-            })
-            .map_err(md_error)?;
+            })?;
         }
         done += n;
         if let Some(f) = &callback {

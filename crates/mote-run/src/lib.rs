@@ -120,8 +120,19 @@ pub trait Propagator {
     }
 }
 
+/// A sample whose values are named columns: an observables table's header
+/// and rows, and what a caller reads without knowing the engine.
+pub trait Columns {
+    /// The name and unit of each column.
+    const COLUMNS: &'static [(&'static str, &'static str)];
+    /// The values, in the order of [`Columns::COLUMNS`].
+    fn values(&self) -> Vec<f64>;
+}
+
 /// Something that samples a run on a schedule (tables, trajectories).
-pub trait Observer<P: Propagator> {
+/// Observers are `Send`, so that a state and its driver can be stepped
+/// from another thread (Python's, with its lock released).
+pub trait Observer<P: Propagator>: Send {
     /// Sample when the step number is a multiple of this (≥ 1); the first
     /// and the last step of a run are always sampled.
     fn every(&self) -> u64;
@@ -209,7 +220,8 @@ impl<P: Propagator> Driver<P> {
     }
 
     /// Primes `state`, then steps it until step `last_step(state)` (asked
-    /// after priming), calling `progress` after every step.
+    /// after priming), calling `progress` after every step: [`Driver::start`]
+    /// then [`Driver::advance_to`] the last step, as one run.
     pub fn run(
         &mut self,
         state: &mut P,
@@ -220,6 +232,43 @@ impl<P: Propagator> Driver<P> {
         state.prime(&mut progress)?;
         let first = state.step();
         let last_step = last_step(state);
+        let initial = self.begin(state)?;
+        let last = self.advance_to(state, last_step, true, &mut progress)?;
+        if let Some(live) = self.live.as_mut() {
+            live.last(state.step(), state.time(), &mut || Self::shown(state));
+        }
+        let last = match last {
+            Some(s) => s,
+            None => initial.clone(),
+        };
+        let mut files: Vec<String> = self.observers.iter().flat_map(|o| o.files()).collect();
+        if let Some(c) = &self.checkpoints {
+            files.push(c.path.display().to_string());
+        }
+        Ok(Report {
+            steps: state.step() - first,
+            wall: start.elapsed(),
+            initial,
+            last,
+            files,
+        })
+    }
+
+    /// Primes `state`, measures it and hands that sample to the observers
+    /// (when [`Driver::sample_at_start`]) and the state to the live tap:
+    /// the start of a run. Returns the sample.
+    pub fn start(
+        &mut self,
+        state: &mut P,
+        progress: &mut dyn FnMut(&P),
+    ) -> Result<P::Sample, P::Error> {
+        state.prime(progress)?;
+        self.begin(state)
+    }
+
+    /// Measures a primed state, hands the sample to the observers and the
+    /// state to the live tap.
+    fn begin(&mut self, state: &mut P) -> Result<P::Sample, P::Error> {
         let initial = state.measure();
         if self.sample_at_start {
             for o in &mut self.observers {
@@ -227,6 +276,23 @@ impl<P: Propagator> Driver<P> {
             }
         }
         self.tap(state)?;
+        Ok(initial)
+    }
+
+    /// Steps `state` to step `last_step` (a run after [`Driver::start`], or
+    /// one stretch of it): observers sample at their multiples, checkpoints
+    /// are written at theirs, a non-finite state or a signal stops it. With
+    /// `ends_run`, `last_step` is the run's last: every observer samples it
+    /// and a checkpoint is written there; a stretch that does not end the
+    /// run samples only on the schedules, so stepping a run in stretches
+    /// writes what stepping it whole does. Returns the last sample taken.
+    pub fn advance_to(
+        &mut self,
+        state: &mut P,
+        last_step: u64,
+        ends_run: bool,
+        progress: &mut dyn FnMut(&P),
+    ) -> Result<Option<P::Sample>, P::Error> {
         let mut last = None;
         while state.step() < last_step {
             state.advance()?;
@@ -240,7 +306,7 @@ impl<P: Propagator> Driver<P> {
                 }
                 .into());
             }
-            let end = step >= last_step;
+            let end = ends_run && step >= last_step;
             let due = |o: &dyn Observer<P>| end || step.is_multiple_of(o.every().max(1));
             if self.observers.iter().any(|o| due(o.as_ref())) {
                 let sample = state.measure();
@@ -274,24 +340,7 @@ impl<P: Propagator> Driver<P> {
                 }
             }
         }
-        if let Some(live) = self.live.as_mut() {
-            live.last(state.step(), state.time(), &mut || Self::shown(state));
-        }
-        let last = match last {
-            Some(s) => s,
-            None => initial.clone(),
-        };
-        let mut files: Vec<String> = self.observers.iter().flat_map(|o| o.files()).collect();
-        if let Some(c) = &self.checkpoints {
-            files.push(c.path.display().to_string());
-        }
-        Ok(Report {
-            steps: state.step() - first,
-            wall: start.elapsed(),
-            initial,
-            last,
-            files,
-        })
+        Ok(last)
     }
 
     /// Shows the state to the live tap and applies the changes it hands
@@ -473,7 +522,7 @@ mod tests {
     }
 
     /// Records the events the driver hands the observers.
-    struct Events(std::rc::Rc<std::cell::RefCell<Vec<(u64, String)>>>);
+    struct Events(std::sync::Arc<std::sync::Mutex<Vec<(u64, String)>>>);
     impl Observer<Decay> for Events {
         fn every(&self) -> u64 {
             1
@@ -482,7 +531,7 @@ mod tests {
             Ok(())
         }
         fn event(&mut self, s: &Decay, text: &str) -> Result<(), DecayError> {
-            self.0.borrow_mut().push((s.step, text.to_string()));
+            self.0.lock().unwrap().push((s.step, text.to_string()));
             Ok(())
         }
     }
@@ -490,7 +539,7 @@ mod tests {
     #[test]
     fn the_live_tap_changes_the_next_step_and_the_observers_record_it() {
         let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
-        let events = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let events = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let mut d = Driver::new();
         d.live = Some(Box::new(Steer(log.clone(), false)));
         d.observers.push(Box::new(Events(events.clone())));
@@ -514,24 +563,27 @@ mod tests {
         // Step 2 is shown again after its changes, before stepping on.
         assert_eq!(log[6], "step 2");
         assert_eq!(log.len(), 9);
-        assert_eq!(*events.borrow(), vec![(2, "dt 0.1 → 0.5".to_string())]);
+        assert_eq!(
+            *events.lock().unwrap(),
+            vec![(2, "dt 0.1 → 0.5".to_string())]
+        );
     }
 
     /// Records the steps it saw.
-    struct Steps(u64, std::rc::Rc<std::cell::RefCell<Vec<u64>>>);
+    struct Steps(u64, std::sync::Arc<std::sync::Mutex<Vec<u64>>>);
     impl Observer<Decay> for Steps {
         fn every(&self) -> u64 {
             self.0
         }
         fn observe(&mut self, s: &Decay, _: &f64) -> Result<(), DecayError> {
-            self.1.borrow_mut().push(s.step);
+            self.1.lock().unwrap().push(s.step);
             Ok(())
         }
     }
 
     #[test]
     fn observers_see_the_start_their_schedule_and_the_last_step() {
-        let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let mut d = Driver::new();
         d.observers.push(Box::new(Steps(4, seen.clone())));
         let mut p = Decay {
@@ -540,10 +592,41 @@ mod tests {
             step: 0,
         };
         let r = d.run(&mut p, |_| 10, |_| {}).unwrap();
-        assert_eq!(*seen.borrow(), vec![0, 4, 8, 10]);
+        assert_eq!(*seen.lock().unwrap(), vec![0, 4, 8, 10]);
         assert_eq!(r.steps, 10);
         assert_eq!(r.initial, 1.0);
         assert_eq!(r.last, (0..10).fold(1.0, |x, _| x * 0.9));
+    }
+
+    /// A run stepped in stretches (Python's chunks and callbacks) samples
+    /// what the run stepped whole samples, and ends in its state.
+    #[test]
+    fn stretches_sample_and_end_as_one_run() {
+        let whole = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let mut d = Driver::new();
+        d.observers.push(Box::new(Steps(4, whole.clone())));
+        let mut p = Decay {
+            x: 1.0,
+            h: 0.1,
+            step: 0,
+        };
+        d.run(&mut p, |_| 10, |_| {}).unwrap();
+
+        let parts = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let mut d = Driver::new();
+        d.observers.push(Box::new(Steps(4, parts.clone())));
+        let mut q = Decay {
+            x: 1.0,
+            h: 0.1,
+            step: 0,
+        };
+        assert_eq!(d.start(&mut q, &mut |_| {}).unwrap(), 1.0);
+        for (to, ends) in [(3, false), (5, false), (9, false), (10, true)] {
+            d.advance_to(&mut q, to, ends, &mut |_| {}).unwrap();
+            assert_eq!(q.step, to);
+        }
+        assert_eq!(*parts.lock().unwrap(), *whole.lock().unwrap());
+        assert_eq!(q.x.to_bits(), p.x.to_bits());
     }
 
     #[test]

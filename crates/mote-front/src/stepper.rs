@@ -1,0 +1,228 @@
+//! Stepping a run from outside, a stretch at a time (Python's classes):
+//! the propagator `mote run` steps, moved by the same [`Driver`], so that
+//! stepping in stretches measures on `mote run`'s schedule and ends in its
+//! bits, and a signal or a non-finite state stops it the same way.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use mote_edmd::run::EventDriven;
+use mote_io::xyz::Frame;
+use mote_run::{Columns, Driver, Observer, Propagator};
+
+use crate::error::FrontError;
+use crate::{Engine, Input};
+
+/// A propagator, the driver that steps it and the samples taken so far:
+/// at the start, at multiples of `observables_every` (absolute steps) and
+/// at the end of each stretch that ends a run, never at other stretch ends.
+pub struct Stepper<P: Propagator> {
+    pub state: P,
+    driver: Driver<P>,
+    samples: Arc<Mutex<Vec<P::Sample>>>,
+    started: bool,
+}
+
+/// The observer that keeps the samples.
+struct Samples<S> {
+    every: u64,
+    taken: Arc<Mutex<Vec<S>>>,
+}
+
+impl<P> Observer<P> for Samples<P::Sample>
+where
+    P: Propagator,
+    P::Sample: Send,
+{
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, _: &P, sample: &P::Sample) -> Result<(), P::Error> {
+        lock(&self.taken).push(sample.clone());
+        Ok(())
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+impl<P> Stepper<P>
+where
+    P: Propagator + Send + 'static,
+    P::Sample: Send + 'static,
+{
+    /// A state not yet started; `observables_every` 0 measures only the
+    /// start and the ends of runs.
+    pub fn new(state: P, observables_every: u64) -> Self {
+        let samples = Arc::new(Mutex::new(Vec::new()));
+        let mut driver = Driver::new();
+        driver.observers.push(Box::new(Samples {
+            every: if observables_every == 0 {
+                u64::MAX
+            } else {
+                observables_every
+            },
+            taken: samples.clone(),
+        }));
+        Stepper {
+            state,
+            driver,
+            samples,
+            started: false,
+        }
+    }
+
+    /// Marks the run as started: a state taken from a checkpoint, whose
+    /// run already measured its start.
+    pub fn mark_started(&mut self) {
+        self.started = true;
+    }
+
+    /// Advances as [`Stepper::advance`], calling `progress(step, time)`
+    /// every 16 steps.
+    pub fn advance_every_16(
+        &mut self,
+        n: u64,
+        ends_run: bool,
+        progress: &mut dyn FnMut(u64, f64),
+    ) -> Result<(), P::Error> {
+        self.advance(n, ends_run, &mut |p| {
+            if p.step().is_multiple_of(16) {
+                progress(p.step(), p.time())
+            }
+        })
+    }
+
+    /// Starts the run on the first call: primes the state and measures
+    /// the start (a propagator is primed once per run; a state that must
+    /// be primed again, after its particles were moved from outside, is
+    /// primed by its owner).
+    pub fn prepare(&mut self) -> Result<(), P::Error> {
+        if !self.started {
+            self.driver.start(&mut self.state, &mut |_| {})?;
+            self.started = true;
+        }
+        Ok(())
+    }
+
+    /// Advances `n` steps through the driver; `ends_run` makes the last of
+    /// them the end of a run (sampled, as `mote run` samples its last step).
+    pub fn advance(
+        &mut self,
+        n: u64,
+        ends_run: bool,
+        progress: &mut dyn FnMut(&P),
+    ) -> Result<(), P::Error> {
+        self.prepare()?;
+        let last = self.state.step() + n;
+        self.driver
+            .advance_to(&mut self.state, last, ends_run, progress)
+            .map(|_| ())
+    }
+
+    /// The samples taken so far.
+    pub fn samples(&self) -> MutexGuard<'_, Vec<P::Sample>> {
+        lock(&self.samples)
+    }
+}
+
+/// Event-driven hard disks (2-D) or spheres (3-D), stepped an output
+/// interval at a time: `mote run`'s propagator for the scene.
+pub enum HardSpheres {
+    Disks(Stepper<EventDriven<2>>),
+    Spheres(Stepper<EventDriven<3>>),
+}
+
+/// The same expression on either dimension's stepper.
+macro_rules! either {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            HardSpheres::Disks($s) => $e,
+            HardSpheres::Spheres($s) => $e,
+        }
+    };
+}
+
+impl HardSpheres {
+    /// The run `mote run` makes of an event-driven scene with `seed` (the
+    /// scene's when `None`), returned with the seed it uses; refused, as
+    /// `mote run` refuses it, if it expects more than 10⁹ events unless
+    /// `force`d.
+    pub fn build(input: &Input, seed: Option<u64>, force: bool) -> Result<(Self, u64), FrontError> {
+        if input.plist || input.engine() != Engine::EventDriven {
+            return Err(FrontError::request(format!(
+                "{}: not an event-driven scene (no [event_driven] table)",
+                input.label
+            )));
+        }
+        let scene = mote_edmd::Scene::parse(&input.text, &input.label)?;
+        let (seed, _) = crate::seed::resolve(seed, scene.seed);
+        let dir = input.folder();
+        let every = 1;
+        let run = if scene.dimension == 2 {
+            HardSpheres::Disks(Stepper::new(
+                EventDriven::new(&scene, seed, &dir, force)?,
+                every,
+            ))
+        } else {
+            HardSpheres::Spheres(Stepper::new(
+                EventDriven::new(&scene, seed, &dir, force)?,
+                every,
+            ))
+        };
+        Ok((run, seed))
+    }
+
+    /// 2 for disks, 3 for spheres.
+    pub fn dimension(&self) -> usize {
+        match self {
+            HardSpheres::Disks(_) => 2,
+            HardSpheres::Spheres(_) => 3,
+        }
+    }
+
+    /// Advances `n` output intervals (the run's steps), measuring each;
+    /// `progress(interval, time)` after each.
+    pub fn advance(
+        &mut self,
+        n: u64,
+        ends_run: bool,
+        progress: &mut dyn FnMut(u64, f64),
+    ) -> Result<(), FrontError> {
+        either!(self, s => s.advance(n, ends_run, &mut |p| progress(p.step(), p.time()))
+            .map_err(FrontError::from))
+    }
+
+    /// Output intervals done.
+    pub fn step(&self) -> u64 {
+        either!(self, s => s.state.step())
+    }
+
+    /// The simulated time.
+    pub fn time(&self) -> f64 {
+        either!(self, s => s.state.time())
+    }
+
+    /// The interval at which the scene's run ends.
+    pub fn last_step(&self) -> u64 {
+        either!(self, s => s.state.last_step())
+    }
+
+    /// The particles now, in the scene's order (disks with z = 0), as the
+    /// trajectory writes them.
+    pub fn frame(&self) -> Frame {
+        either!(self, s => s.state.frame().unwrap_or_default())
+    }
+
+    /// The names and units of the observables (the columns of
+    /// observables.csv).
+    pub fn columns(&self) -> &'static [(&'static str, &'static str)] {
+        mote_edmd::run::EventSample::COLUMNS
+    }
+
+    /// The observables measured so far, one row each.
+    pub fn samples(&self) -> Vec<Vec<f64>> {
+        either!(self, s => s.samples().iter().map(|x| x.values()).collect())
+    }
+}
