@@ -25,6 +25,12 @@ impl FrontError {
         FrontError::Request(message.into())
     }
 
+    /// Whether the run went unstable (a non-finite number: the message
+    /// names the step and the particle).
+    pub fn is_unstable(&self) -> bool {
+        matches!(self, FrontError::Md(mote_md::MdError::Unstable { .. }))
+    }
+
     /// Whether the input is at fault (a scene's `file:line: message`, a
     /// request that cannot be served), not the run.
     pub fn is_bad_input(&self) -> bool {
@@ -33,6 +39,7 @@ impl FrontError {
             FrontError::Parse(_)
                 | FrontError::Request(_)
                 | FrontError::Edmd(mote_edmd::EdmdError::Scene { .. })
+                | FrontError::Md(mote_md::MdError::Parse(_) | mote_md::MdError::Length(_))
         )
     }
 }

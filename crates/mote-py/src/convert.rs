@@ -74,18 +74,8 @@ pub fn front_error(e: mote_front::FrontError) -> PyErr {
     use mote_front::FrontError as F;
     match e {
         e if e.is_bad_input() => PyValueError::new_err(e.to_string()),
+        e if e.is_unstable() => UnstableError::new_err(e.to_string()),
         F::Io(e) => PyOSError::new_err(e.to_string()),
-        other => MoteError::new_err(other.to_string()),
-    }
-}
-
-pub fn parse_error(e: mote_io::ParseError) -> PyErr {
-    PyValueError::new_err(e.to_string())
-}
-
-pub fn md_error(e: mote_md::MdError) -> PyErr {
-    match e {
-        e @ mote_md::MdError::Unstable { .. } => UnstableError::new_err(e.to_string()),
         other => MoteError::new_err(other.to_string()),
     }
 }

@@ -5,9 +5,8 @@
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
-use mote_md::rigid::run::{sphere_frame, RigidDynamics, RigidSample};
-use mote_md::rigid::scene::RigidScene;
-use mote_md::DVec3;
+use glam::DVec3;
+use mote_front::stepper::{BodyVectors, Rigid, RigidObservables};
 use numpy::ndarray::ArrayView2;
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2};
@@ -15,67 +14,36 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{dict_to_toml, front_error, md_error, parse_error};
+use crate::convert::{dict_to_toml, front_error};
 use crate::stepping::{run_loop, time_steps, HasEngine, Stepped};
-use mote_front::stepper::Stepper;
 
-pub struct RigidEngine {
-    stepping: Stepper<RigidDynamics>,
-    label: String,
-    /// The scene text and seed, for checkpoints.
-    text: String,
-    seed: u64,
-}
-
-impl RigidEngine {
-    fn from_text(text: &str, label: &str, seed: Option<u64>) -> PyResult<Self> {
-        let scene = RigidScene::parse(text, label).map_err(parse_error)?;
-        let built = scene.build(text, label, seed).map_err(parse_error)?;
-        let every = scene.output.observables_every.max(1);
-        let seed = built.seed;
-        Ok(RigidEngine {
-            stepping: Stepper::new(RigidDynamics::new(built), every),
-            label: label.into(),
-            text: text.into(),
-            seed,
-        })
-    }
-
-    fn dynamics(&self) -> &RigidDynamics {
-        &self.stepping.state
-    }
-}
-
-impl Stepped for RigidEngine {
+impl Stepped for Rigid {
     fn advance(
         &mut self,
         n: u64,
         end_sample: bool,
         progress: &mut (dyn FnMut(u64, f64) + Send),
     ) -> PyResult<()> {
-        self.stepping
-            .advance_every_16(n, end_sample, progress)
-            .map_err(md_error)
+        Rigid::advance(self, n, end_sample, progress).map_err(front_error)
     }
 
     fn step(&self) -> u64 {
-        self.dynamics().step
+        Rigid::step(self)
     }
 
     fn steps_for(&self, steps: Option<u64>, until: Option<f64>) -> PyResult<u64> {
-        let d = self.dynamics();
         // A rigid scene always gives its length (steps or until).
-        time_steps(steps, until, d.bodies.time, d.dt, || {
-            Ok(Some(d.last_step.saturating_sub(d.step)))
+        time_steps(steps, until, self.time(), self.dt(), || {
+            Ok(Some(self.scene_steps()))
         })
     }
 
     fn describe(&self) -> String {
         format!(
             "{}: {} bodies, dt = {}",
-            self.label,
-            self.dynamics().bodies.len(),
-            self.dynamics().dt
+            self.label(),
+            self.len(),
+            self.dt()
         )
     }
 }
@@ -88,23 +56,23 @@ impl Stepped for RigidEngine {
 /// >>> sim.orientations      # unit quaternions (w, x, y, z) of the bodies
 #[pyclass(module = "mote")]
 pub struct RigidSimulation {
-    engine: Mutex<RigidEngine>,
+    engine: Mutex<Rigid>,
 }
 
 impl HasEngine for RigidSimulation {
-    type Engine = RigidEngine;
-    fn engine(&self) -> PyResult<MutexGuard<'_, RigidEngine>> {
+    type Engine = Rigid;
+    fn engine(&self) -> PyResult<MutexGuard<'_, Rigid>> {
         crate::stepping::lock(&self.engine)
     }
 }
 
 fn body_view<'py>(
     this: &Bound<'py, RigidSimulation>,
-    which: fn(&mote_md::rigid::RigidBodies) -> &[DVec3],
+    which: BodyVectors,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let s = this.borrow();
     let e = s.engine()?;
-    let v = which(&e.dynamics().bodies);
+    let v = e.vectors(which);
     // SAFETY: DVec3 is three f64 in a row; the bodies' arrays are never
     // reallocated after the scene is built, and the array keeps `this` alive.
     let arr = unsafe { ArrayView2::from_shape_ptr((v.len(), 3), v.as_ptr() as *const f64) };
@@ -125,13 +93,8 @@ impl RigidSimulation {
     #[staticmethod]
     #[pyo3(signature = (text, seed=None, name="<string>"))]
     fn from_toml(text: &str, seed: Option<u64>, name: &str) -> PyResult<Self> {
-        if mote_front::Engine::of_scene(text) != mote_front::Engine::Rigid {
-            return Err(PyValueError::new_err(format!(
-                "{name}: not a rigid scene (no [rigid] table): use mote.Simulation or mote.run"
-            )));
-        }
         Ok(RigidSimulation {
-            engine: Mutex::new(RigidEngine::from_text(text, name, seed)?),
+            engine: Mutex::new(Rigid::build(text, name, seed).map_err(front_error)?),
         })
     }
 
@@ -148,43 +111,15 @@ impl RigidSimulation {
     fn resume(path: PathBuf) -> PyResult<Self> {
         let cp =
             mote_io::checkpoint::read(&path).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        if cp.option("engine") != Some("rigid") {
-            return Err(PyValueError::new_err(format!(
-                "{}: not a checkpoint of a rigid run",
-                path.display()
-            )));
-        }
-        let mut engine = RigidEngine::from_text(&cp.input_text, &cp.input_label, Some(cp.seed))?;
-        let state = &mut engine.stepping.state;
-        if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
-            state.dt = dt;
-        }
-        state.resume(&cp, &cp.input_label).map_err(md_error)?;
-        // The checkpoint's run already measured its start.
-        engine.stepping.mark_started();
+        let run = Rigid::resume(&cp, &path.display().to_string()).map_err(front_error)?;
         Ok(RigidSimulation {
-            engine: Mutex::new(engine),
+            engine: Mutex::new(run),
         })
     }
 
     /// Writes a checkpoint that `RigidSimulation.resume` continues bit for bit.
     fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
-        let mut guard = self.engine()?;
-        let e = &mut *guard;
-        e.stepping.prepare().map_err(md_error)?;
-        let mut cp = mote_io::checkpoint::Checkpoint {
-            program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
-            seed: e.seed,
-            options: vec![
-                ("engine".into(), "rigid".into()),
-                ("name".into(), "python".into()),
-                ("output".into(), ".".into()),
-            ],
-            input_label: e.label.clone(),
-            input_text: e.text.clone(),
-            ..Default::default()
-        };
-        mote_run::Propagator::save(&mut e.stepping.state, &mut cp).map_err(md_error)?;
+        let cp = self.engine()?.checkpoint().map_err(front_error)?;
         mote_io::checkpoint::write(&path, &cp).map_err(|e| crate::MoteError::new_err(e.to_string()))
     }
 
@@ -193,7 +128,7 @@ impl RigidSimulation {
     fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
         let mut guard = self.engine()?;
         let engine = &mut *guard;
-        py.detach(|| engine.advance(n, false, &mut |_, _| {}))
+        py.detach(|| Stepped::advance(engine, n, false, &mut |_, _| {}))
     }
 
     /// Runs `steps` steps or until time `until` (the scene's length when
@@ -214,55 +149,55 @@ impl RigidSimulation {
     /// Simulated time.
     #[getter]
     fn time(&self) -> PyResult<f64> {
-        Ok(self.engine()?.dynamics().bodies.time)
+        Ok(self.engine()?.time())
     }
 
     /// Time step (settable between runs).
     #[getter]
     fn dt(&self) -> PyResult<f64> {
-        Ok(self.engine()?.dynamics().dt)
+        Ok(self.engine()?.dt())
     }
 
     #[setter]
     fn set_dt(&self, dt: f64) -> PyResult<()> {
-        self.engine()?.stepping.state.dt = crate::stepping::checked_dt(dt)?;
+        self.engine()?.set_dt(crate::stepping::checked_dt(dt)?);
         Ok(())
     }
 
     /// Steps taken.
     #[getter]
     fn steps(&self) -> PyResult<u64> {
-        Ok(self.engine()?.dynamics().step)
+        Ok(self.engine()?.step())
     }
 
     /// Number of bodies.
     fn __len__(&self) -> PyResult<usize> {
-        Ok(self.engine()?.dynamics().bodies.len())
+        Ok(self.engine()?.len())
     }
 
     /// Centres of mass, (N, 3): a writable view of mote's memory.
     #[getter]
     fn positions<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        body_view(this, |b| &b.position)
+        body_view(this, BodyVectors::Position)
     }
 
     /// Velocities of the centres of mass, (N, 3), a writable view.
     #[getter]
     fn velocities<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        body_view(this, |b| &b.velocity)
+        body_view(this, BodyVectors::Velocity)
     }
 
     /// Angular velocities ω, (N, 3), a writable view.
     #[getter]
     fn omegas<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        body_view(this, |b| &b.omega)
+        body_view(this, BodyVectors::Omega)
     }
 
     /// Rotation vectors r = n·tan(φ/2) of the bodies' placements (seed
     /// 000), (N, 3), a writable view.
     #[getter]
     fn rotations<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        body_view(this, |b| &b.rotation)
+        body_view(this, BodyVectors::Rotation)
     }
 
     /// Orientations as unit quaternions (w, x, y, z) = (1, r)/√(1 + r²),
@@ -270,7 +205,7 @@ impl RigidSimulation {
     #[getter]
     fn orientations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let e = self.engine()?;
-        let r = &e.dynamics().bodies.rotation;
+        let r = e.vectors(BodyVectors::Rotation);
         let flat: Vec<f64> = r
             .iter()
             .flat_map(|r| {
@@ -284,18 +219,13 @@ impl RigidSimulation {
     /// Masses of the bodies, (N,) (a copy: they belong to the templates).
     #[getter]
     fn masses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let e = self.engine()?;
-        let b = &e.dynamics().bodies;
-        Ok(PyArray1::from_vec(
-            py,
-            (0..b.len()).map(|i| b.template(i).mass()).collect(),
-        ))
+        Ok(PyArray1::from_vec(py, self.engine()?.masses()))
     }
 
     /// The spheres in the world: dict of positions (M, 3), velocities
     /// (M, 3), radii (M,), body (M,) index of the body of each.
     fn spheres<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let f = sphere_frame(&self.engine()?.dynamics().bodies);
+        let f = self.engine()?.spheres();
         let m = f.positions.len();
         let flat = |v: &[[f64; 3]]| v.iter().flat_map(|x| *x).collect::<Vec<f64>>();
         let d = PyDict::new(py);
@@ -318,34 +248,37 @@ impl RigidSimulation {
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let guard = self.engine()?;
-        let s = &*guard.stepping.samples();
+        let s = &guard.samples();
         let d = PyDict::new(py);
-        let col = |f: fn(&RigidSample) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
-        let vec3 = |f: fn(&RigidSample) -> DVec3| {
+        let col =
+            |f: fn(&RigidObservables) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
+        let vec3 = |f: fn(&RigidObservables) -> DVec3| {
             let flat: Vec<f64> = s.iter().flat_map(|o| f(o).to_array()).collect();
             PyArray1::from_vec(py, flat).reshape([s.len(), 3])
         };
         d.set_item("time", col(|o| o.time))?;
-        d.set_item("kinetic", col(|o| o.kinetic_energy()))?;
-        d.set_item("translational", col(|o| o.translational_energy))?;
-        d.set_item("rotational", col(|o| o.rotational_energy))?;
-        d.set_item("potential", col(|o| o.potential_energy))?;
-        d.set_item("total", col(|o| o.kinetic_energy() + o.potential_energy))?;
-        d.set_item("momentum", vec3(|o| o.linear_momentum)?)?;
+        d.set_item("kinetic", col(|o| o.translational + o.rotational))?;
+        d.set_item("translational", col(|o| o.translational))?;
+        d.set_item("rotational", col(|o| o.rotational))?;
+        d.set_item("potential", col(|o| o.potential))?;
+        d.set_item(
+            "total",
+            col(|o| o.translational + o.rotational + o.potential),
+        )?;
+        d.set_item("momentum", vec3(|o| o.momentum)?)?;
         d.set_item("angular_momentum", vec3(|o| o.angular_momentum)?)?;
         Ok(d)
     }
 
     fn __repr__(&self) -> PyResult<String> {
         let e = self.engine()?;
-        let d = e.dynamics();
         Ok(format!(
             "<mote.RigidSimulation {}: {} bodies, t = {}, step {}, dt = {}>",
-            e.label,
-            d.bodies.len(),
-            d.bodies.time,
-            d.step,
-            d.dt
+            e.label(),
+            e.len(),
+            e.time(),
+            e.step(),
+            e.dt()
         ))
     }
 }

@@ -10,11 +10,8 @@
 
 use std::path::PathBuf;
 
-use mote_io::checkpoint::Checkpoint;
-use mote_md::observe::Observables;
-use mote_md::scene::Scene;
-use mote_md::DVec3;
-use mote_run::Propagator;
+use glam::DVec3;
+use mote_front::stepper::{PointSample, Points, Scalars, Vectors};
 use numpy::ndarray::{ArrayView1, ArrayView2};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2};
@@ -23,109 +20,35 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, MutexGuard};
 
-use crate::convert::{dict_to_toml, md_error, parse_error};
+use crate::convert::{dict_to_toml, front_error};
 use crate::stepping::{run_loop, time_steps, HasEngine, Stepped};
-use mote_front::stepper::Stepper;
 
-/// The stepping state behind a Python `Simulation` (no Python types: it
-/// runs with the GIL released).
-pub struct Engine {
-    stepping: Stepper<mote_md::Simulation>,
-    /// Scene label and text, kept for checkpoints.
-    label: String,
-    text: String,
-    /// Positions after the last step, to see writes from Python (which
-    /// make the carried accelerations stale).
-    seen: Vec<DVec3>,
-}
-
-impl Engine {
-    fn from_text(text: &str, label: &str, seed: Option<u64>) -> PyResult<Engine> {
-        let scene = Scene::parse(text, label).map_err(parse_error)?;
-        let (seed, _) = mote_front::seed::resolve(seed, scene.seed);
-        let built = scene.build(text, label, seed).map_err(parse_error)?;
-        if built.simulation.dt <= 0.0 {
-            return Err(PyValueError::new_err(format!(
-                "{label}: no time step ([run] dt)"
-            )));
-        }
-        Ok(Engine {
-            stepping: Stepper::new(built.simulation, scene.output.observables_every),
-            label: label.to_string(),
-            text: text.to_string(),
-            seen: Vec::new(),
-        })
-    }
-
-    fn sim(&self) -> &mote_md::Simulation {
-        &self.stepping.state
-    }
-
-    fn sim_mut(&mut self) -> &mut mote_md::Simulation {
-        &mut self.stepping.state
-    }
-
-    /// Primes on the first call, and again after Python moved particles.
-    fn prepare(&mut self) -> Result<(), mote_md::MdError> {
-        if !self.seen.is_empty() && self.seen != self.sim().system.particles.position {
-            let sys = &mut self.sim_mut().system;
-            sys.carried_acceleration.clear();
-            sys.carried_angular_acceleration.clear();
-            // primed again: the first forces of the moved particles
-            self.stepping.state.prime(&mut |_| {})?;
-        }
-        self.stepping.prepare()
-    }
-
-    /// Advances `n` steps (see [`Stepper::advance`]).
-    fn advance(&mut self, n: u64, end_sample: bool) -> Result<(), mote_md::MdError> {
-        self.prepare()?;
-        let result = self
-            .stepping
-            .advance_every_16(n, end_sample, &mut |_, _| {});
-        self.seen
-            .clone_from(&self.stepping.state.system.particles.position);
-        result
-    }
-}
-
-impl Stepped for Engine {
+impl Stepped for Points {
     fn advance(
         &mut self,
         n: u64,
         end_sample: bool,
         progress: &mut (dyn FnMut(u64, f64) + Send),
     ) -> PyResult<()> {
-        self.prepare().map_err(md_error)?;
-        let result = self.stepping.advance_every_16(n, end_sample, progress);
-        self.seen
-            .clone_from(&self.stepping.state.system.particles.position);
-        result.map_err(md_error)
+        Points::advance(self, n, end_sample, progress).map_err(front_error)
     }
 
     fn step(&self) -> u64 {
-        self.sim().system.step
+        Points::step(self)
     }
 
     fn steps_for(&self, steps: Option<u64>, until: Option<f64>) -> PyResult<u64> {
-        let sim = self.sim();
-        time_steps(steps, until, sim.system.time, sim.dt, || {
-            let scene = Scene::parse(&self.text, &self.label).map_err(parse_error)?;
-            let src = mote_io::Source::new(&self.label, &self.text);
-            let length = scene.run.schedule(src).map_err(parse_error)?.2;
-            length
-                .map(|l| l.steps_from(sim.system.time, sim.dt))
-                .transpose()
-                .map_err(|e| PyValueError::new_err(e.to_string()))
+        time_steps(steps, until, self.time(), self.dt(), || {
+            self.scene_steps().map_err(front_error)
         })
     }
 
     fn describe(&self) -> String {
         format!(
             "{}: {} particles, dt = {}",
-            self.label,
-            self.sim().system.particles.len(),
-            self.sim().dt
+            self.label(),
+            self.len(),
+            self.dt()
         )
     }
 }
@@ -140,35 +63,32 @@ impl Stepped for Engine {
 #[pyclass(module = "mote")]
 pub struct Simulation {
     /// Behind a lock: Python may call from several threads.
-    engine: Mutex<Engine>,
+    engine: Mutex<Points>,
 }
 
 impl Simulation {
-    fn new(engine: Engine) -> Self {
+    fn new(engine: Points) -> Self {
         Simulation {
             engine: Mutex::new(engine),
         }
     }
 
-    fn engine(&self) -> PyResult<MutexGuard<'_, Engine>> {
+    fn engine(&self) -> PyResult<MutexGuard<'_, Points>> {
         crate::stepping::lock(&self.engine)
     }
 }
 
 impl HasEngine for Simulation {
-    type Engine = Engine;
-    fn engine(&self) -> PyResult<MutexGuard<'_, Engine>> {
+    type Engine = Points;
+    fn engine(&self) -> PyResult<MutexGuard<'_, Points>> {
         crate::stepping::lock(&self.engine)
     }
 }
 
-fn view<'py>(
-    this: &Bound<'py, Simulation>,
-    which: fn(&mote_md::particles::Particles) -> &[DVec3],
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn view<'py>(this: &Bound<'py, Simulation>, which: Vectors) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let s = this.borrow();
     let e = s.engine()?;
-    let v = which(&e.sim().system.particles);
+    let v = e.vectors(which);
     // DVec3 is three f64 in a row (repr(C)): an (N, 3) array.
     let arr = unsafe { ArrayView2::from_shape_ptr((v.len(), 3), v.as_ptr() as *const f64) };
     // SAFETY: the particle arrays are never reallocated (a time-stepped
@@ -178,11 +98,11 @@ fn view<'py>(
 
 fn view1<'py>(
     this: &Bound<'py, Simulation>,
-    which: fn(&mote_md::particles::Particles) -> &[f64],
+    which: Scalars,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let s = this.borrow();
     let e = s.engine()?;
-    let v = which(&e.sim().system.particles);
+    let v = e.scalars(which);
     let arr = ArrayView1::from(v);
     // SAFETY: as in `view`.
     Ok(unsafe { PyArray1::borrow_from_array(&arr, this.clone().into_any()) })
@@ -230,14 +150,10 @@ impl Simulation {
     #[staticmethod]
     #[pyo3(signature = (path, seed=None))]
     fn from_file(path: PathBuf, seed: Option<u64>) -> PyResult<Self> {
-        let input = mote_front::Input::read(&path.to_string_lossy())
-            .map_err(crate::convert::front_error)?;
-        Self::checked(&input)?;
-        Ok(Simulation::new(Engine::from_text(
-            &input.text,
-            &input.label,
-            seed,
-        )?))
+        let input = mote_front::Input::read(&path.to_string_lossy()).map_err(front_error)?;
+        Ok(Simulation::new(
+            Points::build(&input, seed).map_err(front_error)?,
+        ))
     }
 
     /// A scene given as TOML text; `name` labels its messages.
@@ -250,8 +166,9 @@ impl Simulation {
             text: text.into(),
             plist: false,
         };
-        Self::checked(&input)?;
-        Ok(Simulation::new(Engine::from_text(text, name, seed)?))
+        Ok(Simulation::new(
+            Points::build(&input, seed).map_err(front_error)?,
+        ))
     }
 
     /// A scene given as a dict of the scene file's tables and keys.
@@ -268,48 +185,14 @@ impl Simulation {
     fn resume(path: PathBuf) -> PyResult<Self> {
         let cp =
             mote_io::checkpoint::read(&path).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        if cp.option("engine").is_some_and(|e| e != "particles") {
-            return Err(PyValueError::new_err(format!(
-                "{}: a checkpoint of a {} run: resume it with mote.run(resume=...)",
-                path.display(),
-                cp.option("engine").unwrap_or_default()
-            )));
-        }
-        let mut engine = Engine::from_text(&cp.input_text, &cp.input_label, Some(cp.seed))?;
-        if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
-            engine.sim_mut().dt = dt;
-        }
-        mote_front::resume_state(&cp, engine.sim_mut(), &cp.input_label)
-            .map_err(crate::convert::front_error)?;
-        // The checkpoint's run already measured its start.
-        engine.stepping.mark_started();
-        engine
-            .seen
-            .clone_from(&engine.stepping.state.system.particles.position);
-        Ok(Simulation::new(engine))
+        let run = Points::resume(&cp, &path.display().to_string()).map_err(front_error)?;
+        Ok(Simulation::new(run))
     }
 
     /// Writes a checkpoint: `Simulation.resume(path)` and `mote run
     /// --resume path` go on from it bit for bit.
     fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
-        let mut guard = self.engine()?;
-        let e = &mut *guard;
-        e.prepare().map_err(md_error)?;
-        let mut cp = Checkpoint {
-            program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
-            seed: e.sim().seed,
-            options: vec![
-                ("name".into(), "python".into()),
-                ("plist".into(), "false".into()),
-                ("total-steps".into(), e.sim().system.step.to_string()),
-                ("dt".into(), mote_io::checkpoint::hex(e.sim().dt)),
-                ("output".into(), ".".into()),
-            ],
-            input_label: e.label.clone(),
-            input_text: e.text.clone(),
-            ..Checkpoint::default()
-        };
-        e.sim_mut().save(&mut cp).map_err(md_error)?;
+        let cp = self.engine()?.checkpoint().map_err(front_error)?;
         mote_io::checkpoint::write(&path, &cp).map_err(|e| crate::MoteError::new_err(e.to_string()))
     }
 
@@ -318,7 +201,8 @@ impl Simulation {
     fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
         let mut guard = self.engine()?;
         let engine = &mut *guard;
-        py.detach(|| engine.advance(n, false)).map_err(md_error)
+        py.detach(|| Points::advance(engine, n, false, &mut |_, _| {}))
+            .map_err(front_error)
     }
 
     /// Runs `steps` steps or until time `until` (the scene's run length
@@ -340,7 +224,7 @@ impl Simulation {
     /// Simulated time (settable between runs).
     #[getter]
     fn time(&self) -> PyResult<f64> {
-        Ok(self.engine()?.sim().system.time)
+        Ok(self.engine()?.time())
     }
 
     #[setter]
@@ -348,106 +232,98 @@ impl Simulation {
         if !t.is_finite() {
             return Err(PyValueError::new_err("time must be finite"));
         }
-        self.engine()?.sim_mut().system.time = t;
+        self.engine()?.set_time(t);
         Ok(())
     }
 
     /// Time step (settable between runs).
     #[getter]
     fn dt(&self) -> PyResult<f64> {
-        Ok(self.engine()?.sim().dt)
+        Ok(self.engine()?.dt())
     }
 
     #[setter]
     fn set_dt(&self, dt: f64) -> PyResult<()> {
-        self.engine()?.sim_mut().dt = crate::stepping::checked_dt(dt)?;
+        self.engine()?.set_dt(crate::stepping::checked_dt(dt)?);
         Ok(())
     }
 
     /// Steps taken.
     #[getter]
     fn steps(&self) -> PyResult<u64> {
-        Ok(self.engine()?.sim().system.step)
+        Ok(self.engine()?.step())
     }
 
     /// The seed of the run's random numbers.
     #[getter]
     fn seed(&self) -> PyResult<u64> {
-        Ok(self.engine()?.sim().seed)
+        Ok(self.engine()?.seed())
     }
 
     fn __len__(&self) -> PyResult<usize> {
-        Ok(self.engine()?.sim().system.particles.len())
+        Ok(self.engine()?.len())
     }
 
     /// Positions, (N, 3): a view of mote's memory; writes reach the next step.
     #[getter]
     fn positions<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        view(this, |p| &p.position)
+        view(this, Vectors::Position)
     }
 
     /// `sim.positions = array`: copies an (N, 3) array in.
     #[setter]
     fn set_positions(&self, values: Bound<'_, PyAny>) -> PyResult<()> {
         let mut e = self.engine()?;
-        copy_in(
-            &values,
-            &mut e.sim_mut().system.particles.position,
-            "positions",
-        )
+        copy_in(&values, e.vectors_mut(Vectors::Position), "positions")
     }
 
     /// `sim.velocities = array`: copies an (N, 3) array in.
     #[setter]
     fn set_velocities(&self, values: Bound<'_, PyAny>) -> PyResult<()> {
         let mut e = self.engine()?;
-        copy_in(
-            &values,
-            &mut e.sim_mut().system.particles.velocity,
-            "velocities",
-        )
+        copy_in(&values, e.vectors_mut(Vectors::Velocity), "velocities")
     }
 
     /// Velocities, (N, 3), a writable view.
     #[getter]
     fn velocities<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        view(this, |p| &p.velocity)
+        view(this, Vectors::Velocity)
     }
 
     /// Angular velocities, (N, 3), a writable view.
     #[getter]
     fn omegas<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        view(this, |p| &p.angular_velocity)
+        view(this, Vectors::AngularVelocity)
     }
 
     /// Magnetic dipole moments, (N, 3), a writable view.
     #[getter]
     fn dipoles<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        view(this, |p| &p.dipole)
+        view(this, Vectors::Dipole)
     }
 
     /// Masses, (N,), a writable view.
     #[getter]
     fn masses<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        view1(this, |p| &p.mass)
+        view1(this, Scalars::Mass)
     }
 
     /// Radii, (N,), a writable view.
     #[getter]
     fn radii<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        view1(this, |p| &p.radius)
+        view1(this, Scalars::Radius)
     }
 
     /// Charges, (N,), a writable view.
     #[getter]
     fn charges<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        view1(this, |p| &p.charge)
+        view1(this, Scalars::Charge)
     }
 
     /// The species names of the particles.
     #[getter]
     fn species(&self) -> PyResult<Vec<String>> {
-        Ok(self.engine()?.sim().system.species.clone())
+        Ok(self.engine()?.species().to_vec())
     }
 
     /// The observables measured so far (the columns of `mote run`'s
@@ -457,17 +333,17 @@ impl Simulation {
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let guard = self.engine()?;
-        let s = &*guard.stepping.samples();
+        let s = &guard.samples();
         let d = PyDict::new(py);
-        let col = |f: fn(&Observables) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
-        let vec3 = |f: fn(&Observables) -> DVec3| {
+        let col = |f: fn(&PointSample) -> f64| PyArray1::from_vec(py, s.iter().map(f).collect());
+        let vec3 = |f: fn(&PointSample) -> DVec3| {
             let flat: Vec<f64> = s.iter().flat_map(|o| f(o).to_array()).collect();
             PyArray1::from_vec(py, flat).reshape([s.len(), 3])
         };
         d.set_item("time", col(|o| o.time))?;
         d.set_item("kinetic", col(|o| o.kinetic))?;
         d.set_item("potential", col(|o| o.potential))?;
-        d.set_item("total", col(|o| o.total_energy()))?;
+        d.set_item("total", col(|o| o.kinetic + o.potential))?;
         d.set_item("rotational", col(|o| o.rotational))?;
         d.set_item("kT", col(|o| o.kt))?;
         d.set_item("pressure", col(|o| o.pressure))?;
@@ -487,7 +363,7 @@ impl Simulation {
         width: u32,
         height: u32,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let frame = mote_md::output::frame_of(&self.engine()?.sim().system);
+        let frame = self.engine()?.frame();
         let image = py
             .detach(|| mote_render::frame::picture_image(&frame, width, height))
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -498,31 +374,11 @@ impl Simulation {
         let e = self.engine()?;
         Ok(format!(
             "<mote.Simulation {}: {} particles, t = {}, step {}, dt = {}>",
-            e.label,
-            e.sim().system.particles.len(),
-            e.sim().system.time,
-            e.sim().system.step,
-            e.sim().dt
+            e.label(),
+            e.len(),
+            e.time(),
+            e.step(),
+            e.dt()
         ))
-    }
-}
-
-impl Simulation {
-    /// Refuses inputs of the other engines with the way to run them.
-    fn checked(input: &mote_front::Input) -> PyResult<()> {
-        if input.plist {
-            return Err(PyValueError::new_err(format!(
-                "{}: an MPPphys particle file: run it with mote.run()",
-                input.label
-            )));
-        }
-        match input.engine() {
-            mote_front::Engine::Particles => Ok(()),
-            other => Err(PyValueError::new_err(format!(
-                "{}: a {} scene: mote.Simulation steps time-stepped scenes; run this one with mote.run()",
-                input.label,
-                other.title()
-            ))),
-        }
     }
 }

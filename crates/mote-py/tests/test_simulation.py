@@ -370,3 +370,16 @@ def test_hard_spheres_refuse_what_they_cannot_do():
     )
     disks.run()
     assert disks.positions.shape == (50, 2) and disks.dimension == 2
+
+
+def test_python_depends_on_no_engine_crate():
+    """mote-py reaches every engine through the front (issue 36): its
+    manifest names none of the engine crates."""
+    import pathlib
+    import re
+
+    manifest = (pathlib.Path(__file__).parent.parent / "Cargo.toml").read_text()
+    deps = manifest.split("[dependencies]")[1].split("\n[")[0]
+    names = set(re.findall(r"^([a-z0-9_-]+)\s*=", deps, re.M))
+    assert "mote-front" in names
+    assert not names & {"mote-md", "mote-edmd", "mote-nip", "mote-geom"}, names
