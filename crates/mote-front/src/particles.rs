@@ -166,48 +166,22 @@ pub(crate) fn run(
         trim_outputs(&dir, cp.step, cp.time)?;
     }
     let out = &scene.output;
+    let format = args.trajectory_format(
+        out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
+    )?;
     let sim = &mut built.simulation;
     let mut driver = Driver::<Simulation>::new();
     driver.sample_at_start = !append;
     driver.live = args.live.take();
-    if out.observables_every > 0 {
-        driver.observers.push(Box::new(ObservablesCsv::create(
-            &dir.join("observables.csv"),
-            &provenance,
-            scene.units,
-            out.observables_every,
-            built.probes.clone(),
-            // The pressure where the box is periodic and every interaction
-            // gives its virial (the summary says which does not).
-            sim.system.boundary.periodic.iter().all(|p| *p)
-                && sim.forces.without_virial().is_empty(),
-            sim.forces.pressure_tensor,
-            &sim.forces
-                .interactions
-                .iter()
-                .flat_map(|i| i.wall_forces())
-                .map(|w| w.0)
-                .collect::<Vec<_>>(),
-            sim.system
-                .particles
-                .dipole
-                .iter()
-                .any(|m| *m != mote_md::DVec3::ZERO),
-            append,
-        )?));
-    }
-    if out.trajectory_every > 0 {
-        let format = args.trajectory_format(
-            out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
-        )?;
-        driver.observers.push(Box::new(Trajectory::create(
-            &dir.join(format!("trajectory.{}", format.extension())),
-            format,
-            provenance.clone(),
-            out.trajectory_every,
-            append,
-        )?));
-    }
+    driver.observers = file_observers(
+        &scene,
+        sim,
+        &built.probes,
+        &dir,
+        &provenance,
+        format,
+        append,
+    )?;
     if let Some(every) = args.checkpoint_every {
         let mut options = vec![
             ("name".to_string(), input.name.clone()),
@@ -222,11 +196,7 @@ pub(crate) fn run(
             ("output".to_string(), dir.display().to_string()),
             (
                 "trajectory-format".to_string(),
-                args.trajectory_format(
-                    out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
-                )?
-                .extension()
-                .to_string(),
+                format.extension().to_string(),
             ),
         ];
         options.extend(folder.checkpoint_options());
@@ -302,6 +272,70 @@ pub(crate) fn run(
         Err(e) => return Err(e.into()),
     }
     Ok(outcome)
+}
+
+/// The files a time-stepped run writes as it goes, by the scene's
+/// `[output]`: observables.csv every `observables_every` steps (with the
+/// pressure where the box is periodic and every interaction gives its
+/// virial) and the trajectory every `trajectory_every` in `format`; with
+/// `append`, onto the files of the run being resumed.
+pub(crate) fn file_observers(
+    scene: &Scene,
+    sim: &Simulation,
+    probes: &[mote_md::observe::Probe],
+    dir: &Path,
+    provenance: &mote_io::Provenance,
+    format: mote_io::trajectory::Format,
+    append: bool,
+) -> Result<Vec<Box<dyn mote_run::Observer<Simulation>>>, FrontError> {
+    let out = &scene.output;
+    let mut observers: Vec<Box<dyn mote_run::Observer<Simulation>>> = Vec::new();
+    if out.observables_every > 0 {
+        let mut csv = ObservablesCsv::create(
+            &dir.join("observables.csv"),
+            provenance,
+            scene.units,
+            out.observables_every,
+            probes.to_vec(),
+            sim.system.boundary.periodic.iter().all(|p| *p)
+                && sim.forces.without_virial().is_empty(),
+            sim.forces.pressure_tensor,
+            &sim.forces
+                .interactions
+                .iter()
+                .flat_map(|i| i.wall_forces())
+                .map(|w| w.0)
+                .collect::<Vec<_>>(),
+            sim.system
+                .particles
+                .dipole
+                .iter()
+                .any(|m| *m != mote_md::DVec3::ZERO),
+            append,
+        )?;
+        // The viewer's first plot: what the dynamics leave to watch.
+        let watched = if sim.brownian.is_some() {
+            Some("potential_energy")
+        } else if sim.thermostat.is_some() {
+            Some("kT")
+        } else {
+            None
+        };
+        if let (Some(column), false) = (watched, append) {
+            csv.suggest_plot(column)?;
+        }
+        observers.push(Box::new(csv));
+    }
+    if out.trajectory_every > 0 {
+        observers.push(Box::new(Trajectory::create(
+            &dir.join(format!("trajectory.{}", format.extension())),
+            format,
+            provenance.clone(),
+            out.trajectory_every,
+            append,
+        )?));
+    }
+    Ok(observers)
 }
 
 /// The paragraph that ends a run. Overdamped (Brownian) runs have no

@@ -152,6 +152,16 @@ impl Observer<Simulation> for ObservablesCsv {
     }
 }
 
+impl ObservablesCsv {
+    /// Names the column a viewer plots first (`# plot: NAME`, before the
+    /// rows). Without it the viewer plots the total energy, which a
+    /// Newtonian run conserves; an overdamped or thermostatted run
+    /// conserves none, and names what it watches instead.
+    pub fn suggest_plot(&mut self, column: &str) -> Result<(), MdError> {
+        Ok(self.writer.comment(&format!("plot: {column}"))?)
+    }
+}
+
 /// The comment an observables table records an event of the run with:
 /// `event: step S, t = T: what changed`.
 pub fn event_line(step: u64, time: f64, text: &str) -> String {

@@ -73,6 +73,15 @@ impl Simulation {
         }
     }
 
+    fn build(
+        input: &mote_front::Input,
+        seed: Option<u64>,
+        output: Option<PathBuf>,
+    ) -> PyResult<Self> {
+        let run = Points::build(input, seed, output.as_deref()).map_err(front_error)?;
+        Ok(Simulation::new(run))
+    }
+
     fn engine(&self) -> PyResult<MutexGuard<'_, Points>> {
         crate::stepping::lock(&self.engine)
     }
@@ -146,37 +155,45 @@ fn copy_in(values: &Bound<'_, PyAny>, target: &mut [DVec3], what: &str) -> PyRes
 
 #[pymethods]
 impl Simulation {
-    /// A scene file or `example:NAME`; `seed` replaces the scene's.
+    /// A scene file or `example:NAME`; `seed` replaces the scene's. With
+    /// `output` (a folder), the run writes there what `mote run` writes as
+    /// it goes (observables.csv, the trajectory, on the scene's `[output]`
+    /// schedules); without it, no files.
     #[staticmethod]
-    #[pyo3(signature = (path, seed=None))]
-    fn from_file(path: PathBuf, seed: Option<u64>) -> PyResult<Self> {
+    #[pyo3(signature = (path, seed=None, output=None))]
+    fn from_file(path: PathBuf, seed: Option<u64>, output: Option<PathBuf>) -> PyResult<Self> {
         let input = mote_front::Input::read(&path.to_string_lossy()).map_err(front_error)?;
-        Ok(Simulation::new(
-            Points::build(&input, seed).map_err(front_error)?,
-        ))
+        Self::build(&input, seed, output)
     }
 
     /// A scene given as TOML text; `name` labels its messages.
     #[staticmethod]
-    #[pyo3(signature = (text, seed=None, name="<string>"))]
-    fn from_toml(text: &str, seed: Option<u64>, name: &str) -> PyResult<Self> {
+    #[pyo3(signature = (text, seed=None, name="<string>", output=None))]
+    fn from_toml(
+        text: &str,
+        seed: Option<u64>,
+        name: &str,
+        output: Option<PathBuf>,
+    ) -> PyResult<Self> {
         let input = mote_front::Input {
             name: "python".into(),
             label: name.into(),
             text: text.into(),
             plist: false,
         };
-        Ok(Simulation::new(
-            Points::build(&input, seed).map_err(front_error)?,
-        ))
+        Self::build(&input, seed, output)
     }
 
     /// A scene given as a dict of the scene file's tables and keys.
     #[staticmethod]
-    #[pyo3(signature = (scene, seed=None))]
-    fn from_dict(scene: &Bound<'_, PyDict>, seed: Option<u64>) -> PyResult<Self> {
+    #[pyo3(signature = (scene, seed=None, output=None))]
+    fn from_dict(
+        scene: &Bound<'_, PyDict>,
+        seed: Option<u64>,
+        output: Option<PathBuf>,
+    ) -> PyResult<Self> {
         let text = dict_to_toml(scene)?;
-        Self::from_toml(&text, seed, "<dict>")
+        Self::from_toml(&text, seed, "<dict>", output)
     }
 
     /// The simulation a checkpoint (`save_checkpoint`, `mote run
@@ -318,6 +335,28 @@ impl Simulation {
     #[getter]
     fn charges<'py>(this: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         view1(this, Scalars::Charge)
+    }
+
+    /// The box as `(lo, hi, periodic)` — corners (3,), ∓inf on an axis
+    /// without faces, and which axes wrap — or None for an open system.
+    #[getter(r#box)]
+    fn box_corners<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let (lo, hi, periodic) = self.engine()?.boundary();
+        // an open box has ∓inf corners on every axis
+        if (0..3).all(|k| lo[k].is_infinite() && hi[k].is_infinite()) {
+            return Ok(None);
+        }
+        let lo = PyArray1::from_vec(py, lo.to_array().to_vec());
+        let hi = PyArray1::from_vec(py, hi.to_array().to_vec());
+        Ok(Some(
+            (lo, hi, periodic.to_vec()).into_pyobject(py)?.into_any(),
+        ))
+    }
+
+    /// The folder the run writes its files to (`output=`), or None.
+    #[getter]
+    fn output(&self) -> PyResult<Option<PathBuf>> {
+        Ok(self.engine()?.output().map(|p| p.to_path_buf()))
     }
 
     /// The species names of the particles.

@@ -62,6 +62,29 @@ def test_run_gives_the_bits_of_mote_run(tmp_path):
     assert np.array_equal(table["potential_energy"], obs["potential"])
 
 
+def test_with_output_a_simulation_writes_what_mote_run_writes(tmp_path):
+    """A stepped Simulation given a folder writes mote run's files there,
+    byte for byte, in chunks and with callbacks; without one it writes none,
+    and it says where it writes."""
+    scene = LJ.replace("trajectory_every = 0", "trajectory_every = 50")
+    sim = mote.Simulation.from_toml(scene, output=tmp_path / "py")
+    assert sim.output == tmp_path / "py"
+    sim.step(30)
+    sim.run(steps=170, callback=lambda s: None, every=40)
+    del sim  # the folder's lock goes with the simulation
+    mote.run(scene, output=tmp_path / "cli")
+    for name in ["observables.csv", "trajectory.xyz"]:
+        ours = (tmp_path / "py" / name).read_bytes()
+        assert len(ours) > 1000, name
+        assert ours == (tmp_path / "cli" / name).read_bytes(), name
+    assert mote.Simulation.from_toml(scene).output is None
+    # Two live simulations cannot write one folder.
+    first = mote.Simulation.from_toml(scene, output=tmp_path / "one")
+    with pytest.raises(Exception, match="one"):
+        mote.Simulation.from_toml(scene, output=tmp_path / "one")
+    del first
+
+
 def test_chunks_and_callbacks_change_nothing():
     whole = mote.Simulation.from_toml(LJ)
     whole.run(steps=200)
@@ -203,7 +226,10 @@ def test_ase_atoms_in_and_out():
     assert np.array_equal(sim.velocities, atoms.get_velocities())
     assert np.array_equal(sim.masses, atoms.get_masses())
     sim.step(10)  # no forces: straight lines
-    back = mote.to_ase(sim, box=([0, 0, 0], [8, 8, 8], [True] * 3))
+    lo, hi, periodic = sim.box
+    assert list(lo) == [0, 0, 0] and list(hi) == [8, 8, 8] and periodic == [True] * 3
+    back = mote.to_ase(sim)  # the simulation's own box (it was a zero cell)
+    assert np.allclose(back.cell.array, np.diag([8.0, 8.0, 8.0])) and all(back.pbc)
     assert np.allclose(back.positions, (atoms.positions + 1.0 * atoms.get_velocities()) % 8.0, atol=1e-12)
     assert np.allclose(back.get_velocities(), atoms.get_velocities(), atol=1e-15)
     assert back.get_chemical_symbols() == ["Ar"] * 4

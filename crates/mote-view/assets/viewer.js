@@ -554,9 +554,13 @@ function addTable(part) {
     });
     $("obsplot").style.display = "block";
   }
+  // The run's own first plot where it names one (a Brownian run:
+  // potential_energy), else the total energy a Newtonian run conserves.
+  if (part.plot && table.columns.includes(part.plot)) $("obscol").value = part.plot;
   table.rows.push(...part.rows);
   table.events.push(...part.events);
   scene.rows = table.rows.length;
+  scene.plotted = $("obscol").value;
   scene.events = table.events;
 }
 function plots() {

@@ -14,6 +14,11 @@ pub struct Table {
     pub rows: Vec<Vec<f64>>,
     /// `event: …` comment lines, without the `# `.
     pub events: Vec<String>,
+    /// The column to plot first, where the table names one (`# plot:
+    /// NAME`: a run that conserves no energy); else the page plots the
+    /// total energy.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plot: Option<String>,
 }
 
 impl Table {
@@ -30,6 +35,8 @@ impl Table {
                 let comment = comment.trim();
                 if comment.starts_with("event:") {
                     self.events.push(comment.to_string());
+                } else if let Some(column) = comment.strip_prefix("plot:") {
+                    self.plot.get_or_insert_with(|| column.trim().to_string());
                 }
             } else if !header_seen {
                 self.columns = line.split(',').map(|c| c.trim().to_string()).collect();
@@ -97,7 +104,8 @@ impl Follow {
         let mut t = Table::default();
         t.take_lines(&text, self.columns_sent);
         self.columns_sent |= !t.columns.is_empty();
-        (!t.rows.is_empty() || !t.events.is_empty() || !t.columns.is_empty()).then_some(t)
+        (!t.rows.is_empty() || !t.events.is_empty() || !t.columns.is_empty() || t.plot.is_some())
+            .then_some(t)
     }
 }
 
@@ -125,5 +133,27 @@ mod tests {
         assert_eq!(next.rows, vec![vec![1.0, 2.5], vec![2.0, 3.0]]);
         assert_eq!(next.events, ["event: step 2, t = 1: dt 1 → 2"]);
         assert_eq!(Table::read(&path).unwrap().rows.len(), 3);
+    }
+}
+
+#[cfg(test)]
+mod plot_tests {
+    use super::*;
+
+    /// A table that names its first plot (`# plot: NAME`, as a Brownian
+    /// run's does) hands the name to the page; one that does not, none.
+    #[test]
+    fn a_table_names_the_column_to_plot_first() {
+        let mut t = Table::default();
+        t.take_lines(
+            "# mote\ntime,kinetic_energy,potential_energy,total_energy\n# plot: potential_energy\n0,1,2,3\n",
+            false,
+        );
+        assert_eq!(t.plot.as_deref(), Some("potential_energy"));
+        assert_eq!(t.rows.len(), 1);
+        let mut plain = Table::default();
+        plain.take_lines("time,total_energy\n0,1\n", false);
+        assert_eq!(plain.plot, None);
+        assert!(!serde_json::to_string(&plain).unwrap().contains("plot"));
     }
 }

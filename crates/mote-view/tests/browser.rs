@@ -300,3 +300,39 @@ fn a_browser_without_webgl2_is_told_why() {
     assert_eq!(errors.len(), 1, "{errors:?}");
     assert!(errors[0].contains("no WebGL2 context"), "{errors:?}");
 }
+
+/// The page plots first the column its table names (a Brownian run's
+/// `# plot: potential_energy`), else the total energy.
+#[test]
+fn the_page_plots_first_what_the_run_names() {
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: no Chromium (install Debian's chromium, or set MOTE_CHROMIUM)");
+        return;
+    };
+    for (named, plotted) in [
+        (Some("potential_energy"), "potential_energy"),
+        (None, "total_energy"),
+    ] {
+        let table = mote_view::table::Table {
+            columns: ["time", "kinetic_energy", "potential_energy", "total_energy"]
+                .map(String::from)
+                .to_vec(),
+            rows: vec![vec![0.0, 1.0, -2.0, -1.0], vec![1.0, 0.5, -2.5, -2.0]],
+            events: Vec::new(),
+            plot: named.map(String::from),
+        };
+        let app = mote_view::App::file(
+            mote_view::Trajectory::new("grid.xyz".into(), frames()),
+            Some(table),
+        );
+        let port = common::start_app(app);
+        let out = headless(
+            &browser,
+            &["--dump-dom".into()],
+            &format!("http://127.0.0.1:{port}/"),
+        );
+        let state = page_state(&String::from_utf8_lossy(&out.stdout));
+        assert_eq!(state["errors"], serde_json::json!([]), "{state}");
+        assert_eq!(state["plotted"], plotted, "{state}");
+    }
+}

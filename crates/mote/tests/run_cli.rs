@@ -50,6 +50,28 @@ fn example_runs_and_writes_headed_files() {
     assert_eq!(frames[0].positions.len(), 2);
 }
 
+/// A run that conserves no energy names what the viewer plots first:
+/// Brownian dynamics the potential energy (the viewer plotted the total);
+/// a Newtonian run names nothing, and the total energy is plotted.
+#[test]
+fn a_brownian_run_names_its_first_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    for (example, plot) in [
+        ("example:ferrofluid", Some("# plot: potential_energy")),
+        ("example:sun-earth", None),
+    ] {
+        let o = mote(&["run", example, "--steps", "50", "-o", "f"], dir.path());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let csv = std::fs::read_to_string(dir.path().join("f/observables.csv")).unwrap();
+        let comment = csv.lines().find(|l| l.starts_with("# plot:"));
+        assert_eq!(comment, plot, "{example}");
+        // the table still reads: the comment is skipped
+        let table = mote_io::csv::read_table(&dir.path().join("f/observables.csv")).unwrap();
+        assert!(!table.rows.is_empty());
+        std::fs::remove_dir_all(dir.path().join("f")).unwrap();
+    }
+}
+
 #[test]
 fn until_overrides_the_scene() {
     let dir = tempfile::tempdir().unwrap();

@@ -76,6 +76,11 @@ where
         }
     }
 
+    /// Adds an observer (a file the run writes as it goes).
+    pub fn observe_with(&mut self, observer: Box<dyn Observer<P>>) {
+        self.driver.observers.push(observer);
+    }
+
     /// Marks the run as started: a state taken from a checkpoint, whose
     /// run already measured its start.
     pub fn mark_started(&mut self) {

@@ -23,6 +23,8 @@ pub struct Points {
     /// Positions after the last step, to see writes from outside (which
     /// make the carried accelerations stale).
     seen: Vec<DVec3>,
+    /// The folder the run writes its files to, held while it lives.
+    folder: Option<crate::lock::RunFolder>,
 }
 
 /// A per-particle vector.
@@ -60,8 +62,15 @@ pub struct PointSample {
 impl Points {
     /// The run `mote run` makes of a time-stepped scene with `seed` (the
     /// scene's when `None`); other engines' scenes and particle files are
-    /// refused with the way to run them.
-    pub fn build(input: &Input, seed: Option<u64>) -> Result<Self, FrontError> {
+    /// refused with the way to run them. With `output`, the run takes that
+    /// folder as `mote run` takes its own (locked and marked) and writes
+    /// there what `mote run` writes as it goes: observables.csv and the
+    /// trajectory on the scene's `[output]` schedules.
+    pub fn build(
+        input: &Input,
+        seed: Option<u64>,
+        output: Option<&std::path::Path>,
+    ) -> Result<Self, FrontError> {
         if input.plist {
             return Err(FrontError::request(format!(
                 "{}: an MPPphys particle file: run it with mote.run()",
@@ -78,10 +87,15 @@ impl Points {
                 )))
             }
         }
-        Self::from_text(&input.text, &input.label, seed)
+        Self::from_text(&input.text, &input.label, seed, output)
     }
 
-    fn from_text(text: &str, label: &str, seed: Option<u64>) -> Result<Self, FrontError> {
+    fn from_text(
+        text: &str,
+        label: &str,
+        seed: Option<u64>,
+        output: Option<&std::path::Path>,
+    ) -> Result<Self, FrontError> {
         let scene = Scene::parse(text, label)?;
         let (seed, _) = crate::seed::resolve(seed, scene.seed);
         let built = scene.build(text, label, seed)?;
@@ -90,12 +104,48 @@ impl Points {
                 "{label}: no time step ([run] dt)"
             )));
         }
+        let mut stepper = Stepper::new(built.simulation, scene.output.observables_every);
+        let folder = match output {
+            None => None,
+            Some(dir) => {
+                let folder = crate::lock::RunFolder::claim(dir, label, text, None)?;
+                let format = scene
+                    .output
+                    .trajectory_format(mote_io::Source::new(label, text))?;
+                let observers = crate::particles::file_observers(
+                    &scene,
+                    &stepper.state,
+                    &built.probes,
+                    dir,
+                    &crate::provenance(label, seed),
+                    format,
+                    false,
+                )?;
+                for o in observers {
+                    stepper.observe_with(o);
+                }
+                Some(folder)
+            }
+        };
         Ok(Points {
-            stepper: Stepper::new(built.simulation, scene.output.observables_every),
+            stepper,
             label: label.to_string(),
             text: text.to_string(),
             seen: Vec::new(),
+            folder,
         })
+    }
+
+    /// The folder the run writes to, if it writes files.
+    pub fn output(&self) -> Option<&std::path::Path> {
+        self.folder.as_ref().map(|f| f.dir.as_path())
+    }
+
+    /// The box: lower and upper corners and which axes are periodic
+    /// (corners at ∓∞ on the axes of an open box).
+    pub fn boundary(&self) -> (DVec3, DVec3, [bool; 3]) {
+        let b = &self.sim().system.boundary;
+        (b.lo, b.hi, b.periodic)
     }
 
     /// The run a checkpoint of a time-stepped run holds, ready to go on bit
@@ -107,7 +157,7 @@ impl Points {
                 cp.option("engine").unwrap_or_default()
             )));
         }
-        let mut run = Self::from_text(&cp.input_text, &cp.input_label, Some(cp.seed))?;
+        let mut run = Self::from_text(&cp.input_text, &cp.input_label, Some(cp.seed), None)?;
         if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
             run.sim_mut().dt = dt;
         }

@@ -63,11 +63,17 @@ def from_ase(atoms, scene=None, seed=None):
 def to_ase(sim, box=None):
     """The state of ``sim`` as ASE ``Atoms``: positions, velocities, masses,
     species as symbols (``X`` where a species is no element), and ``box``
-    (``(lo, hi, periodic)``, default none: a free cluster) as cell and pbc;
+    (``(lo, hi, periodic)``; by default the simulation's own box where it
+    has faces on every axis, else none: a free cluster) as cell and pbc;
     the numbers in the simulation's own units (see ``from_ase``)."""
     import numpy as np
     from ase import Atoms
     from ase.data import chemical_symbols
+
+    if box is None:
+        own = getattr(sim, "box", None)
+        if own is not None and np.all(np.isfinite(own[0])) and np.all(np.isfinite(own[1])):
+            box = own
 
     names = [s if s in chemical_symbols else "X" for s in sim.species] or ["X"] * len(sim)
     atoms = Atoms(symbols=names, positions=np.array(sim.positions), masses=np.array(sim.masses))

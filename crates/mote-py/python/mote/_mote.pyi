@@ -23,13 +23,13 @@ class Simulation:
     dict with the keys of docs/scene-format.md."""
 
     @staticmethod
-    def from_file(path: Path, seed: Optional[int] = None) -> "Simulation":
+    def from_file(path: Path, seed: Optional[int] = None, output: Optional[Path] = None) -> "Simulation":
         """A scene file or ``example:NAME``; ``seed`` replaces the scene's."""
     @staticmethod
-    def from_toml(text: str, seed: Optional[int] = None, name: str = "<string>") -> "Simulation":
+    def from_toml(text: str, seed: Optional[int] = None, name: str = "<string>", output: Optional[Path] = None) -> "Simulation":
         """A scene given as TOML text; ``name`` labels its messages."""
     @staticmethod
-    def from_dict(scene: dict[str, Any], seed: Optional[int] = None) -> "Simulation":
+    def from_dict(scene: dict[str, Any], seed: Optional[int] = None, output: Optional[Path] = None) -> "Simulation":
         """A scene given as a dict of the scene file's tables and keys."""
     @staticmethod
     def resume(path: Path) -> "Simulation":
@@ -129,6 +129,12 @@ def run(
     @property
     def charges(self) -> npt.NDArray[np.float64]:
         """(N,) writable view."""
+    @property
+    def box(self) -> Optional[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], list[bool]]]:
+        """(lo, hi, periodic), or None for an open system."""
+    @property
+    def output(self) -> Optional[Path]:
+        """The folder the run writes its files to, or None."""
     @property
     def species(self) -> list[str]:
         """Species names of the particles."""
