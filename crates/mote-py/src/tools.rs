@@ -184,7 +184,9 @@ pub fn pack<'py>(
 /// The rod-packing estimate of the random close packing fraction (Farr &
 /// Groot 2009), as `mote rcp`: `sigma` for a lognormal of log-width σ
 /// (number-weighted), or `diameters` with `volumes` for a sum of
-/// monodisperse populations; `rods` rods (default 16000).
+/// monodisperse populations; `rods` rods (default 16000). A distribution
+/// the rods cannot resolve raises ValueError; one whose third decimal may be
+/// off warns (`UserWarning`).
 #[pyfunction]
 #[pyo3(signature = (*, sigma=None, diameters=None, volumes=None, rods=16000))]
 pub fn rcp(
@@ -220,8 +222,16 @@ pub fn rcp(
             ))
         }
     };
+    // Checked as `mote rcp` checks it: refused where the rods cannot
+    // resolve the distribution, a warning where its third decimal may be off.
     let packing = RodPacking::default().rods(rods);
-    let out = py.detach(|| packing.estimate(&dist)).map_err(bad)?;
+    let out = py
+        .detach(|| packing.checked_estimate(&dist, |_| {}))
+        .map_err(bad)?;
+    if let Some(note) = &out.note {
+        let warnings = py.import("warnings")?;
+        warnings.call_method1("warn", (note.as_str(),))?;
+    }
     Ok(out.phi)
 }
 

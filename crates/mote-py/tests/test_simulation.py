@@ -214,6 +214,14 @@ def test_pack_and_rcp():
     assert 0.66 < mote.rcp(sigma=0.3) < 0.68
     with pytest.raises(ValueError):
         mote.rcp(sigma=-1.0)
+    # As mote rcp: what the rods cannot resolve is refused, a rough third
+    # decimal warned of.
+    with pytest.raises(ValueError, match="rods"):
+        mote.rcp(diameters=[1.0, 1e5], volumes=[0.5, 0.5])
+    with pytest.raises(ValueError, match="more rods"):
+        mote.rcp(sigma=8.0)
+    with pytest.warns(UserWarning, match="third decimal"):
+        assert 0.96 < mote.rcp(sigma=3.0) < 0.98
 
 
 def test_ase_atoms_in_and_out():

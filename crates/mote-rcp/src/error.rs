@@ -83,4 +83,7 @@ pub enum RcpError {
     /// A design problem is ill-posed (see the message).
     #[error("{0}")]
     Design(String),
+    /// The rods cannot resolve the distribution (see the message).
+    #[error("{0}")]
+    Unresolved(String),
 }

@@ -26,6 +26,7 @@ mod erfc;
 mod error;
 mod fit;
 mod packing;
+pub mod resolution;
 
 pub mod design;
 pub mod heatmap;
@@ -38,6 +39,7 @@ pub use erfc::{erf_as7126, ErfcFlavour};
 pub use error::RcpError;
 pub use fit::{lognormal_fit, MONODISPERSE_FIT};
 pub use packing::{pack_rods, Packing, RodPacker, SPHERE_GAP_FRACTION};
+pub use resolution::Checked;
 
 /// Default number of rods (spherepack1d's default).
 pub const DEFAULT_RODS: usize = 16_000;

@@ -446,10 +446,16 @@ fn classic<R: BufRead, W: Write>(
     } else {
         ProgressBar::hidden()
     };
+    // Refused where the rods cannot resolve the distribution (a population
+    // with no rod, a width past the last quantile); noted where the third
+    // decimal may be off (mote_rcp::resolution).
     let packing = estimator
-        .estimate_with_progress(&dist, |done| bar.set_position(done as u64))
+        .checked_estimate(&dist, |done| bar.set_position(done as u64))
         .or_else(|e| err(format!("Error: {e}.")))?;
     bar.finish_and_clear();
+    if let (Some(note), false) = (&packing.note, global.quiet) {
+        tell!("{note}");
+    }
     if verbose {
         writeln!(out, "\nPredicted maximum packing fraction:")?;
     }
