@@ -34,6 +34,10 @@ pub enum EdmdError {
     /// An initial state or setting that cannot be simulated.
     #[error("{0}")]
     Invalid(String),
+    /// A packing setting out of its domain, with its key (the caller says
+    /// where the value came from).
+    #[error("{0}")]
+    Setting(pack::SettingError),
     /// A scene file that does not parse, with file and line.
     #[error("{file}:{line}: {message}")]
     Scene {

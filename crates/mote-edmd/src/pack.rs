@@ -132,6 +132,27 @@ impl SizeSpec {
     }
 }
 
+/// The highest reduced pressure a packing can be grown to (see
+/// [`PackSettings::check`]).
+pub const MAX_REDUCED_PRESSURE: f64 = 1e14;
+
+/// A packing setting out of its domain: the key as a scene spells it
+/// (`rate`, `phi_start`, `phi`, `rescale_every`, `max_pressure`, `n`,
+/// `jam_start`, `jam_step`, `jam_relax`), its value and why, so that the
+/// caller can say where the value came from (a scene's line, an option).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettingError {
+    pub key: &'static str,
+    pub value: String,
+    pub why: String,
+}
+
+impl std::fmt::Display for SettingError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} = {}: {}", self.key, self.value, self.why)
+    }
+}
+
 /// Settings of a packing run.
 #[derive(Debug, Clone)]
 pub struct PackSettings {
@@ -163,6 +184,134 @@ pub struct PackSettings {
     /// Grow from these spheres instead of a random start (`n`, `sizes` and
     /// `phi_start` are then ignored).
     pub start: Option<PackStart>,
+}
+
+impl PackSettings {
+    /// The domain of every setting, checked before anything is built (the
+    /// one check of the packer, of `mote pack`'s options and of `[packing]`
+    /// scenes, which add where a value came from).
+    pub fn check(&self) -> Result<(), SettingError> {
+        // as a user writes a number: -1, 0.05, 1e300 (not 301 digits)
+        let written = |x: f64| {
+            if x == 0.0 || (x.abs() >= 1e-4 && x.abs() < 1e15) {
+                format!("{x}")
+            } else {
+                format!("{x:e}")
+            }
+        };
+        let bad = |key: &'static str, value: f64, why: &str| SettingError {
+            key,
+            value: written(value),
+            why: why.to_string(),
+        };
+        let n = match (&self.start, &self.sizes) {
+            (Some(s), _) => s.radii.len(),
+            (None, SizeSpec::Radii(r)) => r.len(),
+            _ => self.n,
+        };
+        if n < 2 {
+            return Err(SettingError {
+                key: "n",
+                value: n.to_string(),
+                why: "need at least 2 particles".into(),
+            });
+        }
+        // (a rate of 1.8e308 overflowed the growth of the radii)
+        if !(self.rate > 0.0 && self.rate <= 1e3) {
+            return Err(bad(
+                "rate",
+                self.rate,
+                "the growth rate Γ must lie in (0, 10³] (spheropack grows at 10⁻³ … 1)",
+            ));
+        }
+        if self.start.is_none() && !(self.phi_start > 0.0 && self.phi_start < 0.3) {
+            return Err(bad(
+                "phi_start",
+                self.phi_start,
+                "the starting packing fraction must lie in (0, 0.3)",
+            ));
+        }
+        if let Some(t) = self.target_phi.filter(|_| self.start.is_none()) {
+            if !(t > self.phi_start && t < 1.0) {
+                return Err(bad(
+                    "phi",
+                    t,
+                    &format!(
+                        "the target packing fraction must lie between the start {} and 1",
+                        self.phi_start
+                    ),
+                ));
+            }
+        }
+        // Growing to jamming takes about 10·N/Γ pair collisions (measured:
+        // 200 spheres took 1.7·10⁶ more at Γ = 0.001 than at 0.01); beyond
+        // 10¹² — a day at 10⁷ a second — a rate is a slip, not a plan (a
+        // rate of 1e-300 ran for ever).
+        let collisions = 10.0 * n as f64 / self.rate;
+        if collisions > 1e12 {
+            return Err(bad(
+                "rate",
+                self.rate,
+                &format!(
+                    "growing {n} particles to jamming at this rate takes about {collisions:.0e} collisions \
+                     (10·N/Γ; days at 10⁷ a second): give a rate of at least {:.0e}",
+                    10.0 * n as f64 / 1e12
+                ),
+            ));
+        }
+        // (1e300 collisions a particle made one window run for ever)
+        if !(self.rescale_every > 0.0 && self.rescale_every <= 1e4) {
+            return Err(bad(
+                "rescale_every",
+                self.rescale_every,
+                "the collisions per particle between rescalings must lie in (0, 10⁴]",
+            ));
+        }
+        if self.max_pressure.is_nan() || self.max_pressure <= 1.0 {
+            return Err(bad(
+                "max_pressure",
+                self.max_pressure,
+                "the pressure threshold must exceed 1 (the ideal gas)",
+            ));
+        }
+        // Z ≈ D/(relative gap): 10¹⁴ is a gap of 10⁻¹⁴ of a diameter, what
+        // 64-bit positions resolve; a higher threshold is never reached
+        // (1e300 ran the quasi-static finish for ever).
+        if self.max_pressure > MAX_REDUCED_PRESSURE {
+            return Err(bad(
+                "max_pressure",
+                self.max_pressure,
+                "the reduced pressure cannot pass 10¹⁴ (gaps of 10⁻¹⁴ of a diameter are what 64-bit positions resolve)",
+            ));
+        }
+        if let Some(f) = self.finish {
+            if f.start_pressure.is_nan() || f.start_pressure <= 1.0 {
+                return Err(bad(
+                    "jam_start",
+                    f.start_pressure,
+                    "the quasi-static finish's start pressure must exceed 1",
+                ));
+            }
+            // each cycle closes this fraction of the estimated gap, so the
+            // cycles to jamming go as ln(Z_max/Z_start)/step (a step of
+            // 2e-308 ran for ever)
+            if !(f.step >= 1e-3 && f.step <= 0.5) {
+                return Err(bad(
+                    "jam_step",
+                    f.step,
+                    "the quasi-static finish's step must lie in [0.001, 0.5]",
+                ));
+            }
+            if f.relax_windows < 1 {
+                return Err(SettingError {
+                    key: "jam_relax",
+                    value: f.relax_windows.to_string(),
+                    why: "the quasi-static finish needs at least 1 relaxation window".into(),
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A start given by the caller (a frame of a file): the box's side lengths,
@@ -496,38 +645,7 @@ impl<const D: usize> Packer<D> {
             (None, SizeSpec::Radii(r)) => r.len(),
             _ => settings.n,
         };
-        if n < 2 {
-            return Err(invalid(format!("need at least 2 particles, got {n}")));
-        }
-        if !(settings.rate > 0.0 && settings.rate.is_finite()) {
-            return Err(invalid(format!(
-                "growth rate Γ = {} must be positive",
-                settings.rate
-            )));
-        }
-        if settings.start.is_none() && !(settings.phi_start > 0.0 && settings.phi_start < 0.3) {
-            return Err(invalid(format!(
-                "starting packing fraction {} must lie in (0, 0.3)",
-                settings.phi_start
-            )));
-        }
-        if let Some(t) = settings.target_phi.filter(|_| settings.start.is_none()) {
-            if !(t > settings.phi_start && t < 1.0) {
-                return Err(invalid(format!(
-                    "target packing fraction {t} must lie between the start {} and 1",
-                    settings.phi_start
-                )));
-            }
-        }
-        if !(settings.rescale_every > 0.0 && settings.rescale_every.is_finite()) {
-            return Err(invalid("rescale interval must be positive".into()));
-        }
-        if settings.max_pressure.is_nan() || settings.max_pressure <= 1.0 {
-            return Err(invalid(format!(
-                "pressure threshold {} must exceed 1 (the ideal gas)",
-                settings.max_pressure
-            )));
-        }
+        settings.check().map_err(EdmdError::Setting)?;
         let mut walls = [false; D];
         for (k, w) in settings.walls.iter().enumerate().take(D) {
             walls[k] = *w;
@@ -581,23 +699,19 @@ impl<const D: usize> Packer<D> {
             .fold(f64::INFINITY, f64::min);
         let largest = 2.0 * radii.iter().cloned().fold(0.0, f64::max) * growth;
         if largest * MIN_CELLS > side {
-            return Err(invalid(format!(
+            return Err(EdmdError::Setting(SettingError {
+                key: "n",
+                value: n.to_string(),
+                why: format!(
                 "{n} particles are too few for this size distribution: grown to φ ≈ {phi_end:.3} the largest diameter would be {:.3} of the periodic box side, and the event system needs less than 1/{MIN_CELLS} (try about {:.0} particles, or a narrower distribution)",
                 largest / side,
                 (n as f64 * (largest * MIN_CELLS / side).powi(D as i32)).ceil()
-            )));
+            ),
+            }));
         }
         let masses = vec![1.0; n];
         let vel = thermal_velocities::<D, _>(&masses, 1.0, &mut rng);
         let ke_target = 0.5 * D as f64 * n as f64;
-        if let Some(f) = settings.finish {
-            if !(f.start_pressure > 1.0 && f.step > 0.0 && f.step <= 0.5 && f.relax_windows >= 1) {
-                return Err(invalid(format!(
-                    "quasi-static finish: start pressure {} must exceed 1, step {} lie in (0, 0.5] and relax windows {} be ≥ 1",
-                    f.start_pressure, f.step, f.relax_windows
-                )));
-            }
-        }
         let sys = Self::epoch(simbox, pos, vel, radii, masses, &settings)?;
         Ok(Packer {
             sys,

@@ -1,4 +1,5 @@
 //! The integration tests of mote-front, one binary (`cargo test -p mote-front --test front MODULE::`).
 
 mod live;
+mod packing_values;
 mod rigid_runs;

@@ -28,6 +28,7 @@ mod rigid_free_flight;
 mod rigid_mass;
 mod rigid_pair;
 mod rigid_scene;
+mod rigid_scene_values;
 mod rigid_top;
 mod scene_values;
 mod shared_neighbours;

@@ -151,3 +151,48 @@ fn a_file_whose_bodies_fit_no_template_names_the_scene_line() {
         "{x}"
     );
 }
+
+/// Found by the rigid scene property test: a placement region of 1.8e308
+/// panicked in the uniform draw, a bead of 1 000 lobes would take most of
+/// an hour to integrate and one of 10¹² lobes aborted asking for 40 TB; all
+/// are refused at their table, at once.
+#[test]
+fn a_region_too_wide_to_draw_from_and_a_template_too_costly_are_refused() {
+    let scene = |lobes: &str, hi: &str| {
+        format!(
+            "seed = 7\n[rigid]\n[[rigid.template]]\nname = \"bead\"\ngenerator = \"irregular\"\n\
+             radius = 1e-3\nlobes = {lobes}\nseed = 1\ndensity = 2000.0\n\
+             [[rigid.random]]\ntemplate = \"bead\"\nn = 3\nlo = [2e-3, 2e-3, 2e-3]\nhi = [{hi}, 9e-3, 9e-3]\n\
+             [run]\ndt = 5e-6\nsteps = 1\n"
+        )
+    };
+    let t0 = std::time::Instant::now();
+    let text = scene("9", "1.7976931348623157e308");
+    let e = RigidScene::parse(&text, "s.toml")
+        .unwrap()
+        .build(&text, "s.toml", None)
+        .err()
+        .unwrap();
+    assert_eq!(e.line, 10, "{e}");
+    assert!(e.to_string().contains("wider than a placement"), "{e}");
+    let text = scene("1000", "9e-3");
+    let e = RigidScene::parse(&text, "s.toml")
+        .unwrap()
+        .build(&text, "s.toml", None)
+        .err()
+        .unwrap();
+    assert_eq!(e.line, 3, "{e}");
+    assert!(
+        e.to_string().contains("1001 spheres overlapping") && e.to_string().contains("minutes"),
+        "{e}"
+    );
+    // 10¹² lobes asked for 40 TB before anything was checked
+    let text = scene("1000000000000", "9e-3");
+    let e = RigidScene::parse(&text, "s.toml")
+        .unwrap()
+        .build(&text, "s.toml", None)
+        .err()
+        .unwrap();
+    assert!(e.to_string().contains("at most 10000 spheres"), "{e}");
+    assert!(t0.elapsed().as_secs_f64() < 5.0);
+}

@@ -693,7 +693,7 @@ fn negative_numbers_are_refused_as_values() {
         ),
         (
             &["pack", "--rate", "-1"][..],
-            "growth rate Γ = -1 must be positive",
+            "--rate -1: the growth rate Γ must lie in (0, 10³]",
         ),
     ] {
         let o = mote(args, dir.path());

@@ -141,6 +141,20 @@ impl Naming<'_> {
     }
 }
 
+impl Naming<'_> {
+    /// An engine error where the packer refused a setting (its domain, or
+    /// too few particles for the distribution), said as the request spelled
+    /// the key; any other error as it is.
+    pub fn locate(&self, e: FrontError) -> FrontError {
+        match e {
+            FrontError::Edmd(mote_edmd::EdmdError::Setting(s)) => {
+                FrontError::request(format!("{}: {}", self.said(s.key, &s.value, false), s.why))
+            }
+            other => other,
+        }
+    }
+}
+
 impl PackingSpec {
     /// The method, or a message naming the bad key as the request spelled
     /// it; the soft method packs spheres in a periodic box from a random
@@ -241,7 +255,7 @@ impl PackingSpec {
                 refuse!("{}: must be a non-negative number", said("tol", &t));
             }
         }
-        Ok(PackSettings {
+        let settings = PackSettings {
             n: self.n,
             sizes,
             rate: self.rate,
@@ -259,7 +273,12 @@ impl PackingSpec {
             }),
             seed,
             start,
-        })
+        };
+        // The engine's one check of every value, said where it came from.
+        settings
+            .check()
+            .map_err(|e| naming.locate(mote_edmd::EdmdError::Setting(e).into()))?;
+        Ok(settings)
     }
 }
 
@@ -726,6 +745,7 @@ pub(crate) fn run(
         resume: None,
     };
     packed_outcome(
+        Naming::Scene(source),
         &input.label,
         seed,
         spec,
@@ -740,6 +760,7 @@ pub(crate) fn run(
 /// Packs and says what `mote run` says of it.
 #[allow(clippy::too_many_arguments)]
 fn packed_outcome(
+    naming: Naming,
     label: &str,
     seed: u64,
     spec: &PackingSpec,
@@ -758,7 +779,8 @@ fn packed_outcome(
         files,
         &provenance,
         monitor,
-    )?;
+    )
+    .map_err(|e| naming.locate(e))?;
     Ok(Outcome {
         engine: Engine::Packing,
         seed,
@@ -832,6 +854,7 @@ pub(crate) fn resume(
         resume: Some(cp.clone()),
     };
     packed_outcome(
+        Naming::Scene(source),
         &cp.input_label,
         seed,
         spec,

@@ -675,6 +675,15 @@ impl RigidScene {
                 if (0..3).any(|d| hi[d] < lo[d]) {
                     return Err(err(span, "lo must not exceed hi".into()));
                 }
+                // (a region of 1.8e308 made the uniform draw overflow and panic)
+                if (0..3).any(|d| !(2.0 * (hi[d] - lo[d])).is_finite()) {
+                    return Err(err(
+                        span,
+                        format!(
+                            "the region [lo, hi] = [{lo}, {hi}] is wider than a placement can draw from"
+                        ),
+                    ));
+                }
                 let sites = if random {
                     random_sites(ps.n, lo, hi, bound, &bodies, &mut rng)
                 } else {
@@ -1101,6 +1110,14 @@ fn template_spec(
             };
             if g.lobe_radius.0 > g.lobe_radius.1 || g.offset.0 > g.offset.1 {
                 return Err("lobe_radius and offset are [min, max] ranges".into());
+            }
+            // (lobes = 10¹² asked for 40 TB before anything was checked)
+            if g.lobes >= super::template::MAX_TEMPLATE_SPHERES {
+                return Err(format!(
+                    "lobes = {}: a template holds at most {} spheres",
+                    g.lobes,
+                    super::template::MAX_TEMPLATE_SPHERES
+                ));
             }
             g.generate(ts.seed.unwrap_or(seed))
         }

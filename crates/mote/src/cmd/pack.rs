@@ -250,7 +250,8 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         &files,
         &provenance,
         &mut terminal,
-    )?;
+    )
+    .map_err(|e| Naming::Options.locate(e))?;
     if !quiet {
         for line in &packed.summary {
             say!("{line}");
