@@ -71,3 +71,120 @@ impl UnitSystem {
         }
     }
 }
+
+/// The units a file from another program is written in (LAMMPS's `units`
+/// names), for `[[from_file]] units`: what one of its length, time, mass
+/// and charge units is in SI.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileUnits {
+    Si,
+    /// cm, s, g, statcoulomb.
+    Cgs,
+    /// Å, fs, g/mol, e.
+    Real,
+    /// Å, ps, g/mol, e.
+    Metal,
+    /// µm, µs, pg, pC.
+    Micro,
+    /// nm, ns, ag, e.
+    Nano,
+    /// Reduced units: taken as they are, into a scene in LJ units only.
+    Lj,
+}
+
+/// What one unit of length, time, mass and charge of a file is in the
+/// scene's units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scales {
+    pub length: f64,
+    pub time: f64,
+    pub mass: f64,
+    pub charge: f64,
+}
+
+impl FileUnits {
+    /// LAMMPS's name of a unit system.
+    pub fn named(name: &str) -> Option<Self> {
+        Some(match name {
+            "si" => FileUnits::Si,
+            "cgs" => FileUnits::Cgs,
+            "real" => FileUnits::Real,
+            "metal" => FileUnits::Metal,
+            "micro" => FileUnits::Micro,
+            "nano" => FileUnits::Nano,
+            "lj" => FileUnits::Lj,
+            _ => return None,
+        })
+    }
+
+    /// The SI value of one unit of length, time, mass and charge (CODATA
+    /// 2018: e = 1.602176634e-19 C exactly, 1 g/mol per particle =
+    /// 1.66053906660e-27 kg, 1 statC = 3.335640952e-10 C); `None` for LJ.
+    pub fn si(self) -> Option<Scales> {
+        const E: f64 = 1.602_176_634e-19;
+        const DALTON: f64 = 1.660_539_066_60e-27;
+        let (length, time, mass, charge) = match self {
+            FileUnits::Si => (1.0, 1.0, 1.0, 1.0),
+            FileUnits::Cgs => (1e-2, 1.0, 1e-3, 3.335_640_952e-10),
+            FileUnits::Real => (1e-10, 1e-15, DALTON, E),
+            FileUnits::Metal => (1e-10, 1e-12, DALTON, E),
+            FileUnits::Micro => (1e-6, 1e-6, 1e-15, 1e-12),
+            FileUnits::Nano => (1e-9, 1e-9, 1e-21, E),
+            FileUnits::Lj => return None,
+        };
+        Some(Scales {
+            length,
+            time,
+            mass,
+            charge,
+        })
+    }
+
+    /// What one unit of the file is in a scene's units: into an SI scene
+    /// from any physical system, into an LJ scene from LJ only; the
+    /// astronomical scene takes no files in other units (its charges have
+    /// none).
+    pub fn into(self, scene: UnitSystem) -> Result<Scales, String> {
+        match (scene, self) {
+            (UnitSystem::Lj, FileUnits::Lj) => Ok(Scales {
+                length: 1.0,
+                time: 1.0,
+                mass: 1.0,
+                charge: 1.0,
+            }),
+            (UnitSystem::Lj, _) | (UnitSystem::Si, FileUnits::Lj) => Err(
+                "reduced (lj) units and physical units do not convert into each other: \
+                 a scene in lj units takes files in lj units, an si scene files in physical units"
+                    .into(),
+            ),
+            (UnitSystem::Si, physical) => Ok(physical.si().expect("physical units")),
+            (UnitSystem::Astro, _) => Err(
+                "a scene in astro units takes files in its own units: convert the file, or write the scene in si".into(),
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod file_units_tests {
+    use super::*;
+
+    /// An argon atom at 300 K in LAMMPS's real and metal units comes out
+    /// the same in SI: 39.948 g/mol, a thermal speed of 0.002741 Å/fs =
+    /// 2.741 Å/ps = 274.1 m/s.
+    #[test]
+    fn real_and_metal_agree_in_si() {
+        let real = FileUnits::Real.into(UnitSystem::Si).unwrap();
+        let metal = FileUnits::Metal.into(UnitSystem::Si).unwrap();
+        let v_real = 0.002741 * real.length / real.time;
+        let v_metal = 2.741 * metal.length / metal.time;
+        assert!((v_real - 274.1).abs() < 1e-9 && (v_metal - 274.1).abs() < 1e-9);
+        assert!((39.948 * real.mass - 6.6335e-26).abs() < 1e-29);
+        assert_eq!(real.charge, metal.charge);
+        assert!(FileUnits::Real.into(UnitSystem::Lj).is_err());
+        assert!(FileUnits::Lj.into(UnitSystem::Si).is_err());
+        assert_eq!(FileUnits::Lj.into(UnitSystem::Lj).unwrap().length, 1.0);
+        assert_eq!(FileUnits::named("metal"), Some(FileUnits::Metal));
+        assert_eq!(FileUnits::named("imperial"), None);
+    }
+}

@@ -290,3 +290,48 @@ fn replicate_copies_a_periodic_frame_without_a_seam() {
     let e = energy("replicate = [0, 1, 1]\n").unwrap_err();
     assert!(e.contains("at least one copy"), "{e}");
 }
+
+/// `units` on `[[from_file]]`: the same argon data file written by LAMMPS
+/// in `real` units (Å, Å/fs, g/mol) comes into an SI scene in metres,
+/// metres a second and kilograms; a radius filled in by the scene stays in
+/// the scene's units; lj files go into lj scenes only, and an unknown name
+/// is refused at the table's line.
+#[test]
+fn a_file_in_real_units_comes_into_an_si_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("argon.data"),
+        "LAMMPS data file\n\n2 atoms\n1 atom types\n\n0 10 xlo xhi\n0 10 ylo yhi\n-5 5 zlo zhi\n\n\
+         Masses\n\n1 39.948\n\nAtoms # atomic\n\n1 1 1 2 3\n2 1 4 5 -1 0 0 0\n\nVelocities\n\n1 0.002741 0 0\n2 0 0 -0.5\n",
+    )
+    .unwrap();
+    let table =
+        "[[from_file]]\nfile = \"argon.data\"\nradius = 1.7e-10\nperiodic = [true, true, true]\n";
+    let sys = build(
+        dir.path(),
+        &format!("units = \"si\"\n{RUN}{table}units = \"real\"\n"),
+    )
+    .unwrap();
+    let p = &sys.particles;
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs();
+    assert!(close(p.position[0].y, 2e-10) && close(p.position[1].z, -1e-10));
+    assert!(close(p.velocity[0].x, 274.1), "{}", p.velocity[0].x); // 0.002741 Å/fs
+    assert!(close(p.mass[0], 39.948 * 1.660_539_066_60e-27));
+    assert_eq!(p.radius[0], 1.7e-10); // the scene's own number
+    assert!(close(sys.boundary.hi.x, 1e-9) && close(sys.boundary.lo.z, -5e-10));
+    let e = build(
+        dir.path(),
+        &format!("units = \"lj\"\n{RUN}{table}units = \"real\"\n"),
+    )
+    .unwrap_err();
+    assert!(e.contains("scene.toml:5:") && e.contains("lj"), "{e}");
+    let e = build(
+        dir.path(),
+        &format!("units = \"si\"\n{RUN}{table}units = \"imperial\"\n"),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("scene.toml:5:") && e.contains("not one of"),
+        "{e}"
+    );
+}

@@ -239,6 +239,12 @@ pub struct DataSpec {
     /// The atom style of a data file whose `Atoms` line names none
     /// (MDAnalysis writes none): atomic, charge, molecular, full, sphere.
     pub atom_style: Option<String>,
+    /// The file's unit system, as LAMMPS names them (`si`, `cgs`, `real`,
+    /// `metal`, `micro`, `nano`, `lj`): positions, velocities, spins,
+    /// masses, radii, charges and the box are converted into the scene's
+    /// units (default: the file is in the scene's units). `radius`,
+    /// `mass` and `density` here are in the scene's units.
+    pub units: Option<String>,
     pub radius: Option<f64>,
     pub mass: Option<f64>,
     /// Masses from the radii, m = ρ 4π r³/3 (for files without masses).
@@ -259,14 +265,25 @@ type FromFile = (
 
 /// The particles of one `[[from_file]]`, their species and the file's box
 /// if it has one. `data`: read it as a LAMMPS data file whatever its name
-/// (`[[lammps_data]]`). Errors in the file name its own lines; the others
-/// come back as messages for the scene's line (`at`).
+/// (`[[lammps_data]]`). `scales`: one unit of the file's length, time,
+/// mass and charge in the scene's units (`units`), applied to what the
+/// file gives before `radius`, `mass` or `density` (scene units) fill in
+/// what it lacks. Errors in the file name its own lines; the others come
+/// back as messages for the scene's line (`at`).
 fn from_file(
     s: &DataSpec,
     path: &std::path::Path,
     data: bool,
+    scales: Option<crate::units::Scales>,
     at: &dyn Fn(String) -> ParseError,
 ) -> Result<FromFile, ParseError> {
+    let k = scales.unwrap_or(crate::units::Scales {
+        length: 1.0,
+        time: 1.0,
+        mass: 1.0,
+        charge: 1.0,
+    });
+    let speed = k.length / k.time;
     let io = |e: mote_io::IoError| match e {
         mote_io::IoError::Parse(p) if p.line > 0 => p,
         other => at(other.to_string()),
@@ -321,22 +338,22 @@ fn from_file(
             } else {
                 a.mass
             };
-            let (radius, mass) = fill(radius, mass)?;
+            let (radius, mass) = fill(radius * k.length, mass * k.mass)?;
             out.push(ParticleInit {
-                position: DVec3::from(a.position),
-                velocity: DVec3::from(a.velocity),
-                angular_velocity: DVec3::from(a.angular_velocity),
+                position: DVec3::from(a.position) * k.length,
+                velocity: DVec3::from(a.velocity) * speed,
+                angular_velocity: DVec3::from(a.angular_velocity) / k.time,
                 mass,
                 radius,
-                charge: a.charge,
+                charge: a.charge * k.charge,
                 color: s.color,
                 ..ParticleInit::default()
             });
         }
         let boundary = match s.periodic {
             Some(periodic) if data.bounded.iter().all(|b| *b) => Some(crate::boundary::Boundary {
-                lo: DVec3::from(data.lo),
-                hi: DVec3::from(data.hi),
+                lo: DVec3::from(data.lo) * k.length,
+                hi: DVec3::from(data.hi) * k.length,
                 periodic,
             }),
             Some(_) => {
@@ -368,16 +385,22 @@ fn from_file(
             DVec3::ZERO
         }
     };
+    if scales.is_some() && f.dipoles.iter().any(|m| *m != [0.0; 3]) {
+        return Err(at(format!(
+            "{}: the file's magnetic dipoles have no unit conversion: leave out units",
+            path.display()
+        )));
+    }
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
         let (radius, mass) = fill(
-            f.radii.get(i).copied().unwrap_or(0.0),
-            f.masses.get(i).copied().unwrap_or(0.0),
+            f.radii.get(i).copied().unwrap_or(0.0) * k.length,
+            f.masses.get(i).copied().unwrap_or(0.0) * k.mass,
         )?;
         out.push(ParticleInit {
-            position: DVec3::from(f.positions[i]),
-            velocity: get(&f.velocities, i),
-            angular_velocity: get(&f.angular_velocities, i),
+            position: DVec3::from(f.positions[i]) * k.length,
+            velocity: get(&f.velocities, i) * speed,
+            angular_velocity: get(&f.angular_velocities, i) / k.time,
             dipole: get(&f.dipoles, i),
             mass,
             radius,
@@ -393,10 +416,10 @@ fn from_file(
         && c[2][0] == 0.0
         && c[2][1] == 0.0;
     let boundary = (f.pbc.iter().any(|p| *p) && orthogonal).then(|| {
-        let lo = DVec3::from(f.origin);
+        let lo = DVec3::from(f.origin) * k.length;
         crate::boundary::Boundary {
             lo,
-            hi: lo + DVec3::new(c[0][0], c[1][1], c[2][2]),
+            hi: lo + DVec3::new(c[0][0], c[1][1], c[2][2]) * k.length,
             periodic: f.pbc,
         }
     });
@@ -876,7 +899,20 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
             .unwrap_or(std::path::Path::new("."))
             .join(&s.file);
         let at = |m: String| err(spec.span(), m);
-        let (mut made, mut names, mut file_box) = from_file(s, &path, data, &at)?;
+        let scales = match &s.units {
+            None => None,
+            Some(name) => Some(
+                crate::units::FileUnits::named(name)
+                    .ok_or_else(|| {
+                        at(format!(
+                            "units = \"{name}\": not one of si, cgs, real, metal, micro, nano, lj"
+                        ))
+                    })?
+                    .into(scene.units)
+                    .map_err(|m| at(format!("units = \"{name}\": {m}")))?,
+            ),
+        };
+        let (mut made, mut names, mut file_box) = from_file(s, &path, data, scales, &at)?;
         if let Some(copies) = s.replicate {
             let b = replicate(&mut made, &mut names, file_box, copies)
                 .map_err(|m| at(format!("{}: {m}", path.display())))?;
