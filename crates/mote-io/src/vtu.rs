@@ -107,6 +107,83 @@ fn write_to(
         writeln!(out, "{}", types.get(i).copied().unwrap_or(0))?;
     }
     writeln!(out, "</DataArray>")?;
+    // What the frame has besides: masses, spins, dipoles, ids, and a rigid
+    // body's index and orientation per sphere, so that a run restarts from
+    // its own .vtp as from its .xyz (orientations in OVITO's order x y z w).
+    let has = |len: usize| len == n && n > 0;
+    let array = |out: &mut dyn Write,
+                 ty: &str,
+                 name: &str,
+                 k: usize,
+                 rows: &mut dyn Iterator<Item = String>|
+     -> std::io::Result<()> {
+        writeln!(
+            out,
+            "<DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{k}\" format=\"ascii\">"
+        )?;
+        for row in rows {
+            writeln!(out, "{row}")?;
+        }
+        writeln!(out, "</DataArray>")
+    };
+    let vec3 = |v: &[f64; 3]| format!("{:e} {:e} {:e}", v[0], v[1], v[2]);
+    if has(frame.masses.len()) {
+        array(
+            out,
+            "Float64",
+            "mass",
+            1,
+            &mut frame.masses.iter().map(|m| format!("{m:e}")),
+        )?;
+    }
+    if has(frame.angular_velocities.len()) {
+        array(
+            out,
+            "Float64",
+            "AngularVelocity",
+            3,
+            &mut frame.angular_velocities.iter().map(vec3),
+        )?;
+    }
+    if has(frame.dipoles.len()) {
+        array(
+            out,
+            "Float64",
+            "Dipole",
+            3,
+            &mut frame.dipoles.iter().map(vec3),
+        )?;
+    }
+    if has(frame.ids.len()) {
+        array(
+            out,
+            "Int64",
+            "id",
+            1,
+            &mut frame.ids.iter().map(|i| i.to_string()),
+        )?;
+    }
+    if has(frame.bodies.len()) {
+        array(
+            out,
+            "Int64",
+            "body",
+            1,
+            &mut frame.bodies.iter().map(|b| b.to_string()),
+        )?;
+    }
+    if has(frame.orientations.len()) {
+        array(
+            out,
+            "Float64",
+            "Orientation",
+            4,
+            &mut frame
+                .orientations
+                .iter()
+                .map(|q| format!("{:e} {:e} {:e} {:e}", q[1], q[2], q[3], q[0])),
+        )?;
+    }
     writeln!(out, "</PointData>")?;
     writeln!(out, "<Points>")?;
     writeln!(
@@ -600,6 +677,32 @@ pub fn parse_vtu_bytes(bytes: &[u8], name: &str) -> Result<Frame, ParseError> {
         check(&v, "velocity", 3 * n)?;
         frame.velocities = v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     }
+    if let Some(m) = optional("mass")? {
+        check(&m, "mass", n)?;
+        frame.masses = m;
+    }
+    let triples = |v: Vec<f64>| v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    if let Some(w) = optional("AngularVelocity")? {
+        check(&w, "AngularVelocity", 3 * n)?;
+        frame.angular_velocities = triples(w);
+    }
+    if let Some(d) = optional("Dipole")? {
+        check(&d, "Dipole", 3 * n)?;
+        frame.dipoles = triples(d);
+    }
+    if let Some(i) = optional("id")? {
+        check(&i, "id", n)?;
+        frame.ids = i.iter().map(|&x| x as u64).collect();
+    }
+    if let Some(b) = optional("body")? {
+        check(&b, "body", n)?;
+        frame.bodies = b.iter().map(|&x| x as u64).collect();
+    }
+    if let Some(q) = optional("Orientation")? {
+        check(&q, "Orientation", 4 * n)?;
+        // OVITO's order x y z w, kept (w, x, y, z) in a frame
+        frame.orientations = q.chunks(4).map(|c| [c[3], c[0], c[1], c[2]]).collect();
+    }
     if let Ok(t) = numbers(text, appended, name, "TIME") {
         frame.time = t.first().copied().unwrap_or(0.0);
     }
@@ -796,6 +899,36 @@ mod tests {
             radii: vec![0.5, 0.25, 0.5],
             ..Default::default()
         }
+    }
+
+    /// A rigid run's frame — each sphere's body, orientation, mass, spin —
+    /// and dipoles and ids come back from a .vtp bit for bit, so a run
+    /// restarts from its own VTK file as from its XYZ (they were dropped).
+    #[test]
+    fn bodies_orientations_masses_and_spins_round_trip() {
+        let mut f = frame(1.5);
+        f.masses = vec![1.0, 2.0 / 3.0, 1e-20];
+        f.angular_velocities = vec![[0.1, -0.2, 0.3], [0.0; 3], [1e10, 0.0, -1.0 / 7.0]];
+        f.dipoles = vec![[0.0, 0.0, 1.0], [0.5, 0.5, 0.0], [0.0; 3]];
+        f.ids = vec![7, 8, 9];
+        f.bodies = vec![0, 0, 1];
+        let c = (0.5f64).sqrt();
+        f.orientations = vec![[c, c, 0.0, 0.0], [c, c, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]];
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.vtp");
+        write_vtp(&path, &f, &Provenance::default()).unwrap();
+        let back = read_vtu(&path).unwrap();
+        assert_eq!(back.masses, f.masses);
+        assert_eq!(back.angular_velocities, f.angular_velocities);
+        assert_eq!(back.dipoles, f.dipoles);
+        assert_eq!(back.ids, f.ids);
+        assert_eq!(back.bodies, f.bodies);
+        assert_eq!(back.orientations, f.orientations);
+        assert_eq!(back.positions, f.positions);
+        // OVITO's order in the file: x y z w
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("Name=\"Orientation\" NumberOfComponents=\"4\""));
+        assert!(text.contains(&format!("{c:e} 0e0 0e0 {c:e}")), "{text}");
     }
 
     #[test]
