@@ -8,6 +8,8 @@
 
 use proptest::prelude::*;
 
+use crate::common::hostile;
+
 use mote_md::rigid::run::RigidDynamics;
 use mote_md::rigid::scene::RigidScene;
 use mote_run::Propagator;
@@ -28,18 +30,6 @@ fn valid() -> Vec<std::ops::Range<f64>> {
         8e-3..10e-3,
         3.0..12.0,
         3.0..9.0,
-    ]
-}
-
-fn hostile() -> impl Strategy<Value = f64> {
-    prop_oneof![
-        Just(0.0),
-        Just(-1.0),
-        Just(1e-300),
-        Just(1e300),
-        Just(f64::MIN_POSITIVE),
-        Just(f64::MAX),
-        -1e3..1e3f64,
     ]
 }
 

@@ -7,6 +7,8 @@
 
 use proptest::prelude::*;
 
+use crate::common::hostile;
+
 use mote_md::scene::Scene;
 
 /// A scene whose numeric keys are filled from `v` (ten numbers).
@@ -34,19 +36,6 @@ fn valid() -> Vec<std::ops::Range<f64>> {
         0.1..2.0,
         0.5..2.0,
         0.0..0.5,
-    ]
-}
-
-/// A number a careless or hostile user might write.
-fn hostile() -> impl Strategy<Value = f64> {
-    prop_oneof![
-        Just(0.0),
-        Just(-1.0),
-        Just(1e-300),
-        Just(1e300),
-        Just(f64::MIN_POSITIVE),
-        Just(f64::MAX),
-        -1e3..1e3f64,
     ]
 }
 
