@@ -1,16 +1,16 @@
 //! Event-driven runs in mote's one loop: the engine as a [`Propagator`]
 //! whose step is one output interval (it jumps from collision to collision
-//! in between), its observers (observables.csv, trajectory.xyz),
+//! in between, equilibrating when primed), its table (observables.csv),
 //! checkpoints that rebuild the system so a resumed run continues in the
-//! same bits, and [`run_scene`], which puts them together with the
-//! equilibration and the summary's statistics.
+//! same bits, and the summary's statistics ([`summarise`]). The run is
+//! put together by mote-front's one run, as every engine's is.
 
 use std::path::PathBuf;
 
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
-use mote_io::trajectory::{Format, TrajectoryWriter};
-use mote_run::{Checkpoints, Columns, Driver, Observer, Propagator, Stopped};
+use mote_io::trajectory::Format;
+use mote_run::{Columns, Observer, Propagator, Stopped};
 
 use crate::scene::Scene;
 use crate::system::{Boundary, SimBox, System};
@@ -54,25 +54,6 @@ pub struct Run {
     /// The state at the end (for a picture of it).
     pub final_frame: Option<mote_io::xyz::Frame>,
     pub outputs: Vec<PathBuf>,
-}
-
-/// Output destinations and provenance.
-pub struct Outputs {
-    /// Folder the output files go to.
-    pub base: PathBuf,
-    /// Folder the scene's own relative paths (`file = ...`) resolve against.
-    pub scene_dir: PathBuf,
-    pub provenance: mote_io::Provenance,
-    /// Write a checkpoint every this many output intervals (the template
-    /// holds the input, seed and options; the state is added at each write).
-    pub checkpoints: Option<Checkpoints>,
-    /// Continue this checkpoint's run, appending to the files.
-    pub resume: Option<Checkpoint>,
-    /// The live viewer's tap, if the run is watched.
-    pub live: mote_run::LiveSlot,
-    /// Run even if the run is expected to take more than
-    /// [`mote_run::MAX_STEPS`] events ([`Scene::check_run_length`]).
-    pub force: bool,
 }
 
 /// What a checkpoint of an event-driven run carries beside positions and
@@ -257,6 +238,20 @@ impl<const D: usize> EventDriven<D> {
         Ok(Self::with_state(scene, built, 0.0, 0, ledger, false))
     }
 
+    /// The run a checkpoint of `scene`'s run holds: its (rebuilt)
+    /// system, clock offset, output index and ledger, so it continues in
+    /// the bits of the run that wrote it.
+    pub fn resume(
+        scene: &Scene,
+        seed: u64,
+        scene_dir: &std::path::Path,
+        cp: &Checkpoint,
+    ) -> Result<Self, EdmdError> {
+        let built = scene.build::<D>(seed, scene_dir)?;
+        let (sys, t_offset, k, ledger) = resumed(cp, *built.simbox())?;
+        Ok(Self::with_state(scene, sys, t_offset, k, ledger, true))
+    }
+
     fn with_state(
         scene: &Scene,
         sys: System<D>,
@@ -288,7 +283,7 @@ impl<const D: usize> EventDriven<D> {
     }
 
     /// The global time now.
-    fn now(&self) -> f64 {
+    pub fn now(&self) -> f64 {
         self.t_offset + self.sys.time()
     }
 
@@ -465,77 +460,45 @@ impl<const D: usize> Observer<EventDriven<D>> for EventCsv {
     }
 }
 
-/// The trajectory of an event-driven run (global times; the output index
-/// as the step of dumps and GSD).
-struct EventTrajectory(TrajectoryWriter);
-
-impl<const D: usize> Observer<EventDriven<D>> for EventTrajectory {
-    fn every(&self) -> u64 {
-        1
-    }
-
-    fn observe(&mut self, p: &EventDriven<D>, _: &EventSample) -> Result<(), EdmdError> {
-        let mut f = frame(&p.sys);
-        f.time = p.now();
-        Ok(self.0.write(p.k, &f)?)
-    }
-}
-
-/// Runs a scene: builds the system (or takes the checkpoint's),
-/// equilibrates, runs `time` with outputs every `output_interval`; calls
-/// `progress(fraction)` now and then.
-pub fn run_scene<const D: usize>(
+/// The tables an event-driven run writes as it goes, each output
+/// interval: the scene's `observables` (in `base`); with `append`, onto
+/// the file of the run being resumed. (The trajectory is the run's own:
+/// `mote_run::Trajectory` of [`Propagator::frame`].)
+pub fn file_observers<const D: usize>(
     scene: &Scene,
-    seed: u64,
-    out: &Outputs,
-    mut progress: impl FnMut(f64),
-) -> Result<Run, EdmdError> {
-    let mut p = match &out.resume {
-        // A resumed run starts from its checkpoint's (rebuilt) system, clock
-        // offset, output index and ledger; a fresh one from the scene.
-        Some(cp) => {
-            let built = scene.build::<D>(seed, &out.scene_dir)?;
-            let (sys, t_offset, k, ledger) = resumed(cp, *built.simbox())?;
-            EventDriven::with_state(scene, sys, t_offset, k, ledger, true)
-        }
-        None => EventDriven::new(scene, seed, &out.scene_dir, out.force)?,
-    };
-    let resuming = out.resume.is_some();
-    let mut driver = Driver::new();
-    driver.sample_at_start = !resuming;
-    driver.live = out.live.take();
-    if let Some(f) = &scene.trajectory {
-        let path = out.base.join(f);
-        let format = Format::of_path(&path).unwrap_or_default();
-        let prov = out.provenance.clone();
-        driver.observers.push(Box::new(EventTrajectory(if resuming {
-            TrajectoryWriter::append(&path, format, prov, false)?
-        } else {
-            TrajectoryWriter::create(&path, format, prov, false)?
-        })));
-    }
+    base: &std::path::Path,
+    provenance: &mote_io::Provenance,
+    append: bool,
+) -> Result<Vec<Box<dyn Observer<EventDriven<D>>>>, EdmdError> {
+    let mut observers: Vec<Box<dyn Observer<EventDriven<D>>>> = Vec::new();
     if let Some(f) = &scene.observables {
-        let path = out.base.join(f);
+        let path = base.join(f);
         let cols: Vec<String> = EventSample::COLUMNS.iter().map(|c| c.0.into()).collect();
         let units: Vec<String> = EventSample::COLUMNS.iter().map(|c| c.1.into()).collect();
-        driver.observers.push(Box::new(EventCsv(if resuming {
+        observers.push(Box::new(EventCsv(if append {
             CsvWriter::append(&path, cols.len())?
         } else {
-            CsvWriter::create(&path, &out.provenance, &cols, &units)?
+            CsvWriter::create(&path, provenance, &cols, &units)?
         })));
     }
-    driver.checkpoints = out.checkpoints.clone();
-    let total = (scene.equilibrate + scene.time).max(1e-300);
-    let report = driver.run(&mut p, |p| p.last_step(), |p| progress(p.now() / total))?;
-    summarise(&p, scene, seed, out, report.wall.as_secs_f64())
+    Ok(observers)
+}
+
+/// The trajectory format of an event-driven scene's `trajectory` file,
+/// by its extension (extended XYZ for one that names none).
+pub fn trajectory_format(file: &str) -> Format {
+    Format::of_path(std::path::Path::new(file)).unwrap_or_default()
 }
 
 /// The statistics of a finished run, and the speed histogram when asked.
-fn summarise<const D: usize>(
+///
+/// The histogram goes to `base`, with `provenance`.
+pub fn summarise<const D: usize>(
     p: &EventDriven<D>,
     scene: &Scene,
     seed: u64,
-    out: &Outputs,
+    base: &std::path::Path,
+    provenance: &mote_io::Provenance,
     wall_seconds: f64,
 ) -> Result<Run, EdmdError> {
     let sys = &p.sys;
@@ -598,8 +561,7 @@ fn summarise<const D: usize>(
             "density".to_string(),
             "maxwell_boltzmann".to_string(),
         ];
-        let mut w =
-            mote_io::csv::CsvWriter::create(&out.base.join(f), &out.provenance, &cols, &[])?;
+        let mut w = mote_io::csv::CsvWriter::create(&base.join(f), provenance, &cols, &[])?;
         let dv = vmax / bins as f64;
         for (k, hk) in h.iter().enumerate() {
             let v = (k as f64 + 0.5) * dv;
@@ -623,7 +585,7 @@ fn summarise<const D: usize>(
         .into_iter()
         .flatten()
     {
-        result.outputs.push(out.base.join(f));
+        result.outputs.push(base.join(f));
     }
     Ok(result)
 }

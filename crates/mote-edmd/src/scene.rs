@@ -1099,7 +1099,7 @@ fn vec_d<const D: usize>(v: &[f64]) -> [f64; D] {
     x
 }
 
-pub use crate::run::{frame, run_scene, Outputs, Run};
+pub use crate::run::{frame, Run};
 
 #[cfg(test)]
 mod tests {

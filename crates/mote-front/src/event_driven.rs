@@ -1,14 +1,17 @@
-//! Event-driven hard spheres and disks (`mote_edmd::scene::run_scene`).
+//! Event-driven hard spheres and disks (`mote_edmd::run::EventDriven`)
+//! in the one run.
 
 use std::path::PathBuf;
 
-use mote_edmd::scene::{run_scene, Outputs};
+use mote_edmd::run::EventDriven;
 use mote_edmd::Scene;
-
 use mote_io::checkpoint::Checkpoint;
+use mote_io::trajectory::Format;
+use mote_run::{Observer, Report};
 
-use crate::checkpoints::{hex, trim_outputs, unhex};
+use crate::checkpoints::{hex, unhex};
 use crate::error::{refuse, FrontError};
+use crate::runner::{run_engine, Done, EngineRun, RunFiles, SampleOf};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
 /// The words of the old `mote edmd` command, kept as an alias for one
@@ -119,129 +122,159 @@ fn run_events(
         scene.observables = None;
         scene.histogram = None;
     }
-    let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
-    // A run that writes no files (`--no-output`) takes no folder: it
-    // neither makes one nor marks the current one as its own.
-    let writes = !words.no_output || options.checkpoint_every.is_some() || resumed.is_some();
-    let folder = if writes {
-        Some(crate::lock::RunFolder::claim(
-            &dir,
-            &input.label,
-            &input.text,
-            resumed.zip(options.resume.as_deref()),
-        )?)
-    } else {
-        None
-    };
     let scene_dir = input.folder();
-    let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
-    monitor.start(&format!(
-        "mote run {}: event-driven hard {}, simulated time {} after {} of equilibration, {}",
-        input.label,
-        if scene.dimension == 2 {
-            "disks"
-        } else {
-            "spheres"
-        },
-        scene.time,
-        scene.equilibrate,
-        crate::seed_phrase(seed, chosen),
-    ));
-    let provenance = crate::provenance(&input.label, seed);
-    if let Some(cp) = resumed {
-        trim_outputs(&dir, cp.step, cp.time)?;
+    match scene.dimension {
+        2 => run_engine(
+            EventRun::<2>::new(scene, scene_dir, words, options, input),
+            input,
+            options,
+            resumed,
+            monitor,
+        ),
+        _ => run_engine(
+            EventRun::<3>::new(scene, scene_dir, words, options, input),
+            input,
+            options,
+            resumed,
+            monitor,
+        ),
     }
-    // Checkpoints every N output intervals; the measured time is recorded
-    // so a resumed run ends where this one would have.
-    let checkpoints = options.checkpoint_every.map(|every| {
-        let template = Checkpoint {
-            program: provenance.program.clone(),
-            seed,
-            options: vec![
-                ("engine".into(), "event-driven".into()),
-                ("name".into(), input.name.clone()),
-                ("checkpoint-every".into(), every.to_string()),
-                ("time".into(), hex(scene.time)),
-                ("output".into(), dir.display().to_string()),
-                (
-                    "trajectory-format".into(),
-                    scene
-                        .trajectory
-                        .as_deref()
-                        .and_then(|t| std::path::Path::new(t).extension())
-                        .map_or("xyz".into(), |e| e.to_string_lossy().into_owned()),
-                ),
-            ]
-            .into_iter()
-            .chain(
-                folder
-                    .iter()
-                    .flat_map(crate::lock::RunFolder::checkpoint_options),
-            )
-            .collect(),
-            input_label: input.label.clone(),
-            input_text: input.text.clone(),
-            ..Checkpoint::default()
-        };
-        mote_run::Checkpoints {
-            every: every.max(1),
-            path: dir.join("checkpoint.mote"),
-            template,
+}
+
+/// An event-driven scene's part of the one run.
+struct EventRun<const D: usize> {
+    scene: Scene,
+    /// The folder the scene's own relative paths resolve against.
+    scene_dir: PathBuf,
+    no_output: bool,
+    force: bool,
+    label: String,
+}
+
+impl<const D: usize> EventRun<D> {
+    fn new(
+        scene: Scene,
+        scene_dir: PathBuf,
+        words: &EdmdWords,
+        options: &RunOptions,
+        input: &Input,
+    ) -> Self {
+        EventRun {
+            scene,
+            scene_dir,
+            no_output: words.no_output,
+            force: options.force,
+            label: input.label.clone(),
         }
-    });
-    let out = Outputs {
-        base: dir.clone(),
-        scene_dir,
-        provenance,
-        checkpoints,
-        resume: resumed.cloned(),
-        live: options.live.clone(),
-        force: options.force,
-    };
-    let cpu0 = crate::cpu::cpu_seconds();
-    let progress = |f: f64| monitor.progress((f * 1000.0) as u64, 1000, "");
-    let r = match scene.dimension {
-        2 => run_scene::<2>(&scene, seed, &out, progress),
-        _ => run_scene::<3>(&scene, seed, &out, progress),
-    };
-    let r = match r {
-        Ok(r) => r,
-        Err(e @ mote_edmd::EdmdError::Interrupted { signal, .. }) => {
-            return Ok(Outcome {
-                engine: Engine::EventDriven,
-                seed,
-                dir,
-                summary: Vec::new(),
-                ending: Ending::Interrupted {
-                    signal,
-                    message: e.to_string(),
-                },
-            })
-        }
-        // refused before it started, at a line of the scene
-        Err(e @ mote_edmd::EdmdError::Scene { .. }) => return Err(e.into()),
-        Err(e) => {
-            return Err(FrontError::request(format!(
+    }
+}
+
+impl<const D: usize> EngineRun for EventRun<D> {
+    type State = EventDriven<D>;
+    const ENGINE: Engine = Engine::EventDriven;
+    const NAME: &'static str = "event-driven";
+
+    fn scene_seed(&self) -> Option<u64> {
+        self.scene.seed
+    }
+
+    fn scene_dir(&self) -> Option<&String> {
+        self.scene.output.dir.as_ref()
+    }
+
+    fn build(
+        &mut self,
+        seed: u64,
+        resumed: Option<&Checkpoint>,
+    ) -> Result<Self::State, FrontError> {
+        Ok(match resumed {
+            Some(cp) => EventDriven::resume(&self.scene, seed, &self.scene_dir, cp)?,
+            None => EventDriven::new(&self.scene, seed, &self.scene_dir, self.force)?,
+        })
+    }
+
+    fn writes_files(&self) -> bool {
+        !self.no_output
+    }
+
+    fn observers(
+        &self,
+        _: &Self::State,
+        files: &RunFiles,
+    ) -> Result<Vec<Box<dyn Observer<Self::State>>>, FrontError> {
+        Ok(mote_edmd::run::file_observers(
+            &self.scene,
+            &files.dir,
+            &files.provenance,
+            files.append,
+        )?)
+    }
+
+    fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
+        // A frame every output interval (the propagator's step).
+        Ok(self
+            .scene
+            .trajectory
+            .as_ref()
+            .map(|t| (t.clone(), mote_edmd::run::trajectory_format(t), 1)))
+    }
+
+    fn checkpoint_options(&self, _: &Self::State) -> Vec<(String, String)> {
+        // The measured time, so a resumed run ends where this one would.
+        vec![("time".into(), hex(self.scene.time))]
+    }
+
+    fn last_step(&self, state: &Self::State) -> u64 {
+        state.last_step()
+    }
+
+    fn opening(&self, _: &Self::State) -> String {
+        format!(
+            "event-driven hard {}, simulated time {} after {} of equilibration",
+            if D == 2 { "disks" } else { "spheres" },
+            self.scene.time,
+            self.scene.equilibrate,
+        )
+    }
+
+    fn progress(&self, state: &Self::State, _: u64, monitor: &mut dyn Monitor) {
+        // Thousandths of the simulated time, equilibration included.
+        let total = (self.scene.equilibrate + self.scene.time).max(1e-300);
+        let f = (state.now() / total).clamp(0.0, 1.0);
+        monitor.progress((f * 1000.0) as u64, 1000, "");
+    }
+
+    fn ending(&self, e: mote_edmd::EdmdError) -> Result<Ending, FrontError> {
+        match e {
+            mote_edmd::EdmdError::Interrupted { signal, .. } => Ok(Ending::Interrupted {
+                signal,
+                message: e.to_string(),
+            }),
+            // refused before it started, at a line of the scene
+            e @ mote_edmd::EdmdError::Scene { .. } => Err(e.into()),
+            e => Err(FrontError::request(format!(
                 "{}: run stopped: {e}",
-                input.label
-            )))
+                self.label
+            ))),
         }
-    };
-    let cpu = crate::cpu::cpu_seconds() - cpu0;
-    let mut outcome = Outcome {
-        engine: Engine::EventDriven,
-        seed,
-        dir,
-        summary: summary(&r, &scene, cpu),
-        ending: Ending::Finished,
-    };
-    if let (Some(png), Some(frame)) = (&options.picture, &r.final_frame) {
-        mote_render::frame::picture(frame, png, 1920, 1080)?;
-        outcome
-            .summary
-            .push(format!("Picture of the final state: {}.", png.display()));
     }
-    Ok(outcome)
+
+    fn summary(
+        &self,
+        state: &Self::State,
+        report: &Report<SampleOf<Self>>,
+        done: &Done,
+    ) -> Result<Vec<String>, FrontError> {
+        let r = mote_edmd::run::summarise(
+            state,
+            &self.scene,
+            done.seed,
+            &done.files.dir,
+            &done.files.provenance,
+            report.wall.as_secs_f64(),
+        )?;
+        Ok(summary(&r, &self.scene, done.cpu))
+    }
 }
 
 /// The paragraph that ends an event-driven run, then the final speeds of

@@ -18,6 +18,7 @@ pub mod lock;
 pub mod packing;
 mod particles;
 mod rigid;
+mod runner;
 pub mod seed;
 pub mod stepper;
 pub mod terminal;

@@ -4,13 +4,15 @@
 use std::path::Path;
 
 use mote_io::checkpoint::{self, Checkpoint};
-use mote_md::output::{ObservablesCsv, Trajectory};
+use mote_io::trajectory::Format;
+use mote_md::output::ObservablesCsv;
 use mote_md::scene::{PlistSystem, Scene};
 use mote_md::{MdError, RunLength, RunReport, Simulation};
-use mote_run::{Checkpoints, Driver};
+use mote_run::Observer;
 
-use crate::checkpoints::{hex, restore, trim_outputs};
+use crate::checkpoints::{hex, restore};
 use crate::error::{refuse, FrontError};
+use crate::runner::{run_engine, Done, EngineRun, RunFiles};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
 /// Puts the checkpoint's state into the freshly built simulation.
@@ -111,183 +113,169 @@ pub(crate) fn run(
             input.label
         );
     }
-    let (seed, chosen) = crate::seed::resolve(args.seed, scene.seed);
-    let mut built = scene.build(&input.text, &input.label, seed)?;
-    let length = match (args.steps, args.until, built.length) {
-        (Some(n), _, _) => RunLength::Steps(n),
-        (None, Some(t), _) => RunLength::Until(t),
-        (None, None, Some(l)) => l,
-        (None, None, None) => refuse!(
-            "{}: no run length: give --until T or --steps N",
-            input.label
-        ),
-    };
-    if let (RunLength::Until(t), None) = (length, &resumed) {
-        let t0 = built.simulation.system.time;
-        if t <= t0 {
-            refuse!(
-                "{}: until {t}: the run starts at t = {t0}: nothing to run",
-                input.label
-            );
-        }
-    }
-    let total_steps = length
-        .steps_from(built.simulation.system.time, built.simulation.dt)
-        .map_err(|e| FrontError::request(format!("{}: {e}", input.label)))?;
-    if resumed.is_none() {
-        mote_run::check_run_length(total_steps, built.simulation.dt, options.force)
-            .map_err(|m| FrontError::request(format!("{}: {m}", input.label)))?;
-    }
-
-    let dir = input.output_dir(args.output.as_ref(), scene.output.dir.as_ref());
-    if resumed.is_none() && !options.force {
-        check_disk(
-            &dir,
-            &scene.output,
-            total_steps,
-            built.simulation.system.particles.len(),
-        )
-        .map_err(|m| FrontError::request(format!("{}: {m}", input.label)))?;
-    }
-    let folder = crate::lock::RunFolder::claim(
-        &dir,
-        &input.label,
-        &input.text,
-        resumed.as_ref().zip(options.resume.as_deref()),
-    )?;
-    let append = resumed.is_some();
-    if let Some(cp) = &resumed {
-        resume_state(cp, &mut built.simulation, &input.label)?;
-    }
-    let length =
-        RunLength::Steps(total_steps - resumed.as_ref().map_or(0, |cp| cp.step.min(total_steps)));
-    let provenance = crate::provenance(&input.label, seed);
-    if let Some(cp) = &resumed {
-        trim_outputs(&dir, cp.step, cp.time)?;
-    }
-    let out = &scene.output;
     let format = args.trajectory_format(
-        out.trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
+        scene
+            .output
+            .trajectory_format(mote_io::Source::new(&input.label, &input.text))?,
     )?;
-    let sim = &mut built.simulation;
-    let mut driver = Driver::<Simulation>::new();
-    driver.sample_at_start = !append;
-    driver.live = args.live.take();
-    driver.observers = file_observers(
-        &scene,
-        sim,
-        &built.probes,
-        &dir,
-        &provenance,
+    let engine = PointsRun {
+        scene,
+        input: input.clone(),
+        args: args.clone(),
         format,
-        append,
-    )?;
-    if let Some(every) = args.checkpoint_every {
-        let mut options = vec![
-            ("name".to_string(), input.name.clone()),
-            ("plist".to_string(), input.plist.to_string()),
-            (
-                "system".to_string(),
-                args.system.clone().unwrap_or_else(|| "nbody".into()),
-            ),
-            ("total-steps".to_string(), total_steps.to_string()),
-            ("checkpoint-every".to_string(), every.to_string()),
-            ("dt".to_string(), hex(sim.dt)),
-            ("output".to_string(), dir.display().to_string()),
-            (
-                "trajectory-format".to_string(),
-                format.extension().to_string(),
-            ),
-        ];
-        options.extend(folder.checkpoint_options());
-        if let Some(s) = &args.solver {
-            options.push(("solver".to_string(), s.clone()));
-        }
-        driver.checkpoints = Some(Checkpoints {
-            path: dir.join("checkpoint.mote"),
-            every: every.max(1),
-            template: Checkpoint {
-                program: provenance.program.clone(),
-                seed,
-                options,
-                input_label: input.label.clone(),
-                input_text: input.text.clone(),
-                ..Checkpoint::default()
-            },
-        });
-    }
-
-    let steps = length.steps_from(sim.system.time, sim.dt)?;
-    let last_step = sim.system.step + steps;
-    let propagator = if sim.brownian.is_some() {
-        "Brownian dynamics".to_string()
-    } else {
-        sim.stepper.scheme.name().to_string()
+        probes: Vec::new(),
+        total_steps: 0,
+        last_step: 0,
     };
-    monitor.start(&format!(
-        "mote run {}: {} particles, {} with dt = {}, {} steps, {}, {}",
-        input.label,
-        sim.system.particles.len(),
-        propagator,
-        mote_io::system::human_number(sim.dt),
-        steps,
-        crate::seed_phrase(seed, chosen),
-        crate::threads_phrase(),
-    ));
-    let result = driver.run(
-        sim,
-        |_| last_step,
-        |sim| {
-            let sys = &sim.system;
-            if sys.step % 16 == 0 {
-                monitor.progress(sys.step, last_step, &format!("t = {:.6e}", sys.time));
-            }
-        },
-    );
-    let mut outcome = Outcome {
-        engine: Engine::Particles,
-        seed,
-        dir: dir.clone(),
-        summary: Vec::new(),
-        ending: Ending::Finished,
-    };
-    match result {
-        Ok(report) => {
-            outcome.summary.push(summary(&report, sim, &scene, &dir));
-            if let Some(png) = &args.picture {
-                let frame = mote_md::output::frame_of(&sim.system);
-                mote_render::frame::picture(&frame, png, 1920, 1080)?;
-                outcome
-                    .summary
-                    .push(format!("Picture of the final state: {}.", png.display()));
-            }
-        }
-        Err(e @ MdError::Unstable { .. }) => outcome.ending = Ending::Unstable(e.to_string()),
-        Err(e @ MdError::Interrupted { signal, .. }) => {
-            outcome.ending = Ending::Interrupted {
-                signal,
-                message: e.to_string(),
-            }
-        }
-        Err(e) => return Err(e.into()),
-    }
-    Ok(outcome)
+    run_engine(engine, &input, &args, resumed.as_ref(), monitor)
 }
 
-/// The files a time-stepped run writes as it goes, by the scene's
+/// A time-stepped scene's part of the one run.
+struct PointsRun {
+    scene: Scene,
+    input: Input,
+    /// The options, or those of the run a checkpoint continues.
+    args: RunOptions,
+    format: mote_io::trajectory::Format,
+    probes: Vec<mote_md::observe::Probe>,
+    /// Steps of the whole run, from its start (before any resume).
+    total_steps: u64,
+    last_step: u64,
+}
+
+impl EngineRun for PointsRun {
+    type State = Simulation;
+    const ENGINE: Engine = Engine::Particles;
+    const NAME: &'static str = "particles";
+
+    fn scene_seed(&self) -> Option<u64> {
+        self.scene.seed
+    }
+
+    fn scene_dir(&self) -> Option<&String> {
+        self.scene.output.dir.as_ref()
+    }
+
+    /// The scene built with `seed` and its length resolved (the options'
+    /// `--steps` or `--until`, else the scene's), the checkpoint's state
+    /// put in when resuming.
+    fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<Simulation, FrontError> {
+        let (args, label) = (&self.args, &self.input.label);
+        let built = self.scene.build(&self.input.text, label, seed)?;
+        let length = match (args.steps, args.until, built.length) {
+            (Some(n), _, _) => RunLength::Steps(n),
+            (None, Some(t), _) => RunLength::Until(t),
+            (None, None, Some(l)) => l,
+            (None, None, None) => refuse!("{label}: no run length: give --until T or --steps N"),
+        };
+        let mut sim = built.simulation;
+        if let (RunLength::Until(t), None) = (length, resumed) {
+            let t0 = sim.system.time;
+            if t <= t0 {
+                refuse!("{label}: until {t}: the run starts at t = {t0}: nothing to run");
+            }
+        }
+        self.total_steps = length
+            .steps_from(sim.system.time, sim.dt)
+            .map_err(|e| FrontError::request(format!("{label}: {e}")))?;
+        if resumed.is_none() {
+            mote_run::check_run_length(self.total_steps, sim.dt, args.force)
+                .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
+        }
+        if let Some(cp) = resumed {
+            resume_state(cp, &mut sim, label)?;
+        }
+        let done = resumed.map_or(0, |cp| cp.step.min(self.total_steps));
+        self.last_step = sim.system.step + (self.total_steps - done);
+        self.probes = built.probes;
+        Ok(sim)
+    }
+
+    fn check_folder(&self, sim: &Simulation, dir: &Path) -> Result<(), FrontError> {
+        check_disk(
+            dir,
+            &self.scene.output,
+            self.total_steps,
+            sim.system.particles.len(),
+        )
+        .map_err(|m| FrontError::request(format!("{}: {m}", self.input.label)))
+    }
+
+    fn observers(
+        &self,
+        sim: &Simulation,
+        files: &RunFiles,
+    ) -> Result<Vec<Box<dyn Observer<Simulation>>>, FrontError> {
+        table_observers(&self.scene, sim, &self.probes, files)
+    }
+
+    fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
+        Ok(crate::runner::scene_trajectory(
+            self.scene.output.trajectory_every,
+            self.format,
+        ))
+    }
+
+    fn checkpoint_options(&self, sim: &Simulation) -> Vec<(String, String)> {
+        let mut options = vec![
+            (
+                "system".to_string(),
+                self.args.system.clone().unwrap_or_else(|| "nbody".into()),
+            ),
+            ("total-steps".to_string(), self.total_steps.to_string()),
+            ("dt".to_string(), hex(sim.dt)),
+        ];
+        if let Some(s) = &self.args.solver {
+            options.push(("solver".to_string(), s.clone()));
+        }
+        options
+    }
+
+    fn last_step(&self, _: &Simulation) -> u64 {
+        self.last_step
+    }
+
+    fn opening(&self, sim: &Simulation) -> String {
+        let propagator = if sim.brownian.is_some() {
+            "Brownian dynamics".to_string()
+        } else {
+            sim.stepper.scheme.name().to_string()
+        };
+        format!(
+            "{} particles, {} with dt = {}, {} steps",
+            sim.system.particles.len(),
+            propagator,
+            mote_io::system::human_number(sim.dt),
+            self.last_step - sim.system.step,
+        )
+    }
+
+    fn ending(&self, e: MdError) -> Result<Ending, FrontError> {
+        crate::rigid::md_ending(e)
+    }
+
+    fn summary(
+        &self,
+        sim: &Simulation,
+        report: &RunReport,
+        done: &Done,
+    ) -> Result<Vec<String>, FrontError> {
+        Ok(vec![summary(report, sim, &self.scene, &done.files.dir)])
+    }
+}
+
+/// The tables a time-stepped run writes as it goes, by the scene's
 /// `[output]`: observables.csv every `observables_every` steps (with the
 /// pressure where the box is periodic and every interaction gives its
-/// virial) and the trajectory every `trajectory_every` in `format`; with
-/// `append`, onto the files of the run being resumed.
-pub(crate) fn file_observers(
+/// virial); with `files.append`, onto the table of the run being resumed.
+/// The trajectory is the run's own (`mote_run::Trajectory`).
+pub(crate) fn table_observers(
     scene: &Scene,
     sim: &Simulation,
     probes: &[mote_md::observe::Probe],
-    dir: &Path,
-    provenance: &mote_io::Provenance,
-    format: mote_io::trajectory::Format,
-    append: bool,
+    files: &RunFiles,
 ) -> Result<Vec<Box<dyn mote_run::Observer<Simulation>>>, FrontError> {
+    let (dir, provenance, append) = (&files.dir, &files.provenance, files.append);
     let out = &scene.output;
     let mut observers: Vec<Box<dyn mote_run::Observer<Simulation>>> = Vec::new();
     if out.observables_every > 0 {
@@ -325,15 +313,6 @@ pub(crate) fn file_observers(
             csv.suggest_plot(column)?;
         }
         observers.push(Box::new(csv));
-    }
-    if out.trajectory_every > 0 {
-        observers.push(Box::new(Trajectory::create(
-            &dir.join(format!("trajectory.{}", format.extension())),
-            format,
-            provenance.clone(),
-            out.trajectory_every,
-            append,
-        )?));
     }
     Ok(observers)
 }

@@ -1,11 +1,10 @@
 //! Observers that write files through mote-io: observables as CSV (with the
-//! particle inspector's columns) and trajectories as extended XYZ.
+//! particle inspector's columns); trajectories go through `mote_run::Trajectory`.
 
 use std::path::Path;
 
 use glam::DVec3;
 use mote_io::csv::CsvWriter;
-use mote_io::trajectory::{Format, TrajectoryWriter};
 use mote_io::xyz::Frame;
 use mote_io::Provenance;
 
@@ -168,34 +167,6 @@ pub fn event_line(step: u64, time: f64, text: &str) -> String {
     format!("event: step {step}, t = {time}: {text}")
 }
 
-/// The trajectory: every particle's position, velocity, radius, mass and
-/// (where present) spin and dipole, in any of mote's formats.
-pub struct Trajectory {
-    writer: TrajectoryWriter,
-    every: u64,
-}
-
-impl Trajectory {
-    /// Writes `path` in `format` every `every` steps; `append` continues
-    /// the file of an interrupted run.
-    pub fn create(
-        path: &Path,
-        format: Format,
-        provenance: Provenance,
-        every: u64,
-        append: bool,
-    ) -> Result<Self, MdError> {
-        Ok(Self {
-            writer: if append {
-                TrajectoryWriter::append(path, format, provenance, false)?
-            } else {
-                TrajectoryWriter::create(path, format, provenance, false)?
-            },
-            every,
-        })
-    }
-}
-
 /// The system as a plain frame: the cell is the simulation box when it is
 /// finite, else a box enclosing the particles.
 pub fn frame_of(sys: &System) -> Frame {
@@ -237,22 +208,5 @@ fn nonzero(v: &[DVec3]) -> Vec<[f64; 3]> {
         v.iter().map(|x| x.to_array()).collect()
     } else {
         Vec::new()
-    }
-}
-
-impl Observer<Simulation> for Trajectory {
-    fn every(&self) -> u64 {
-        self.every
-    }
-
-    fn observe(&mut self, sim: &Simulation, _obs: &Observables) -> Result<(), MdError> {
-        let written = self.writer.write(sim.system.step, &frame_of(&sim.system));
-        // The frame was a transient copy: its pages go back at once.
-        mote_io::system::release_free_memory();
-        Ok(written?)
-    }
-
-    fn files(&self) -> Vec<String> {
-        vec![self.writer.path().display().to_string()]
     }
 }

@@ -23,7 +23,9 @@ use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::xyz::Frame;
 
 mod steer;
+mod trajectory;
 pub use steer::{Change, FieldKind, Live, LiveSlot, Shown, WallGeometry};
+pub use trajectory::Trajectory;
 
 /// The most steps a run takes without being told `--force`: a run longer
 /// than this is far more likely a time step or an end time mistyped

@@ -112,17 +112,25 @@ impl Points {
                 let format = scene
                     .output
                     .trajectory_format(mote_io::Source::new(label, text))?;
-                let observers = crate::particles::file_observers(
+                let files = crate::runner::RunFiles {
+                    dir: dir.to_path_buf(),
+                    provenance: crate::provenance(label, seed),
+                    append: false,
+                };
+                let observers = crate::particles::table_observers(
                     &scene,
                     &stepper.state,
                     &built.probes,
-                    dir,
-                    &crate::provenance(label, seed),
-                    format,
-                    false,
+                    &files,
                 )?;
                 for o in observers {
                     stepper.observe_with(o);
+                }
+                if let Some(spec) =
+                    crate::runner::scene_trajectory(scene.output.trajectory_every, format)
+                {
+                    stepper
+                        .observe_with(Box::new(crate::runner::trajectory_observer(&spec, &files)?));
                 }
                 Some(folder)
             }

@@ -8,7 +8,6 @@
 use glam::DVec3;
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
-use mote_io::trajectory::TrajectoryWriter;
 use mote_io::xyz::Frame;
 use mote_io::{ParseError, Provenance};
 use mote_run::{Observer, Propagator};
@@ -282,33 +281,6 @@ impl Observer<RigidDynamics> for RigidCsv {
         Ok(self
             .writer
             .comment(&crate::output::event_line(d.step, d.bodies.time, text))?)
-    }
-}
-
-/// trajectory.xyz of a rigid run: the spheres of every body.
-pub struct SphereTrajectory {
-    writer: TrajectoryWriter,
-    every: u64,
-}
-
-impl SphereTrajectory {
-    /// Writes the spheres every `every` steps through `writer`.
-    pub fn new(writer: TrajectoryWriter, every: u64) -> Self {
-        Self { writer, every }
-    }
-}
-
-impl Observer<RigidDynamics> for SphereTrajectory {
-    fn every(&self) -> u64 {
-        self.every
-    }
-
-    fn observe(&mut self, d: &RigidDynamics, _: &RigidSample) -> Result<(), MdError> {
-        Ok(self.writer.write(d.step, &d.sphere_frame())?)
-    }
-
-    fn files(&self) -> Vec<String> {
-        vec![self.writer.path().display().to_string()]
     }
 }
 
