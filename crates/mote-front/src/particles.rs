@@ -6,7 +6,7 @@ use std::path::Path;
 use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::trajectory::Format;
 use mote_md::output::ObservablesCsv;
-use mote_md::scene::{PlistSystem, Scene};
+use mote_md::scene::{PlistSystem, Scene, Setting};
 use mote_md::{MdError, RunLength, RunReport, Simulation};
 use mote_run::Observer;
 
@@ -99,13 +99,13 @@ pub(crate) fn run(
         }
         let mut scene = Scene::parse(&input.text, &input.label)?;
         if let Some(s) = &args.solver {
-            scene.run.integrator = toml::Spanned::new(0..0, s.clone());
+            scene.run.integrator = Setting::from_option("--solver", s.clone());
         }
         scene
     };
     let mut scene = scene;
     if let Some(dt) = args.dt {
-        scene.run.dt = Some(toml::Spanned::new(0..0, dt));
+        scene.run.dt = Some(Setting::from_option("--dt", dt));
     }
     if scene.run.dt.is_none() {
         refuse!(

@@ -364,6 +364,28 @@ fn options_an_engine_lacks_are_refused_with_the_reason() {
     );
 }
 
+/// An option that replaces a scene's value is named where that value is
+/// refused (the scene has no line for it): a granular scene stepped with
+/// another integrator than leap-frog.
+#[test]
+fn a_refused_option_value_is_named_not_a_line_of_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = mote(
+        &["run", "example:settling", "--solver", "rk4", "--steps", "2"],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("example:settling: --solver rk4: [granular] contacts turn the spheres"),
+        "{err}"
+    );
+    assert!(
+        !dir.path().join("out").exists(),
+        "a refused run wrote files"
+    );
+}
+
 /// A rigid run honours --dt, --steps, --seed, -o and --picture, and a
 /// scene without a seed gets one chosen and printed.
 #[test]

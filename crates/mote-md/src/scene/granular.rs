@@ -101,10 +101,11 @@ impl Section for GranularSettings {
         if radius.iter().any(|r| *r <= 0.0) {
             return bad("[granular] needs every particle to have a radius > 0");
         }
-        if Integrator::from_name(scene.run.integrator.get_ref()) != Some(Integrator::LeapFrog) {
-            return Err(err(
-                scene.run.integrator.span(),
-                "[granular] contacts turn the spheres: use integrator = \"leapfrog\"".into(),
+        let integrator = &scene.run.integrator;
+        if Integrator::from_name(&integrator.value) != Some(Integrator::LeapFrog) {
+            return Err(integrator.error(
+                src,
+                "[granular] contacts turn the spheres: use integrator = \"leapfrog\"",
             ));
         }
         let damping = match v.damping.as_str() {

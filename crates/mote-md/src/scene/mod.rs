@@ -59,7 +59,7 @@ pub use particles::{
     PlummerSpec, Properties, RandomBoxSpec, RingSpec, SpeedSpec, SpringSpec,
 };
 pub use plist::PlistSystem;
-pub use run::{BoxSettings, OutputSettings, RunSettings};
+pub use run::{BoxSettings, Origin, OutputSettings, RunSettings, Setting};
 
 /// A whole scene file.
 #[derive(Debug, Clone, Default, Deserialize)]

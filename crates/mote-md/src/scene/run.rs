@@ -20,8 +20,8 @@ use crate::simulation::RunLength;
 pub struct RunSettings {
     /// Default: leapfrog.
     #[serde(default = "default_integrator")]
-    pub integrator: Spanned<String>,
-    pub dt: Option<Spanned<f64>>,
+    pub integrator: Setting<String>,
+    pub dt: Option<Setting<f64>>,
     pub steps: Option<u64>,
     pub until: Option<f64>,
     /// Move to the centre-of-mass frame before the run (only if nothing is fixed).
@@ -29,8 +29,72 @@ pub struct RunSettings {
     pub centre_of_mass: bool,
 }
 
-fn default_integrator() -> Spanned<String> {
-    Spanned::new(0..0, "leapfrog".into())
+fn default_integrator() -> Setting<String> {
+    Setting {
+        value: "leapfrog".into(),
+        origin: Origin::Default,
+    }
+}
+
+/// A run setting and where it was given, so that an error about it names
+/// its line in the scene, or the option that replaced the scene's value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setting<T> {
+    pub value: T,
+    pub origin: Origin,
+}
+
+/// Where a [`Setting`] was given.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Origin {
+    /// In the scene text, at this byte span.
+    Scene(std::ops::Range<usize>),
+    /// By a command-line option or argument (`--dt`) replacing the scene's.
+    Option(&'static str),
+    /// Nowhere: the default, or an MPPphys particle file's own.
+    Default,
+}
+
+impl<T: std::fmt::Display> Setting<T> {
+    /// The value as `option` gave it.
+    pub fn from_option(option: &'static str, value: T) -> Self {
+        Setting {
+            value,
+            origin: Origin::Option(option),
+        }
+    }
+
+    /// A value given nowhere in particular (a default, a particle file's).
+    pub fn plain(value: T) -> Self {
+        Setting {
+            value,
+            origin: Origin::Default,
+        }
+    }
+
+    /// An error about this setting: `file:line: message` where the scene
+    /// gave it, `file: --option value: message` where an option did.
+    pub fn error(&self, src: Source, message: impl Into<String>) -> ParseError {
+        match &self.origin {
+            Origin::Scene(span) => src.error(span.clone(), message),
+            Origin::Option(option) => ParseError::new(
+                src.file,
+                0,
+                format!("{option} {}: {}", self.value, message.into()),
+            ),
+            Origin::Default => src.whole(message),
+        }
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Setting<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let spanned = Spanned::<T>::deserialize(d)?;
+        Ok(Setting {
+            origin: Origin::Scene(spanned.span()),
+            value: spanned.into_inner(),
+        })
+    }
 }
 
 impl Default for RunSettings {
@@ -127,23 +191,20 @@ impl RunSettings {
         &self,
         src: Source,
     ) -> Result<(Integrator, f64, Option<RunLength>), ParseError> {
-        let integrator = Integrator::from_name(self.integrator.get_ref()).ok_or_else(|| {
-            src.error(
-                self.integrator.span(),
+        let integrator = Integrator::from_name(&self.integrator.value).ok_or_else(|| {
+            self.integrator.error(
+                src,
                 format!(
                     "unknown integrator '{}': expected {}",
-                    self.integrator.get_ref(),
+                    self.integrator.value,
                     Integrator::NAMES
                 ),
             )
         })?;
         let dt = match &self.dt {
-            Some(dt) if *dt.get_ref() > 0.0 && dt.get_ref().is_finite() => *dt.get_ref(),
+            Some(dt) if dt.value > 0.0 && dt.value.is_finite() => dt.value,
             Some(dt) => {
-                return Err(src.error(
-                    dt.span(),
-                    format!("dt must be positive, found {}", dt.get_ref()),
-                ))
+                return Err(dt.error(src, format!("dt must be positive, found {}", dt.value)))
             }
             None => return Err(src.whole("[run] needs a time step: dt = ...")),
         };
