@@ -97,10 +97,11 @@ pub fn run<'py>(
 
 /// A packing by growing hard spheres (Lubachevsky–Stillinger), the keys
 /// of `mote pack` (`mote pack --help`). Returns a dict: positions (N, D),
-/// radii (N,), box (D,), phi, pressure, summary (lines). `output` also
-/// writes it (format by extension) with its CSV of windows.
+/// radii (N,), box (D,), phi, pressure, summary (lines). `output` (a folder,
+/// as `mote pack -o` takes) also writes it, `output/packing.EXT` in
+/// `format`, with its CSV of windows and POV-Ray scene.
 #[pyfunction]
-#[pyo3(signature = (n=1000, *, dimension=3, dist="mono", rate=0.01, max_pressure=1e12, phi=None, walls="", jam=true, seed=None, start=None, output=None, method="hard", min_pressure=1e-8))]
+#[pyo3(signature = (n=1000, *, dimension=3, dist="mono", rate=0.01, max_pressure=1e12, phi=None, walls="", jam=true, seed=None, start=None, output=None, format="xyz", method="hard", min_pressure=1e-8))]
 #[allow(clippy::too_many_arguments)]
 pub fn pack<'py>(
     py: Python<'py>,
@@ -115,9 +116,26 @@ pub fn pack<'py>(
     seed: Option<u64>,
     start: Option<String>,
     output: Option<PathBuf>,
+    format: &str,
     method: &str,
     min_pressure: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let format = mote_io::trajectory::Format::named(format).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "format = {format:?}: expected one of {}",
+            mote_io::trajectory::Format::NAMES
+        ))
+    })?;
+    if let Some(named) = output
+        .as_deref()
+        .and_then(mote_front::packing::named_like_a_file)
+    {
+        return Err(PyValueError::new_err(format!(
+            "output = {:?}: output names the packing's folder, as mote.run's does; the packing goes to DIR/packing.{}",
+            output.as_ref().map(|p| p.display().to_string()).unwrap_or_default(),
+            named.extension()
+        )));
+    }
     use mote_front::packing::{pack, Naming, PackFiles, PackingSpec};
     let spec = PackingSpec {
         n,
@@ -143,8 +161,17 @@ pub fn pack<'py>(
         scene: format!("mote.pack(n={n}, dist={dist:?}, rate={rate})"),
         seed,
     };
+    let _folder = match &output {
+        Some(dir) => Some(
+            mote_front::lock::RunFolder::fresh(dir, &provenance.scene, &provenance.scene)
+                .map_err(front_error)?,
+        ),
+        None => None,
+    };
     let files = PackFiles {
-        xyz: output,
+        xyz: output
+            .as_deref()
+            .map(|dir| mote_front::packing::packing_file(dir, format)),
         ..PackFiles::default()
     };
     let packed = py

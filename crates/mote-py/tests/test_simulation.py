@@ -321,13 +321,17 @@ def test_rigid_clumps_step_from_python_with_the_bits_of_mote_run(tmp_path):
 
 def test_pack_gives_the_packing_of_a_packing_scene(tmp_path):
     ase_io = pytest.importorskip("ase.io")
-    p = mote.pack(300, phi=0.55, seed=3, output=tmp_path / "p.xyz")
+    p = mote.pack(300, phi=0.55, seed=3, output=tmp_path / "p")
     mote.run({"packing": {"n": 300, "phi": 0.55}}, seed=3, output=tmp_path / "scene")
-    a = ase_io.read(tmp_path / "p.xyz")
+    a = ase_io.read(tmp_path / "p" / "packing.xyz")
     b = ase_io.read(tmp_path / "scene" / "packing.xyz")
     # The same packing, bit for bit (both files are written exactly).
     assert np.array_equal(a.positions, b.positions)
     assert np.array_equal(a.positions, p["positions"] + 0.0)
+    # output is a folder, as everywhere; a packing file's name is refused.
+    with pytest.raises(ValueError, match="names the packing's folder"):
+        mote.pack(50, phi=0.3, output=tmp_path / "q.xyz")
+    assert not (tmp_path / "q.xyz").exists()
 
 
 HARD_SPHERES = """

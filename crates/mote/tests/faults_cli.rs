@@ -107,13 +107,13 @@ fn a_full_disk_ends_rigid_event_driven_and_packing_runs() {
         .output()
         .unwrap();
     assert_refused(&out, "observables.csv", FULL);
-    let dir = full_folder("p.xyz");
+    let dir = full_folder("packing.xyz");
     let out = mote()
         .args(["-q", "pack", "--n", "100", "--phi", "0.3", "-o"])
-        .arg(dir.path().join("p.xyz"))
+        .arg(dir.path())
         .output()
         .unwrap();
-    assert_refused(&out, "p.xyz", FULL);
+    assert_refused(&out, "packing.xyz", FULL);
 }
 
 #[test]
@@ -141,7 +141,7 @@ fn an_output_folder_that_cannot_be_made_is_named() {
             "--phi",
             "0.3",
             "-o",
-            "/sys/mote-out/p.xyz",
+            "/sys/mote-out/p",
         ])
         .output()
         .unwrap();

@@ -344,6 +344,20 @@ fn read_radii(path: &Path) -> Result<Vec<f64>, FrontError> {
     Ok(radii)
 }
 
+/// The packing file of a run folder, `DIR/packing.EXT` in `format`: where
+/// `mote pack -o DIR` and a `[packing]` scene under `mote run` put it.
+pub fn packing_file(dir: &Path, format: mote_io::trajectory::Format) -> PathBuf {
+    dir.join(format!("packing.{}", format.extension()))
+}
+
+/// The format a packing's folder `dir` names by its extension, as a
+/// packing file did before folders (`-o p.gsd`): such a name is refused
+/// with the new spelling, not made into a folder. `None` for a folder's
+/// name (or a folder that exists).
+pub fn named_like_a_file(dir: &Path) -> Option<mote_io::trajectory::Format> {
+    mote_io::trajectory::Format::of_path(dir).filter(|_| !dir.is_dir())
+}
+
 /// Where a packing goes: the XYZ file (the CSV and POV-Ray scene go beside
 /// it, same stem), a picture, checkpoints; and the checkpoint it resumes.
 #[derive(Debug, Clone, Default)]
@@ -678,7 +692,8 @@ struct PackingOutput {
 }
 
 /// `mote run` on a scene with a `[packing]` table: the packing goes to
-/// `DIR/packing.xyz` (with .csv and .pov beside it).
+/// `DIR/packing.xyz` (or the format of `--trajectory-format`; with .csv
+/// and .pov beside it).
 pub(crate) fn run(
     input: &Input,
     options: &RunOptions,
@@ -713,6 +728,10 @@ pub(crate) fn run(
     let spec = &scene.packing;
     let settings = spec.settings(seed, Naming::Scene(source), &base)?;
     let method = spec.method(Naming::Scene(source))?;
+    let xyz = packing_file(
+        &dir,
+        options.trajectory_format(mote_io::trajectory::Format::Xyz)?,
+    );
     let _folder = crate::lock::RunFolder::fresh(&dir, &input.label, &input.text)?;
     let how = match method {
         Method::Hard => format!("by growth (rate {}", spec.rate),
@@ -733,7 +752,6 @@ pub(crate) fn run(
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase()
     ));
-    let xyz = dir.join("packing.xyz");
     let files = PackFiles {
         checkpoints: options.checkpoint_every.map(|every| PackCheckpointFile {
             every,

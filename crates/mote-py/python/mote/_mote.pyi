@@ -224,12 +224,15 @@ def pack(
     seed: Optional[int] = None,
     start: Optional[str] = None,
     output: Optional[Path] = None,
+    format: str = "xyz",
     method: str = "hard",
     min_pressure: float = 1e-8,
 ) -> dict[str, Any]:
     """A packing by growing hard spheres (method="hard") or by soft spheres
     under a barostat (method="soft", phi extrapolated to zero pressure);
-    returns positions, radii, box, phi, pressure, seed and summary."""
+    returns positions, radii, box, phi, pressure, seed and summary. With
+    ``output`` (a folder), writes output/packing.EXT in ``format`` (xyz,
+    dump, gsd, vtk) with its CSV of windows and POV-Ray scene."""
 
 def rcp(
     *,

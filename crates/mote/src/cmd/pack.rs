@@ -13,7 +13,7 @@ use mote_edmd::analyse::{
     bond_order, contacts, deepest_overlap, pair_correlation, stable_contacts,
 };
 use mote_edmd::{Boundary, SimBox};
-use mote_front::packing::{Naming, PackFiles, PackingSpec};
+use mote_front::packing::{packing_file, Naming, PackFiles, PackingSpec};
 use mote_front::{Ending, Monitor};
 
 use super::GlobalOpts;
@@ -89,17 +89,22 @@ pub struct PackArgs {
     /// 1000/max-pressure: force-bearing gaps are ~1/Z).
     #[arg(long)]
     tol: Option<f64>,
-    /// The packing, in the format of the extension (.xyz extended XYZ, .dump
-    /// LAMMPS, .gsd HOOMD, .pvd VTK), numbers exact; also writes STEM.csv (φ
-    /// and pressure per window) and STEM.pov (POV-Ray scene) beside it.
-    #[arg(long, short = 'o', value_name = "FILE")]
+    /// Folder for the packing, as `mote run -o` names a run's:
+    /// DIR/packing.xyz (numbers exact; another format with --format),
+    /// DIR/packing.csv (φ and pressure per window), DIR/packing.pov
+    /// (POV-Ray scene) and DIR/checkpoint.mote. Without it, nothing is written.
+    #[arg(long, short = 'o', value_name = "DIR")]
     output: Option<PathBuf>,
+    /// Format of DIR/packing.* (read back by --start, [[from_file]] and
+    /// other programs).
+    #[arg(long, value_name = "FORMAT", default_value = "xyz", value_parser = super::choices::trajectory_format())]
+    format: String,
     /// Render the packing to this PNG.
     #[arg(long, value_name = "FILE.png")]
     picture: Option<PathBuf>,
-    /// Write STEM.checkpoint.mote every N pressure windows and when a
+    /// Write DIR/checkpoint.mote every N pressure windows and when a
     /// signal stops the run (needs -o); continue with
-    /// `mote run --resume STEM.checkpoint.mote`.
+    /// `mote run --resume DIR/checkpoint.mote`.
     #[arg(long, value_name = "N")]
     checkpoint_every: Option<u64>,
 }
@@ -176,10 +181,30 @@ impl PackArgs {
 /// `mote run` (`mote_front::packing`), spelled as options.
 fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
     let quiet = global.quiet;
-    // Files named for formats mote does not write are refused before the
-    // packing is made, not after.
+    let format = mote_io::trajectory::Format::named(&a.format).with_context(|| {
+        format!(
+            "--format {}: expected one of {}",
+            a.format,
+            mote_io::trajectory::Format::NAMES
+        )
+    })?;
+    // -o named the packing file before it named the folder, as in `mote run`.
     if let Some(o) = &a.output {
-        mote_front::written_format(o)?;
+        if let Some(named) = mote_front::packing::named_like_a_file(o) {
+            let folder = o.with_extension("");
+            anyhow::bail!(
+                "-o {}: -o names the packing's folder, as `mote run -o` names a run's; \
+                 the packing goes to DIR/packing.{}: give -o {}{}",
+                o.display(),
+                named.extension(),
+                folder.display(),
+                if named == mote_io::trajectory::Format::Xyz {
+                    String::new()
+                } else {
+                    format!(" --format {}", format_name(named))
+                }
+            );
+        }
     }
     if let Some(p) = &a.picture {
         mote_front::check_picture_path(p)?;
@@ -218,26 +243,35 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         (None, _) => None,
         (Some(0), _) => anyhow::bail!("--checkpoint-every 0: give a number of windows ≥ 1"),
         (Some(_), None) => {
-            anyhow::bail!("--checkpoint-every needs -o FILE: the packing is resumed into it")
+            anyhow::bail!("--checkpoint-every needs -o DIR: the packing is resumed into it")
         }
-        (Some(every), Some(xyz)) => {
+        (Some(every), Some(dir)) => {
             let text = mote_front::packing::spec_scene_text(&spec, seed)?;
             Some(mote_front::packing::PackCheckpointFile {
                 every,
-                path: xyz.with_extension("checkpoint.mote"),
+                path: dir.join("checkpoint.mote"),
                 template: mote_front::packing::checkpoint_template(
                     &label,
                     &text,
                     seed,
                     every,
-                    xyz,
+                    &packing_file(dir, format),
                     Path::new("."),
                 ),
             })
         }
     };
+    // The folder is held as `mote run` holds a run's: locked and marked.
+    let _folder = match &a.output {
+        Some(dir) => Some(mote_front::lock::RunFolder::fresh(
+            dir,
+            &label,
+            &mote_front::packing::spec_scene_text(&spec, seed)?,
+        )?),
+        None => None,
+    };
     let files = PackFiles {
-        xyz: a.output.clone(),
+        xyz: a.output.as_deref().map(|dir| packing_file(dir, format)),
         picture: a.picture.clone(),
         checkpoints,
         resume: None,
@@ -263,6 +297,17 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from((128 + signal).clamp(0, 255) as u8));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The name --format gives `format` by.
+fn format_name(format: mote_io::trajectory::Format) -> &'static str {
+    use mote_io::trajectory::Format;
+    match format {
+        Format::Xyz => "xyz",
+        Format::Dump => "dump",
+        Format::Gsd => "gsd",
+        Format::Vtk => "vtk",
+    }
 }
 
 fn analyse_cmd(global: &GlobalOpts, a: &AnalyseArgs) -> anyhow::Result<ExitCode> {
