@@ -4,7 +4,6 @@
 //! `mote run`, so a run from Python ends in `mote run`'s bits.
 
 use std::path::PathBuf;
-use std::sync::{Mutex, MutexGuard};
 
 use numpy::prelude::*;
 use numpy::{PyArray1, PyArray2};
@@ -13,7 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{dict_to_toml, front_error};
-use crate::stepping::{run_loop, HasEngine, Stepped};
+use crate::stepping::{simulation_class, Stepped};
 
 /// The run behind a Python `HardSpheres` (no Python types: it runs with
 /// the GIL released).
@@ -50,6 +49,14 @@ impl Stepped for HardEngine {
         }
     }
 
+    fn time(&self) -> f64 {
+        self.run.time()
+    }
+
+    fn len(&self) -> usize {
+        self.run.frame().positions.len()
+    }
+
     fn describe(&self) -> String {
         format!(
             "{}: {} hard {}, output interval {} of {}",
@@ -66,40 +73,15 @@ impl Stepped for HardEngine {
     }
 }
 
-/// Event-driven hard disks or spheres (a scene with `[event_driven]`, see
-/// docs/edmd.md): free flight between exact elastic collisions. A step is
-/// one output interval of the scene (`[output] interval`).
-///
-/// >>> hs = mote.HardSpheres.from_file("example:eos")
-/// >>> hs.run()                       # to the scene's [run] until
-/// >>> hs.observables["compressibility"][-1]
-#[pyclass(module = "mote")]
-pub struct HardSpheres {
-    engine: Mutex<HardEngine>,
-}
-
-impl HasEngine for HardSpheres {
-    type Engine = HardEngine;
-    fn engine(&self) -> PyResult<MutexGuard<'_, HardEngine>> {
-        crate::stepping::lock(&self.engine)
-    }
-}
-
 impl HardSpheres {
-    fn engine(&self) -> PyResult<MutexGuard<'_, HardEngine>> {
-        crate::stepping::lock(&self.engine)
-    }
-
     fn build(input: &mote_front::Input, seed: Option<u64>, force: bool) -> PyResult<Self> {
         let (run, seed) =
             mote_front::stepper::HardSpheres::build(input, seed, force).map_err(front_error)?;
-        Ok(HardSpheres {
-            engine: Mutex::new(HardEngine {
-                run,
-                label: input.label.clone(),
-                seed,
-            }),
-        })
+        Ok(HardSpheres::wrap(HardEngine {
+            run,
+            label: input.label.clone(),
+            seed,
+        }))
     }
 
     /// An (N, D) array of the frame's rows (D = 2 for disks).
@@ -117,8 +99,17 @@ impl HardSpheres {
     }
 }
 
-#[pymethods]
-impl HardSpheres {
+simulation_class! {
+    /// Event-driven hard disks or spheres (a scene with `[event_driven]`, see
+    /// docs/edmd.md): free flight between exact elastic collisions. A step is
+    /// one output interval of the scene (`[output] interval`).
+    ///
+    /// >>> hs = mote.HardSpheres.from_file("example:eos")
+    /// >>> hs.run()                       # to the scene's [run] until
+    /// >>> hs.observables["compressibility"][-1]
+    pub struct HardSpheres(HardEngine);
+    unit = "output intervals", every = 1;
+
     /// An event-driven scene file or `example:NAME`; `seed` replaces the
     /// scene's; `force` runs a scene expected to take more than 10⁹ events.
     #[staticmethod]
@@ -148,41 +139,6 @@ impl HardSpheres {
         Self::from_toml(&dict_to_toml(scene)?, seed, "<dict>", force)
     }
 
-    /// Advances `n` output intervals (the GIL is released meanwhile).
-    #[pyo3(signature = (n=1))]
-    fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
-        let mut guard = self.engine()?;
-        let engine = &mut *guard;
-        py.detach(|| engine.advance(n, false, &mut |_, _| {}))
-    }
-
-    /// Runs `steps` output intervals, or to the scene's end (`[run]
-    /// until`) when not given, calling `callback(hs)` every `every`
-    /// intervals; `progress=True` shows `mote run`'s progress bar.
-    #[pyo3(signature = (steps=None, until=None, callback=None, every=1, progress=false))]
-    fn run(
-        slf: Bound<'_, Self>,
-        steps: Option<u64>,
-        until: Option<f64>,
-        callback: Option<Bound<'_, PyAny>>,
-        every: u64,
-        progress: bool,
-    ) -> PyResult<()> {
-        run_loop(&slf, steps, until, callback, every, progress)
-    }
-
-    /// Simulated time.
-    #[getter]
-    fn time(&self) -> PyResult<f64> {
-        Ok(self.engine()?.run.time())
-    }
-
-    /// Output intervals done.
-    #[getter]
-    fn steps(&self) -> PyResult<u64> {
-        Ok(self.engine()?.run.step())
-    }
-
     /// The output interval at which the scene's run ends.
     #[getter]
     fn last_step(&self) -> PyResult<u64> {
@@ -210,10 +166,6 @@ impl HardSpheres {
         let cell = e.run.frame().cell;
         let d = e.run.dimension();
         Ok(PyArray1::from_vec(py, (0..d).map(|k| cell[k][k]).collect()))
-    }
-
-    fn __len__(&self) -> PyResult<usize> {
-        Ok(self.engine()?.run.frame().positions.len())
     }
 
     /// Positions now, (N, D) in the scene's order: a copy (each particle

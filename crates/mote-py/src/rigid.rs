@@ -3,7 +3,6 @@
 //! measurement schedule (see [`crate::stepping`]).
 
 use std::path::PathBuf;
-use std::sync::{Mutex, MutexGuard};
 
 use glam::DVec3;
 use mote_front::stepper::{BodyVectors, Rigid, RigidObservables};
@@ -15,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{dict_to_toml, front_error};
-use crate::stepping::{run_loop, time_steps, HasEngine, Stepped};
+use crate::stepping::{simulation_class, time_steps, Stepped};
 
 impl Stepped for Rigid {
     fn advance(
@@ -38,6 +37,14 @@ impl Stepped for Rigid {
         })
     }
 
+    fn time(&self) -> f64 {
+        Rigid::time(self)
+    }
+
+    fn len(&self) -> usize {
+        Rigid::len(self)
+    }
+
     fn describe(&self) -> String {
         format!(
             "{}: {} bodies, dt = {}",
@@ -45,24 +52,6 @@ impl Stepped for Rigid {
             self.len(),
             self.dt()
         )
-    }
-}
-
-/// Rigid clumps of overlapping spheres (a scene with `[rigid]`, see
-/// docs/rigid.md) stepped by the Fast Rigid Bodies Integrator.
-///
-/// >>> sim = mote.RigidSimulation.from_file("example:magnet-in-field")
-/// >>> sim.run(steps=1000)
-/// >>> sim.orientations      # unit quaternions (w, x, y, z) of the bodies
-#[pyclass(module = "mote")]
-pub struct RigidSimulation {
-    engine: Mutex<Rigid>,
-}
-
-impl HasEngine for RigidSimulation {
-    type Engine = Rigid;
-    fn engine(&self) -> PyResult<MutexGuard<'_, Rigid>> {
-        crate::stepping::lock(&self.engine)
     }
 }
 
@@ -79,8 +68,16 @@ fn body_view<'py>(
     Ok(unsafe { PyArray2::borrow_from_array(&arr, this.clone().into_any()) })
 }
 
-#[pymethods]
-impl RigidSimulation {
+simulation_class! {
+    /// Rigid clumps of overlapping spheres (a scene with `[rigid]`, see
+    /// docs/rigid.md) stepped by the Fast Rigid Bodies Integrator.
+    ///
+    /// >>> sim = mote.RigidSimulation.from_file("example:magnet-in-field")
+    /// >>> sim.run(steps=1000)
+    /// >>> sim.orientations      # unit quaternions (w, x, y, z) of the bodies
+    pub struct RigidSimulation(Rigid);
+    unit = "steps", every = 100;
+
     /// A rigid scene file or `example:NAME`; `seed` replaces the scene's.
     #[staticmethod]
     #[pyo3(signature = (path, seed=None))]
@@ -93,9 +90,9 @@ impl RigidSimulation {
     #[staticmethod]
     #[pyo3(signature = (text, seed=None, name="<string>"))]
     fn from_toml(text: &str, seed: Option<u64>, name: &str) -> PyResult<Self> {
-        Ok(RigidSimulation {
-            engine: Mutex::new(Rigid::build(text, name, seed).map_err(front_error)?),
-        })
+        Ok(RigidSimulation::wrap(
+            Rigid::build(text, name, seed).map_err(front_error)?,
+        ))
     }
 
     /// A rigid scene given as a dict of the scene file's tables and keys.
@@ -112,44 +109,13 @@ impl RigidSimulation {
         let cp =
             mote_io::checkpoint::read(&path).map_err(|e| PyValueError::new_err(e.to_string()))?;
         let run = Rigid::resume(&cp, &path.display().to_string()).map_err(front_error)?;
-        Ok(RigidSimulation {
-            engine: Mutex::new(run),
-        })
+        Ok(RigidSimulation::wrap(run))
     }
 
     /// Writes a checkpoint that `RigidSimulation.resume` continues bit for bit.
     fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
         let cp = self.engine()?.checkpoint().map_err(front_error)?;
         mote_io::checkpoint::write(&path, &cp).map_err(|e| crate::MoteError::new_err(e.to_string()))
-    }
-
-    /// Advances `n` steps (the GIL is released meanwhile).
-    #[pyo3(signature = (n=1))]
-    fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
-        let mut guard = self.engine()?;
-        let engine = &mut *guard;
-        py.detach(|| Stepped::advance(engine, n, false, &mut |_, _| {}))
-    }
-
-    /// Runs `steps` steps or until time `until` (the scene's length when
-    /// neither is given), calling `callback(sim)` every `every` steps;
-    /// `progress=True` shows `mote run`'s progress bar.
-    #[pyo3(signature = (steps=None, until=None, callback=None, every=100, progress=false))]
-    fn run(
-        slf: Bound<'_, Self>,
-        steps: Option<u64>,
-        until: Option<f64>,
-        callback: Option<Bound<'_, PyAny>>,
-        every: u64,
-        progress: bool,
-    ) -> PyResult<()> {
-        run_loop(&slf, steps, until, callback, every, progress)
-    }
-
-    /// Simulated time.
-    #[getter]
-    fn time(&self) -> PyResult<f64> {
-        Ok(self.engine()?.time())
     }
 
     /// Time step (settable between runs).
@@ -162,17 +128,6 @@ impl RigidSimulation {
     fn set_dt(&self, dt: f64) -> PyResult<()> {
         self.engine()?.set_dt(crate::stepping::checked_dt(dt)?);
         Ok(())
-    }
-
-    /// Steps taken.
-    #[getter]
-    fn steps(&self) -> PyResult<u64> {
-        Ok(self.engine()?.step())
-    }
-
-    /// Number of bodies.
-    fn __len__(&self) -> PyResult<usize> {
-        Ok(self.engine()?.len())
     }
 
     /// Centres of mass, (N, 3): a writable view of mote's memory.

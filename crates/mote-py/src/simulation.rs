@@ -18,10 +18,9 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::sync::{Mutex, MutexGuard};
 
 use crate::convert::{dict_to_toml, front_error};
-use crate::stepping::{run_loop, time_steps, HasEngine, Stepped};
+use crate::stepping::{simulation_class, time_steps, Stepped};
 
 impl Stepped for Points {
     fn advance(
@@ -43,6 +42,14 @@ impl Stepped for Points {
         })
     }
 
+    fn time(&self) -> f64 {
+        Points::time(self)
+    }
+
+    fn len(&self) -> usize {
+        Points::len(self)
+    }
+
     fn describe(&self) -> String {
         format!(
             "{}: {} particles, dt = {}",
@@ -53,44 +60,14 @@ impl Stepped for Points {
     }
 }
 
-/// A time-stepped simulation (gravity, springs, Lennard-Jones, granular,
-/// dipoles, Brownian dynamics) built from a scene: a file, a TOML string
-/// or a dict with the keys of docs/scene-format.md.
-///
-/// >>> sim = mote.Simulation.from_file("examples/sun-earth.toml")
-/// >>> sim.run(until=365.25)
-/// >>> sim.positions[1]
-#[pyclass(module = "mote")]
-pub struct Simulation {
-    /// Behind a lock: Python may call from several threads.
-    engine: Mutex<Points>,
-}
-
 impl Simulation {
-    fn new(engine: Points) -> Self {
-        Simulation {
-            engine: Mutex::new(engine),
-        }
-    }
-
     fn build(
         input: &mote_front::Input,
         seed: Option<u64>,
         output: Option<PathBuf>,
     ) -> PyResult<Self> {
         let run = Points::build(input, seed, output.as_deref()).map_err(front_error)?;
-        Ok(Simulation::new(run))
-    }
-
-    fn engine(&self) -> PyResult<MutexGuard<'_, Points>> {
-        crate::stepping::lock(&self.engine)
-    }
-}
-
-impl HasEngine for Simulation {
-    type Engine = Points;
-    fn engine(&self) -> PyResult<MutexGuard<'_, Points>> {
-        crate::stepping::lock(&self.engine)
+        Ok(Simulation::wrap(run))
     }
 }
 
@@ -153,8 +130,17 @@ fn copy_in(values: &Bound<'_, PyAny>, target: &mut [DVec3], what: &str) -> PyRes
     Ok(())
 }
 
-#[pymethods]
-impl Simulation {
+simulation_class! {
+    /// A time-stepped simulation (gravity, springs, Lennard-Jones, granular,
+    /// dipoles, Brownian dynamics) built from a scene: a file, a TOML string
+    /// or a dict with the keys of docs/scene-format.md.
+    ///
+    /// >>> sim = mote.Simulation.from_file("examples/sun-earth.toml")
+    /// >>> sim.run(until=365.25)
+    /// >>> sim.positions[1]
+    pub struct Simulation(Points);
+    unit = "steps", every = 100;
+
     /// A scene file or `example:NAME`; `seed` replaces the scene's. With
     /// `output` (a folder), the run writes there what `mote run` writes as
     /// it goes (observables.csv, the trajectory, on the scene's `[output]`
@@ -203,7 +189,7 @@ impl Simulation {
         let cp =
             mote_io::checkpoint::read(&path).map_err(|e| PyValueError::new_err(e.to_string()))?;
         let run = Points::resume(&cp, &path.display().to_string()).map_err(front_error)?;
-        Ok(Simulation::new(run))
+        Ok(Simulation::wrap(run))
     }
 
     /// Writes a checkpoint: `Simulation.resume(path)` and `mote run
@@ -211,37 +197,6 @@ impl Simulation {
     fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
         let cp = self.engine()?.checkpoint().map_err(front_error)?;
         mote_io::checkpoint::write(&path, &cp).map_err(|e| crate::MoteError::new_err(e.to_string()))
-    }
-
-    /// Advances `n` steps (the GIL is released meanwhile).
-    #[pyo3(signature = (n=1))]
-    fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
-        let mut guard = self.engine()?;
-        let engine = &mut *guard;
-        py.detach(|| Points::advance(engine, n, false, &mut |_, _| {}))
-            .map_err(front_error)
-    }
-
-    /// Runs `steps` steps or until time `until` (the scene's run length
-    /// when neither is given), calling `callback(sim)` every `every` steps
-    /// when given; `progress=True` shows `mote run`'s progress bar on
-    /// stderr. The GIL is released while mote computes.
-    #[pyo3(signature = (steps=None, until=None, callback=None, every=100, progress=false))]
-    fn run(
-        slf: Bound<'_, Self>,
-        steps: Option<u64>,
-        until: Option<f64>,
-        callback: Option<Bound<'_, PyAny>>,
-        every: u64,
-        progress: bool,
-    ) -> PyResult<()> {
-        run_loop(&slf, steps, until, callback, every, progress)
-    }
-
-    /// Simulated time (settable between runs).
-    #[getter]
-    fn time(&self) -> PyResult<f64> {
-        Ok(self.engine()?.time())
     }
 
     #[setter]
@@ -265,20 +220,10 @@ impl Simulation {
         Ok(())
     }
 
-    /// Steps taken.
-    #[getter]
-    fn steps(&self) -> PyResult<u64> {
-        Ok(self.engine()?.step())
-    }
-
     /// The seed of the run's random numbers.
     #[getter]
     fn seed(&self) -> PyResult<u64> {
         Ok(self.engine()?.seed())
-    }
-
-    fn __len__(&self) -> PyResult<usize> {
-        Ok(self.engine()?.len())
     }
 
     /// Positions, (N, 3): a view of mote's memory; writes reach the next step.

@@ -29,7 +29,99 @@ pub trait Stepped: Send {
     fn steps_for(&self, steps: Option<u64>, until: Option<f64>) -> PyResult<u64>;
     /// The opening line's description (label, size, step).
     fn describe(&self) -> String;
+    /// The simulated time.
+    fn time(&self) -> f64;
+    /// The number of particles (bodies for clumps).
+    fn len(&self) -> usize;
 }
+
+/// Defines a Python simulation class once: the struct holding its engine
+/// behind a lock, and the methods every class has — `step`, `run`, the
+/// `time` and `steps` getters, `len()` — beside the class's own. `unit`
+/// names a step in the docstrings ("steps", "output intervals"); `every`
+/// is `run`'s default callback interval.
+macro_rules! simulation_class {
+    (
+        $(#[$attr:meta])*
+        pub struct $class:ident($engine:ty);
+        unit = $unit:literal, every = $every:literal;
+        $($own:tt)*
+    ) => {
+        $(#[$attr])*
+        #[pyo3::pyclass(module = "mote")]
+        pub struct $class {
+            /// Behind a lock: Python may call from several threads.
+            engine: std::sync::Mutex<$engine>,
+        }
+
+        impl $class {
+            fn wrap(engine: $engine) -> Self {
+                $class {
+                    engine: std::sync::Mutex::new(engine),
+                }
+            }
+
+            fn engine(&self) -> pyo3::PyResult<std::sync::MutexGuard<'_, $engine>> {
+                $crate::stepping::lock(&self.engine)
+            }
+        }
+
+        impl $crate::stepping::HasEngine for $class {
+            type Engine = $engine;
+            fn engine(&self) -> pyo3::PyResult<std::sync::MutexGuard<'_, $engine>> {
+                $crate::stepping::lock(&self.engine)
+            }
+        }
+
+        #[pyo3::pymethods]
+        impl $class {
+            #[doc = concat!("Advances `n` ", $unit, " (the GIL is released meanwhile).")]
+            #[pyo3(signature = (n=1))]
+            fn step(&self, py: pyo3::Python<'_>, n: u64) -> pyo3::PyResult<()> {
+                let mut guard = self.engine()?;
+                let engine = &mut *guard;
+                py.detach(|| $crate::stepping::Stepped::advance(engine, n, false, &mut |_, _| {}))
+            }
+
+            #[doc = concat!(
+                "Runs `steps` ", $unit, ", or to the first step at time `until` or past it ",
+                "(where the class steps in time), or to the scene's end when neither is given, calling `callback(sim)` every `every` ", $unit,
+                " when given; `progress=True` shows `mote run`'s progress bar on stderr. ",
+                "The GIL is released while mote computes."
+            )]
+            #[pyo3(signature = (steps=None, until=None, callback=None, every=$every, progress=false))]
+            fn run(
+                slf: pyo3::Bound<'_, Self>,
+                steps: Option<u64>,
+                until: Option<f64>,
+                callback: Option<pyo3::Bound<'_, pyo3::PyAny>>,
+                every: u64,
+                progress: bool,
+            ) -> pyo3::PyResult<()> {
+                $crate::stepping::run_loop(&slf, steps, until, callback, every, progress)
+            }
+
+            /// Simulated time.
+            #[getter]
+            fn time(&self) -> pyo3::PyResult<f64> {
+                Ok($crate::stepping::Stepped::time(&*self.engine()?))
+            }
+
+            #[doc = concat!("The ", $unit, " taken.")]
+            #[getter]
+            fn steps(&self) -> pyo3::PyResult<u64> {
+                Ok($crate::stepping::Stepped::step(&*self.engine()?))
+            }
+
+            fn __len__(&self) -> pyo3::PyResult<usize> {
+                Ok($crate::stepping::Stepped::len(&*self.engine()?))
+            }
+
+            $($own)*
+        }
+    };
+}
+pub(crate) use simulation_class;
 
 /// The steps of a time-stepped run from `time` with steps of `dt`: `steps`,
 /// or to the first step at or past `until` (`mote run --until`'s rule), or

@@ -421,3 +421,21 @@ def test_python_depends_on_no_engine_crate():
     names = set(re.findall(r"^([a-z0-9_-]+)\s*=", deps, re.M))
     assert "mote-front" in names
     assert not names & {"mote-md", "mote-edmd", "mote-nip", "mote-geom"}, names
+
+
+def test_every_simulation_class_steps_and_runs_the_same_way():
+    # One definition (stepping.rs's simulation_class!): the same stepping
+    # surface on every class, with the unit of its step in the docstrings.
+    for cls, unit in [
+        (mote.Simulation, "steps"),
+        (mote.RigidSimulation, "steps"),
+        (mote.HardSpheres, "output intervals"),
+    ]:
+        assert cls.step.__text_signature__ == "($self, n=1)"
+        run = cls.run.__text_signature__
+        assert run.startswith("($self, steps=None, until=None, callback=None, every="), run
+        assert run.endswith(", progress=False)"), run
+        assert f"Advances `n` {unit}" in cls.step.__doc__
+        assert f"The {unit} taken" in cls.steps.__doc__
+        for attribute in ("time", "steps", "__len__", "observables"):
+            assert hasattr(cls, attribute), (cls, attribute)
