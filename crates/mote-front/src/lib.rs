@@ -260,10 +260,24 @@ const WHY_NO_SOLVER: &str = "collisions are predicted exactly; there is no integ
 /// Why `--system` means nothing to a TOML scene.
 const WHY_NO_SYSTEM: &str = "it chooses the model of an MPPphys particle file";
 
-/// "1 thread" / "2 threads".
+/// Refuses a SIMD level `MOTE_SIMD` forces that this CPU or build lacks
+/// (callers check once, before anything runs; the kernels would fall back
+/// to the widest level without a word).
+pub fn check_simd_request() -> Result<(), FrontError> {
+    mote_geom::simd::requested()
+        .map(|_| ())
+        .map_err(FrontError::Request)
+}
+
+/// "1 thread, AVX-512" / "2 threads, AVX2 + FMA (portable kernels)": the
+/// threads and the SIMD level the kernels run at (`MOTE_SIMD` forces one).
 fn threads_phrase() -> String {
     let n = rayon::current_num_threads();
-    format!("{n} thread{}", if n == 1 { "" } else { "s" })
+    format!(
+        "{n} thread{}, {}",
+        if n == 1 { "" } else { "s" },
+        mote_geom::simd::isa().name()
+    )
 }
 
 /// ", seed 7" or ", seed 7 (chosen)".

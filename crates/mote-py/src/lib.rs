@@ -36,6 +36,8 @@ pyo3::create_exception!(
 #[pymodule]
 fn _mote(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    mote_front::check_simd_request()
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
     m.add("MoteError", py.get_type::<MoteError>())?;
     m.add("UnstableError", py.get_type::<UnstableError>())?;
     m.add_class::<simulation::Simulation>()?;

@@ -128,7 +128,12 @@ fn main() -> ExitCode {
         Command::Plot(args) => cmd::plot::run(&global, args),
         Command::View(args) => cmd::view::run(&global, args),
     };
-    let result = pool.and_then(|pool| pool.install(command));
+    // A SIMD level forced by MOTE_SIMD that this CPU or build lacks is
+    // refused before anything runs (not quietly replaced).
+    let result = mote_geom::simd::requested()
+        .map_err(anyhow::Error::msg)
+        .and(pool)
+        .and_then(|pool| pool.install(command));
     ended(match result {
         Ok(code) => code,
         Err(err) => {

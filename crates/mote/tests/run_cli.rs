@@ -973,3 +973,40 @@ fn a_trajectory_given_to_run_is_named_with_what_to_do() {
     let o = mote(&["run", "two.txt", "--steps", "2", "-o", "p"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// The opening line names the SIMD level; `MOTE_SIMD` forces one, and a
+/// level the CPU lacks or a name that is none is refused before anything
+/// runs (never quietly replaced by another).
+#[test]
+fn the_simd_level_is_named_and_a_forced_one_the_cpu_lacks_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |level: &str| {
+        Command::new(env!("CARGO_BIN_EXE_mote"))
+            .args(["run", "example:sun-earth", "--steps", "2", "-o", "se"])
+            .env("MOTE_SIMD", level)
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    let o = run("avx2");
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The opening line goes to stderr with the progress.
+    let opening = stderr(&o);
+    assert!(opening.contains("AVX2 + FMA (portable kernels)"), "{opening}");
+    let o = run("sse9");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("MOTE_SIMD=sse9: expected avx512, avx2 or portable"));
+    let o = run("avx512");
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+    {
+        assert!(stderr(&o).contains("AVX-512"), "{}", stderr(&o));
+    } else {
+        assert_eq!(o.status.code(), Some(1));
+        assert!(
+            stderr(&o).contains("MOTE_SIMD=avx512: this CPU lacks it"),
+            "{}",
+            stderr(&o)
+        );
+    }
+}
