@@ -26,6 +26,7 @@
 
 pub mod grids;
 mod inertia;
+pub mod lanes;
 mod objects;
 mod placement;
 mod rotation;

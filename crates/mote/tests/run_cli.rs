@@ -992,7 +992,10 @@ fn the_simd_level_is_named_and_a_forced_one_the_cpu_lacks_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
     // The opening line goes to stderr with the progress.
     let opening = stderr(&o);
-    assert!(opening.contains("AVX2 + FMA (portable kernels)"), "{opening}");
+    assert!(
+        opening.contains("AVX2 + FMA (portable kernels)"),
+        "{opening}"
+    );
     let o = run("sse9");
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("MOTE_SIMD=sse9: expected avx512, avx2 or portable"));

@@ -64,6 +64,7 @@ use rayon::prelude::*;
 
 mod avx512;
 mod listed;
+mod portable;
 mod tiled;
 
 use super::{Interaction, Spin, State, Virial};

@@ -23,6 +23,9 @@ use glam::DVec3;
 use mote_geom::simd::Isa;
 use rayon::prelude::*;
 
+use mote_geom::lanes::{Lanes, LANES};
+
+use super::portable::pair_lanes;
 use super::{DipoleDipole, Kernel, Soa};
 
 /// Above this many particles the reaction arrays would pass ~100 MB.
@@ -80,9 +83,10 @@ pub(super) struct TileRow {
     reactions: Reactions,
 }
 
-/// Force and torque on i (returned with the pairs' virial) from the pairs
-/// (i, j), j in `j_start..j_end` and j < n, with the reactions added to
-/// `r` at j − base; one pair at a time through [`Kernel::pair`].
+/// Force, torque and virial share of row i over partners
+/// `j_start..j_end` (those below `n`), each pair's reaction (−F, τ_j)
+/// added to `r` at `j − base`: the portable twin of the AVX-512 rows,
+/// eight partners at a time on [`Lanes`].
 #[allow(clippy::too_many_arguments)]
 pub(super) fn reacting_row_portable(
     kern: &Kernel,
@@ -94,27 +98,57 @@ pub(super) fn reacting_row_portable(
     base: usize,
     r: &mut Reactions,
 ) -> (DVec3, DVec3, f64) {
-    let ri = DVec3::new(s.x[i], s.y[i], s.z[i]);
-    let a = DVec3::new(s.mx[i], s.my[i], s.mz[i]);
-    let (mut f, mut t, mut w) = (DVec3::ZERO, DVec3::ZERO, 0.0);
-    for j in j_start..j_end.min(n) {
-        let d = ri - DVec3::new(s.x[j], s.y[j], s.z[j]);
-        let r2 = d.length_squared();
-        if r2 > 0.0 {
-            let (_, fi, ti, tj, wi) = kern.pair(d, r2, a, DVec3::new(s.mx[j], s.my[j], s.mz[j]));
-            f += fi;
-            t += ti;
-            w += wi;
-            let k = j - base;
-            r.fx[k] -= fi.x;
-            r.fy[k] -= fi.y;
-            r.fz[k] -= fi.z;
-            r.tx[k] += tj.x;
-            r.ty[k] += tj.y;
-            r.tz[k] += tj.z;
+    let a = [s.mx[i], s.my[i], s.mz[i]];
+    let j_max = j_end.min(n);
+    let zero = Lanes::splat(0.0);
+    let (mut f, mut t, mut w) = ([zero; 3], [zero; 3], zero);
+    let mut j0 = j_start;
+    while j0 < j_max {
+        // Lanes past the row's end hold no separation and no moment.
+        let live = (j_max - j0).min(LANES);
+        let apart = |v: &[f64], centre: f64| {
+            let d = Lanes::load(v, j0, live).map(|x| centre - x);
+            if live == LANES {
+                d
+            } else {
+                d * Lanes::load(&[1.0; LANES], 0, live)
+            }
+        };
+        let p = pair_lanes(
+            kern,
+            [
+                apart(&s.x, s.x[i]),
+                apart(&s.y, s.y[i]),
+                apart(&s.z, s.z[i]),
+            ],
+            a,
+            [
+                Lanes::load(&s.mx, j0, live),
+                Lanes::load(&s.my, j0, live),
+                Lanes::load(&s.mz, j0, live),
+            ],
+        );
+        for c in 0..3 {
+            f[c] = f[c] + p.force[c];
+            t[c] = t[c] + p.torque_i[c];
         }
+        w = w + p.virial;
+        let k = j0 - base;
+        for l in 0..live {
+            r.fx[k + l] -= p.force[0].0[l];
+            r.fy[k + l] -= p.force[1].0[l];
+            r.fz[k + l] -= p.force[2].0[l];
+            r.tx[k + l] += p.torque_j[0].0[l];
+            r.ty[k + l] += p.torque_j[1].0[l];
+            r.tz[k + l] += p.torque_j[2].0[l];
+        }
+        j0 += live;
     }
-    (f, t, w)
+    (
+        DVec3::new(f[0].sum(), f[1].sum(), f[2].sum()),
+        DVec3::new(t[0].sum(), t[1].sum(), t[2].sum()),
+        w.sum(),
+    )
 }
 
 impl DipoleDipole {
