@@ -1,11 +1,16 @@
-//! Portable kernels: exact square root and division, any CPU.
+//! Portable kernels: exact square root and division, any CPU; the tiled
+//! pairs on mote-geom's [`Lanes`].
 
 use glam::DVec3;
+use mote_geom::lanes::{Lanes, LANES};
 
 use super::Soa;
 
 /// Own pull on i of the pairs (i, j), j in j_start..j_end, returned; the
-/// reactions −m_i d/r³ are added to r·[j − base].
+/// reactions −m_i d/r³ are added to r·[j − base]. Eight partners at a time
+/// on [`Lanes`] (the build's target vectorises them), the lanes' sums
+/// added in a fixed order; a pair at no distance (r² = 0) adds nothing,
+/// and a lane past `j_end` has no mass and writes no reaction.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn pairs(
     i: usize,
@@ -19,22 +24,30 @@ pub(super) fn pairs(
     rz: &mut [f64],
 ) -> DVec3 {
     let (xi, yi, zi, mi) = (p.x[i], p.y[i], p.z[i], p.m[i]);
-    let mut a = DVec3::ZERO;
-    for j in j_start..j_end {
-        let (dx, dy, dz) = (p.x[j] - xi, p.y[j] - yi, p.z[j] - zi);
+    let zero = Lanes::splat(0.0);
+    let (mut ax, mut ay, mut az) = (zero, zero, zero);
+    let mut j0 = j_start;
+    while j0 < j_end {
+        let live = (j_end - j0).min(LANES);
+        let dx = Lanes::load(p.x, j0, live) - xi;
+        let dy = Lanes::load(p.y, j0, live) - yi;
+        let dz = Lanes::load(p.z, j0, live) - zi;
         let r2 = dx * dx + dy * dy + dz * dz + eps2;
-        if r2 > 0.0 {
-            let s = 1.0 / (r2 * r2.sqrt());
-            let sj = s * p.m[j];
-            a += DVec3::new(sj * dx, sj * dy, sj * dz);
-            let si = s * mi;
-            let k = j - base;
-            rx[k] -= si * dx;
-            ry[k] -= si * dy;
-            rz[k] -= si * dz;
+        let s = (r2 * r2.sqrt()).recip_or_zero();
+        let sj = s * Lanes::load(p.m, j0, live);
+        ax = ax + sj * dx;
+        ay = ay + sj * dy;
+        az = az + sj * dz;
+        let si = s * mi;
+        let k = j0 - base;
+        for l in 0..live {
+            rx[k + l] -= si.0[l] * dx.0[l];
+            ry[k + l] -= si.0[l] * dy.0[l];
+            rz[k + l] -= si.0[l] * dz.0[l];
         }
+        j0 += live;
     }
-    a
+    DVec3::new(ax.sum(), ay.sum(), az.sum())
 }
 
 /// Σ_{j≠i} m_j d_j / (|d_j|² + ε²)^{3/2}, d_j = r_j − r_i (every j).
