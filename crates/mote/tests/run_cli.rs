@@ -978,6 +978,7 @@ fn a_trajectory_given_to_run_is_named_with_what_to_do() {
 /// level the CPU lacks or a name that is none is refused before anything
 /// runs (never quietly replaced by another).
 #[test]
+#[cfg(target_arch = "x86_64")]
 fn the_simd_level_is_named_and_a_forced_one_the_cpu_lacks_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let run = |level: &str| {
