@@ -1278,20 +1278,33 @@ impl<const D: usize> System<D> {
         let b = dot(&r, &v);
         let r2 = dot(&r, &r);
         let (mi, mj) = (self.mass[i], self.mass[j]);
-        let mu = mi * mj / (mi + mj);
         // Δp_i = −2 μ (b / r²) r; growing: −2 μ ((b − s|r|) / r²) r
-        let (f, virial) = if self.growth == 0.0 {
-            (-2.0 * mu * b / r2, -2.0 * mu * b)
+        let b = if self.growth == 0.0 {
+            b
         } else {
-            let s = (self.p[i].r + self.p[j].r) * self.growth;
-            let bs = b - s * r2.sqrt();
-            (-2.0 * mu * bs / r2, -2.0 * mu * bs)
+            b - (self.p[i].r + self.p[j].r) * self.growth * r2.sqrt()
         };
-        for d in 0..D {
-            self.p[i].v[d] += f / mi * r[d];
-            self.p[j].v[d] -= f / mj * r[d];
+        let mu = mi * mj / (mi + mj);
+        if mu.is_normal() {
+            let f = -2.0 * mu * b / r2;
+            for d in 0..D {
+                self.p[i].v[d] += f / mi * r[d];
+                self.p[j].v[d] -= f / mj * r[d];
+            }
+            self.counters.virial += -2.0 * mu * b;
+        } else {
+            // Masses so small (below ~10⁻¹⁵⁴) that m_i m_j underflows: μ = 0
+            // would leave the pair approaching and colliding again at the
+            // same instant for ever. The velocity changes take the mass
+            // fractions m_j/(m_i + m_j), m_i/(m_i + m_j) instead.
+            let (wi, wj) = (mj / (mi + mj), mi / (mi + mj));
+            let f = -2.0 * b / r2;
+            for d in 0..D {
+                self.p[i].v[d] += f * wi * r[d];
+                self.p[j].v[d] -= f * wj * r[d];
+            }
+            self.counters.virial += -2.0 * (mi * wi) * b;
         }
-        self.counters.virial += virial;
         self.counters.collisions += 1;
         self.count[i] = self.count[i].wrapping_add(1);
         self.count[j] = self.count[j].wrapping_add(1);
