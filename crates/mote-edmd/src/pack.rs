@@ -1037,7 +1037,10 @@ impl<const D: usize> Packer<D> {
                     }
                     want = want.min(budget - self.collisions);
                 }
-                self.sys.run_collisions_until(want, f64::INFINITY);
+                if self.collisions_within(want, f64::INFINITY, start).is_none() {
+                    self.harvest();
+                    return Ok(Stop::WallClock);
+                }
                 self.harvest();
                 if self.win_coll < window {
                     continue;
@@ -1058,7 +1061,10 @@ impl<const D: usize> Packer<D> {
             // grow by step/Z over one window's duration
             let delta = f.step / (z * t_w);
             self.restart(delta, t_w)?;
-            let done = self.sys.run_collisions_until(10 * window, t_w);
+            let Some(done) = self.collisions_within(10 * window, t_w, start) else {
+                self.harvest();
+                return Ok(Stop::WallClock);
+            };
             if !done {
                 self.sys.run_until(t_w);
             }
@@ -1067,6 +1073,29 @@ impl<const D: usize> Packer<D> {
             self.win_time = 0.0;
             self.win_coll = 0;
         }
+    }
+
+    /// [`System::run_collisions_until`] that gives up at the wall-clock
+    /// limit, checked every 4096 events (a window of 10⁴ collisions per
+    /// particle ran minutes past `time_limit` when the clock was read only
+    /// between windows): `None` when the limit came first. The events are
+    /// those of the unchecked run.
+    fn collisions_within(&mut self, count: u64, t_end: f64, start: Instant) -> Option<bool> {
+        let Some(limit) = self.settings.wall_clock else {
+            return Some(self.sys.run_collisions_until(count, t_end));
+        };
+        let target = self.sys.counters().collisions + count;
+        let mut events: u32 = 0;
+        while self.sys.counters().collisions < target {
+            if !self.sys.step(t_end) {
+                return Some(false);
+            }
+            events = events.wrapping_add(1);
+            if events.is_multiple_of(4096) && start.elapsed() >= limit {
+                return None;
+            }
+        }
+        Some(true)
     }
 
     /// Runs until a stop criterion fires; `progress` sees every pressure
@@ -1107,7 +1136,10 @@ impl<const D: usize> Packer<D> {
             };
             let horizon = self.sys.horizon();
             let t_end = t_target.min(horizon);
-            let done = self.sys.run_collisions_until(want, t_end);
+            let Some(done) = self.collisions_within(want, t_end, start) else {
+                self.harvest();
+                break Stop::WallClock;
+            };
             if !done {
                 // nothing more before t_end (or no events at all)
                 if t_end.is_finite() {
