@@ -7,7 +7,7 @@
 //! straight. Sums over the lanes go in a fixed order ([`Lanes::sum`]), so
 //! a kernel's bits do not depend on the CPU's vector width.
 
-use std::ops::{Add, Mul, Sub};
+use std::ops::{Add, Div, Mul, Sub};
 
 /// The number of lanes.
 pub const LANES: usize = 8;
@@ -110,6 +110,163 @@ macro_rules! lane_op {
 lane_op!(Add, add, +);
 lane_op!(Sub, sub, -);
 lane_op!(Mul, mul, *);
+lane_op!(Div, div, /);
+
+impl Lanes {
+    /// Bit l set where lane l is below `bound` (a NaN lane is not).
+    #[inline(always)]
+    pub fn bits_below(self, bound: f64) -> u8 {
+        let mut bits = 0u8;
+        #[allow(clippy::needless_range_loop)]
+        for l in 0..LANES {
+            bits |= u8::from(self.0[l] < bound) << l;
+        }
+        bits
+    }
+}
+
+/// Writes `first + l` for every bit l set in `bits`, in increasing l, to
+/// the front of `out` and returns how many: the left-pack that turns a
+/// lane mask into list entries. `out` must have room for eight (it may be
+/// written past the count). With AVX2 it is one table-driven permute and
+/// one store.
+#[inline(always)]
+pub fn pack_indices(bits: u8, first: u32, out: &mut [u32]) -> usize {
+    let out: &mut [u32; LANES] = (&mut out[..LANES]).try_into().expect("eight");
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    {
+        use std::arch::x86_64::*;
+        let order = &PACK_ORDER[bits as usize];
+        // SAFETY: both pointers are to eight u32; unaligned access is used.
+        #[allow(unsafe_code)]
+        unsafe {
+            let index = _mm256_add_epi32(
+                _mm256_set1_epi32(first as i32),
+                _mm256_loadu_si256(order.as_ptr().cast()),
+            );
+            _mm256_storeu_si256(out.as_mut_ptr().cast(), index);
+        }
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    {
+        let mut k = 0;
+        for l in 0..LANES as u32 {
+            out[k] = first + l;
+            k += usize::from(bits >> l & 1 == 1);
+        }
+    }
+    bits.count_ones() as usize
+}
+
+/// For each mask, the set lanes in increasing order (then zeros).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+static PACK_ORDER: [[u32; LANES]; 256] = pack_order();
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+const fn pack_order() -> [[u32; LANES]; 256] {
+    let mut table = [[0u32; LANES]; 256];
+    let mut bits = 0;
+    while bits < 256 {
+        let (mut l, mut k) = (0, 0);
+        while l < LANES {
+            if bits >> l & 1 == 1 {
+                table[bits][k] = l as u32;
+                k += 1;
+            }
+            l += 1;
+        }
+        bits += 1;
+    }
+    table
+}
+
+/// Calls `lanes(index, pad)` on a list row eight entries at a time: full
+/// groups with `pad` zero in every lane, then the rest filled with `fill`
+/// (an index the kernel may load, such as the row's own) and `pad` +∞ in
+/// the filled lanes, which a kernel adds to their r² to put them beyond
+/// every cut-off.
+#[inline(always)]
+pub fn in_eights(row: &[u32], fill: u32, mut lanes: impl FnMut(&[u32; LANES], Lanes)) {
+    let chunks = row.chunks_exact(LANES);
+    let tail = chunks.remainder();
+    for chunk in chunks {
+        lanes(chunk.try_into().expect("eight"), Lanes::splat(0.0));
+    }
+    if !tail.is_empty() {
+        let mut index = [fill; LANES];
+        index[..tail.len()].copy_from_slice(tail);
+        let mut pad = [f64::INFINITY; LANES];
+        pad[..tail.len()].fill(0.0);
+        lanes(&index, Lanes(pad));
+    }
+}
+
+/// Coordinates of eight records gathered into lanes: `[x, y, z]` with
+/// record `index[m]` in lane m. Records are four f64 (x, y, z, pad), the
+/// layout neighbour lists keep their copies in. With AVX2 (the build's
+/// x86-64-v3) each four records are loaded as 128-bit halves and
+/// transposed by in-lane unpacks — eight loads and three shuffles, where
+/// a per-lane gather costs a load and an insert per coordinate.
+#[inline(always)]
+pub fn gather_xyz(records: &[[f64; 4]], index: &[u32; LANES]) -> [Lanes; 3] {
+    for &i in index {
+        assert!(
+            (i as usize) < records.len(),
+            "record {i} of {}",
+            records.len()
+        );
+    }
+    // SAFETY: every index was checked against the records just above.
+    #[allow(unsafe_code)]
+    unsafe {
+        gather_xyz_unchecked(records, index)
+    }
+}
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[inline(always)]
+#[allow(unsafe_code)]
+unsafe fn gather_xyz_unchecked(records: &[[f64; 4]], index: &[u32; LANES]) -> [Lanes; 3] {
+    use std::arch::x86_64::*;
+    let base = records.as_ptr() as *const f64;
+    let mut out = [[0.0; LANES]; 3];
+    for half in 0..2 {
+        // SAFETY: the caller checked every index; a record is four f64.
+        let at = |m: usize| unsafe { base.add(4 * index[4 * half + m] as usize) };
+        // a_m = (x_m, y_m | x_{m+2}, y_{m+2}), b_m the same of (z, pad)
+        let pair = |m: usize, offset: usize| unsafe {
+            _mm256_insertf128_pd::<1>(
+                _mm256_castpd128_pd256(_mm_loadu_pd(at(m).add(offset))),
+                _mm_loadu_pd(at(m + 2).add(offset)),
+            )
+        };
+        let (a0, a1) = (pair(0, 0), pair(1, 0));
+        let (b0, b1) = (pair(0, 2), pair(1, 2));
+        let lanes = 4 * half;
+        // SAFETY: each store writes four of the eight f64 of a lane array.
+        unsafe {
+            _mm256_storeu_pd(out[0][lanes..].as_mut_ptr(), _mm256_unpacklo_pd(a0, a1));
+            _mm256_storeu_pd(out[1][lanes..].as_mut_ptr(), _mm256_unpackhi_pd(a0, a1));
+            _mm256_storeu_pd(out[2][lanes..].as_mut_ptr(), _mm256_unpacklo_pd(b0, b1));
+        }
+    }
+    out.map(Lanes)
+}
+
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+#[inline(always)]
+#[allow(unsafe_code)]
+unsafe fn gather_xyz_unchecked(records: &[[f64; 4]], index: &[u32; LANES]) -> [Lanes; 3] {
+    let mut out = [[0.0; LANES]; 3];
+    for (m, &i) in index.iter().enumerate() {
+        // SAFETY: the caller checked every index.
+        let r = unsafe { records.get_unchecked(i as usize) };
+        for (c, o) in out.iter_mut().enumerate() {
+            o[m] = r[c];
+        }
+    }
+    out.map(Lanes)
+}
 
 #[cfg(test)]
 mod tests {
@@ -142,5 +299,46 @@ mod tests {
         // The sum is in lane order, not pairwise: 1e16 + 1 − 1e16 … shows it.
         let s = Lanes([1e16, 1.0, -1e16, 1.0, 0.0, 0.0, 0.0, 0.0]).sum();
         assert_eq!(s, ((1e16 + 1.0) - 1e16) + 1.0);
+    }
+
+    #[test]
+    fn records_gather_into_coordinate_lanes() {
+        let records: Vec<[f64; 4]> = (0..20)
+            .map(|i| {
+                let i = i as f64;
+                [i, 100.0 + i, 200.0 + i, -1.0]
+            })
+            .collect();
+        let index = [7, 0, 19, 3, 3, 12, 5, 18];
+        let [x, y, z] = gather_xyz(&records, &index);
+        for (m, &i) in index.iter().enumerate() {
+            assert_eq!([x.0[m], y.0[m], z.0[m]], records[i as usize][..3]);
+        }
+    }
+
+    #[test]
+    fn masks_pack_into_list_entries_in_lane_order() {
+        let r2 = Lanes([0.5, 3.0, 1.0, f64::NAN, 2.0, 0.1, 9.0, 1.5]);
+        let bits = r2.bits_below(2.0);
+        assert_eq!(bits, 0b1010_0101);
+        let mut out = [0u32; 10];
+        assert_eq!(pack_indices(bits, 100, &mut out[1..]), 4);
+        assert_eq!(out[1..5], [100, 102, 105, 107]);
+        for bits in 0..=255u8 {
+            let mut out = [0u32; 8];
+            let n = pack_indices(bits, 7, &mut out);
+            let want: Vec<u32> = (0..8)
+                .filter(|l| bits >> l & 1 == 1)
+                .map(|l| 7 + l)
+                .collect();
+            assert_eq!(out[..n], want[..], "mask {bits:08b}");
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "record 20 of 20")]
+    fn a_record_beyond_the_slice_is_refused() {
+        let records = vec![[0.0; 4]; 20];
+        gather_xyz(&records, &[0, 1, 2, 3, 20, 5, 6, 7]);
     }
 }

@@ -10,7 +10,7 @@ pub mod ewald;
 pub mod granular;
 mod gravity;
 pub mod latent;
-mod lennard_jones;
+pub mod lennard_jones;
 pub mod slab;
 mod springs;
 mod uniform;

@@ -9,14 +9,17 @@
 //! The pair loop runs over a [`GhostList`]: a full list (each pair seen from
 //! both sides) over cell-sorted copies with periodic images as ghosts, so a
 //! row sums the force on one particle from plain coordinate differences and
-//! writes nothing else. Rows go eight neighbours at a time with AVX-512 where
-//! the CPU has it (`avx512.rs`, 1/r² from `vrcp14pd` and two Newton steps),
-//! else through the portable loop below; the two agree to a few ulp. Rows are
-//! summed in fixed blocks, so every thread count gives the same bits.
+//! writes nothing else. Rows go eight neighbours at a time: with AVX-512
+//! where the CPU has it (`avx512.rs`, 1/r² from `vrcp14pd` and two Newton
+//! steps), else on [`Lanes`] (every CPU: AVX2 on the x86-64-v3 build, NEON
+//! on aarch64); the one-neighbour-at-a-time loop [`row_reference`] is what
+//! both are tested against, to a few ulp. Rows are summed in fixed blocks,
+//! so every thread count gives the same bits.
 
 use super::{Interaction, State, Virial};
 use crate::neighbor::{Copy4, GhostList};
 use glam::DVec3;
+use mote_geom::lanes::{self, Lanes};
 
 #[cfg(target_arch = "x86_64")]
 mod avx512;
@@ -33,7 +36,29 @@ pub struct LennardJones {
     virial: f64,
     /// Force on the particle of each row (see [`GhostList`]).
     sorted_force: Vec<DVec3>,
-    simd: bool,
+    rows: Rows,
+}
+
+/// The row kernels of [`LennardJones`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rows {
+    /// Eight neighbours at a time in AVX-512 registers (where the CPU has it).
+    Avx512,
+    /// Eight neighbours at a time on [`Lanes`] (every CPU).
+    Lanes,
+    /// One neighbour at a time: the reference the others are tested against.
+    Reference,
+}
+
+impl Rows {
+    /// The fastest the CPU (and `MOTE_SIMD`) allows.
+    pub fn fastest() -> Self {
+        if mote_geom::simd::has_avx512() {
+            Rows::Avx512
+        } else {
+            Rows::Lanes
+        }
+    }
 }
 
 /// The constants of a row kernel: with s⁶ = (σ²/r²)³,
@@ -69,7 +94,7 @@ impl LennardJones {
             list: GhostList::new(cutoff, skin),
             virial: 0.0,
             sorted_force: Vec::new(),
-            simd: simd_available(),
+            rows: Rows::fastest(),
         }
     }
 
@@ -78,11 +103,14 @@ impl LennardJones {
         Self::new(epsilon, sigma, 2f64.powf(1.0 / 6.0) * sigma, true, skin)
     }
 
-    /// Uses the AVX-512 rows where the CPU has them (the default) or the
-    /// portable loop; for tests that compare the two.
+    /// Runs `rows` (AVX-512 falls back to lanes on a CPU without it); for
+    /// tests that compare the kernels.
     #[doc(hidden)]
-    pub fn set_simd(&mut self, on: bool) {
-        self.simd = on && simd_available();
+    pub fn set_rows(&mut self, rows: Rows) {
+        self.rows = match rows {
+            Rows::Avx512 => Rows::fastest(),
+            other => other,
+        };
     }
 
     /// U(r_c), the shift.
@@ -125,49 +153,81 @@ impl LennardJones {
     fn rows(&self, sorted_force: &mut [DVec3], energy: bool) -> (f64, f64) {
         let list = &self.list;
         let c = self.coefficients();
-        let simd = self.simd;
+        let kernel = self.rows;
         let [w, u] = list.sum_rows(sorted_force, |r| {
-            let s = row(list, r, &c, energy, simd);
+            let s = row(list, r, &c, energy, kernel);
             (s.force, [s.virial, s.energy])
         });
         (0.5 * w, 0.5 * u)
     }
 }
 
-fn simd_available() -> bool {
-    mote_geom::simd::has_avx512()
-}
-
-/// The sums of row r, by the AVX-512 kernel or the portable one.
+/// The sums of row r, by `kernel`.
 #[inline]
-fn row(list: &GhostList, r: usize, c: &Coefficients, energy: bool, simd: bool) -> RowSum {
-    #[cfg(target_arch = "x86_64")]
-    if simd {
-        // SAFETY: `simd` is set only where AVX-512F exists; every listed
-        // neighbour and k itself index the coordinate arrays.
-        return unsafe {
-            avx512::row(
-                list.owner[r] as usize,
-                list.row(r),
-                &list.position,
-                c,
-                energy,
-            )
-        };
+fn row(list: &GhostList, r: usize, c: &Coefficients, energy: bool, kernel: Rows) -> RowSum {
+    let (k, neighbours) = (list.owner[r] as usize, list.row(r));
+    match kernel {
+        #[cfg(target_arch = "x86_64")]
+        Rows::Avx512 => {
+            // SAFETY: `Rows::Avx512` is chosen only where AVX-512F exists;
+            // every listed neighbour and k itself index the coordinates.
+            unsafe { avx512::row(k, neighbours, &list.position, c, energy) }
+        }
+        Rows::Reference => row_reference(k, neighbours, &list.position, c, energy),
+        _ if energy => row_lanes::<true>(k, neighbours, &list.position, c),
+        _ => row_lanes::<false>(k, neighbours, &list.position, c),
     }
-    let _ = simd;
-    row_portable(
-        list.owner[r] as usize,
-        list.row(r),
-        &list.position,
-        c,
-        energy,
-    )
 }
 
-/// One row, one neighbour at a time, without branches on the distance.
+/// One row, eight neighbours at a time on [`Lanes`]: the pair law of
+/// [`row_reference`] lane by lane, each pair's force the same bits; the
+/// row's sums go lane by lane, then over the lanes in order. Lanes filled
+/// past the row's end sit at r² = ∞ and add nothing; a neighbour at no
+/// distance is inside the cut-off and gives a non-finite force, as it must.
 #[inline]
-fn row_portable(
+fn row_lanes<const ENERGY: bool>(
+    k: usize,
+    row: &[u32],
+    position: &[Copy4],
+    c: &Coefficients,
+) -> RowSum {
+    let records = Copy4::records(position);
+    let [xi, yi, zi, _] = position[k].0;
+    let zero = Lanes::splat(0.0);
+    let (mut fx, mut fy, mut fz, mut w, mut u) = (zero, zero, zero, zero, zero);
+    lanes::in_eights(row, k as u32, |index, pad| {
+        let [xj, yj, zj] = lanes::gather_xyz(records, index);
+        let (dx, dy, dz) = (
+            Lanes::splat(xi) - xj,
+            Lanes::splat(yi) - yj,
+            Lanes::splat(zi) - zj,
+        );
+        let d2 = dx * dx + dy * dy + dz * dz;
+        let r2 = d2 + pad;
+        let inside = r2.select_below(c.cutoff2, 1.0, 0.0);
+        let inv = Lanes::splat(1.0) / r2;
+        let s2 = inv * c.sigma2;
+        let s6 = s2 * s2 * s2;
+        let f = inv * s6 * (s6 * c.eps48 - c.eps24) * inside;
+        fx = fx + f * dx;
+        fy = fy + f * dy;
+        fz = fz + f * dz;
+        w = w + f * d2;
+        if ENERGY {
+            u = u + (s6 * (s6 * c.eps4 - c.eps4) - c.shift) * inside;
+        }
+    });
+    RowSum {
+        force: DVec3::new(fx.sum(), fy.sum(), fz.sum()),
+        virial: w.sum(),
+        energy: u.sum(),
+    }
+}
+
+/// One row, one neighbour at a time, without branches on the distance:
+/// the reference of the other kernels.
+#[inline]
+fn row_reference(
     k: usize,
     row: &[u32],
     position: &[Copy4],
