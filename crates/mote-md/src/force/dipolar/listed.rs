@@ -13,9 +13,11 @@
 //! not τ_j.
 
 use glam::DVec3;
+use mote_geom::lanes::{self, Lanes};
 use mote_geom::simd::Isa;
 use rayon::prelude::*;
 
+use super::portable::pair_lanes;
 use super::{DipoleDipole, Kernel};
 use crate::boundary::Boundary;
 use crate::neighbor::{Copy4, GhostList};
@@ -58,25 +60,75 @@ pub(super) fn row_portable(
     s
 }
 
-/// Row r of `list` by the kernel `isa` names.
+/// One row's force, torque and virial, eight neighbours at a time on
+/// [`Lanes`] ([`pair_lanes`]; no energy). Lanes past the row's end hold
+/// the row's own copy, at no distance, which the pair law leaves out; a
+/// neighbour at no distance gives a force that is not a number, as on the
+/// reference, so that two particles on one spot stop the run.
+pub(super) fn row_lanes(
+    kern: &Kernel,
+    k: usize,
+    row: &[u32],
+    position: &[Copy4],
+    moment: &[Copy4],
+) -> RowSum {
+    let (positions, moments) = (Copy4::records(position), Copy4::records(moment));
+    let [xi, yi, zi, _] = position[k].0;
+    let [ax, ay, az, _] = moment[k].0;
+    let zero = Lanes::splat(0.0);
+    let (mut force, mut torque, mut virial) = ([zero; 3], [zero; 3], zero);
+    let mut coincident = 0u8;
+    lanes::in_eights(row, k as u32, |index, pad| {
+        let [xj, yj, zj] = lanes::gather_xyz(positions, index);
+        let d = [
+            Lanes::splat(xi) - xj,
+            Lanes::splat(yi) - yj,
+            Lanes::splat(zi) - zj,
+        ];
+        let p = pair_lanes(kern, d, [ax, ay, az], lanes::gather_xyz(moments, index));
+        let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + pad;
+        coincident |= r2.bits_below(f64::MIN_POSITIVE);
+        for c in 0..3 {
+            force[c] = force[c] + p.force[c];
+            torque[c] = torque[c] + p.torque_i[c];
+        }
+        virial = virial + p.virial;
+    });
+    let sum = |v: [Lanes; 3]| DVec3::new(v[0].sum(), v[1].sum(), v[2].sum());
+    RowSum {
+        force: if coincident == 0 {
+            sum(force)
+        } else {
+            DVec3::NAN
+        },
+        torque: sum(torque),
+        virial: virial.sum(),
+        energy: 0.0,
+    }
+}
+
+/// Row r of `list` by the kernel `isa` names (`reference`: one neighbour
+/// at a time).
 #[inline]
 fn row(
     kern: &Kernel,
     list: &GhostList,
     moment: &[Copy4],
     r: usize,
-    isa: Isa,
+    (isa, reference): (Isa, bool),
     energy: bool,
 ) -> RowSum {
     let k = list.owner[r] as usize;
     match isa {
+        _ if reference => row_portable(kern, k, list.row(r), &list.position, moment),
         // SAFETY: `isa` is AVX-512 only where the CPU has it; the row's
         // entries and k index the copies, which `moment` has one of each.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe {
             super::avx512::list_row(kern, k, list.row(r), &list.position, moment, energy)
         },
-        Isa::Portable => row_portable(kern, k, list.row(r), &list.position, moment),
+        Isa::Portable if energy => row_portable(kern, k, list.row(r), &list.position, moment),
+        Isa::Portable => row_lanes(kern, k, list.row(r), &list.position, moment),
     }
 }
 
@@ -100,7 +152,8 @@ impl DipoleDipole {
         }
         let list = &self.list;
         list.gather(dipoles, &mut self.moment);
-        let (kern, isa, moment) = (self.kernel(), self.isa, &self.moment);
+        let (kern, moment) = (self.kernel(), &self.moment);
+        let isa = (self.isa, self.reference_rows);
         self.sorted.resize(pos.len(), (DVec3::ZERO, DVec3::ZERO));
         let [w, u] = list.sum_rows(&mut self.sorted, |r| {
             let s = row(&kern, list, moment, r, isa, energy);

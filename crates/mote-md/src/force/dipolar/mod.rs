@@ -258,6 +258,9 @@ pub struct DipoleDipole {
     tiles: Vec<tiled::TileRow>,
     /// The row kernels' instruction set.
     isa: Isa,
+    /// Run the cut-off rows one neighbour at a time (the reference the
+    /// eight-lane rows are tested against).
+    reference_rows: bool,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -287,6 +290,7 @@ impl DipoleDipole {
             soa: Soa::default(),
             tiles: Vec::new(),
             isa: isa(),
+            reference_rows: false,
         }
     }
 
@@ -351,6 +355,13 @@ impl DipoleDipole {
     #[doc(hidden)]
     pub fn set_simd(&mut self, on: bool) {
         self.isa = if on { isa() } else { Isa::Portable };
+    }
+
+    /// Runs the cut-off rows one neighbour at a time, the reference of
+    /// both eight-lane kernels; for tests.
+    #[doc(hidden)]
+    pub fn set_reference_rows(&mut self, on: bool) {
+        self.reference_rows = on;
     }
 
     fn kernel(&self) -> Kernel {

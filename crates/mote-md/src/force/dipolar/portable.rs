@@ -3,9 +3,8 @@
 //! which the build's target vectorises. Masks are selects: a pair beyond
 //! the dipolar cut-off adds no dipolar term, one beyond the repulsion's
 //! none of it, and an empty lane (zero separation, zero moment) nothing at
-//! all. (The cut-off rows keep their pair-at-a-time portable loop: on
-//! Lanes, gathering the neighbours cost what the vector arithmetic saved,
-//! 7.49 s against 6.97 s for bench/dipole3d.toml without AVX-512.)
+//! all. The cut-off rows use it too (`listed::row_lanes`), their
+//! neighbours gathered by `lanes::gather_xyz`.
 
 use mote_geom::lanes::Lanes;
 
