@@ -1,8 +1,9 @@
-//! The FRBI's free step ([`super::frbi::free_step`]) for eight bodies at
-//! once in AVX-512: the same operations in the same order, each on eight
-//! lanes (one body per lane). No operation is fused or reassociated, so
-//! every lane gets the bits the scalar step gives (tested); CPUs without
-//! AVX-512 take the scalar step body by body.
+//! The FRBI's free step ([`super::frbi::free_step`]), its kick and the
+//! world frame for eight bodies at once — in AVX-512 where the CPU has it,
+//! else on [`mote_geom::lanes::Lanes`] (AVX2 on the x86-64-v3 build, NEON
+//! on aarch64): the same operations in the same order, each on eight lanes
+//! (one body per lane). No operation is fused or reassociated, so every
+//! lane gets the bits the scalar step gives, on both paths (tested).
 //!
 //! Groups with a rotation vector near a half turn (|r|² > 10¹⁰⁰, where the
 //! rotation matrix takes another formula) go through the scalar step; so
@@ -39,6 +40,10 @@ pub fn free_step8(g: &mut Group, dt: f64, flight: FreeFlight, spin: SpinUpdate) 
             return;
         }
     }
+    let vector = flight == FreeFlight::Straight && g.rotation.iter().all(|r| r.dot(*r) <= 1e100);
+    if vector && portable::lanes(g, dt, spin) {
+        return;
+    }
     for l in 0..LANES {
         let (r, x, w) = (&mut g.rotation[l], &mut g.position[l], &mut g.omega[l]);
         free_step(g.inertia[l], r, x, w, g.velocity[l], dt, flight, spin);
@@ -60,6 +65,10 @@ pub fn react8(
         unsafe { avx512::react(inertia, rotation, omega, velocity, impulse) };
         return;
     }
+    if rotation.iter().all(|r| r.dot(*r) <= 1e100) {
+        portable::react(inertia, rotation, omega, velocity, impulse);
+        return;
+    }
     for l in 0..LANES {
         react(
             inertia[l],
@@ -76,7 +85,7 @@ pub fn react8(
 /// x + M b into `centres` (body after body) and dipoles M m₀ into
 /// `dipole`, M = `rotation_matrix(r)`, bit for bit as
 /// `WorldFrame::update` computes them. False, with nothing written, where
-/// the CPU lacks AVX-512 or a rotation is near a half turn.
+/// a rotation is near a half turn.
 pub fn world8(
     rotation: &[DVec3; LANES],
     position: &[DVec3; LANES],
@@ -96,7 +105,10 @@ pub fn world8(
         unsafe { avx512::world(rotation, position, centres0, dipole0, centres, dipole) };
         return true;
     }
-    let _ = (rotation, position, dipole0, dipole);
+    if rotation.iter().all(|r| r.dot(*r) <= 1e100) {
+        portable::world(rotation, position, centres0, dipole0, centres, dipole);
+        return true;
+    }
     false
 }
 
@@ -540,6 +552,330 @@ mod avx512 {
     }
 }
 
+/// The same arithmetic on [`Lanes`], for every CPU: each operation the
+/// scalar step's, in its order, so every lane has its bits (the tests
+/// below hold both paths to them).
+mod portable {
+    use glam::DVec3;
+    use mote_geom::lanes::Lanes;
+    use mote_geom::{Inertia, DE, EPSILON};
+
+    use super::{Group, LANES};
+    use crate::rigid::frbi::SpinUpdate;
+
+    /// Eight vectors, one per lane.
+    #[derive(Clone, Copy)]
+    struct V {
+        x: Lanes,
+        y: Lanes,
+        z: Lanes,
+    }
+
+    impl V {
+        #[inline(always)]
+        fn of(v: &[DVec3; LANES]) -> Self {
+            let coordinate = |k: usize| Lanes(std::array::from_fn(|l| v[l][k]));
+            V {
+                x: coordinate(0),
+                y: coordinate(1),
+                z: coordinate(2),
+            }
+        }
+
+        #[inline(always)]
+        fn splat(v: DVec3) -> Self {
+            V {
+                x: Lanes::splat(v.x),
+                y: Lanes::splat(v.y),
+                z: Lanes::splat(v.z),
+            }
+        }
+
+        #[inline(always)]
+        fn write(self, out: &mut [DVec3; LANES]) {
+            for (l, o) in out.iter_mut().enumerate() {
+                *o = DVec3::new(self.x.0[l], self.y.0[l], self.z.0[l]);
+            }
+        }
+
+        #[inline(always)]
+        fn add(self, o: V) -> V {
+            V {
+                x: self.x + o.x,
+                y: self.y + o.y,
+                z: self.z + o.z,
+            }
+        }
+
+        #[inline(always)]
+        fn sub(self, o: V) -> V {
+            V {
+                x: self.x - o.x,
+                y: self.y - o.y,
+                z: self.z - o.z,
+            }
+        }
+
+        /// Component by component (glam's `DVec3 * DVec3`).
+        #[inline(always)]
+        fn mul(self, o: V) -> V {
+            V {
+                x: self.x * o.x,
+                y: self.y * o.y,
+                z: self.z * o.z,
+            }
+        }
+
+        #[inline(always)]
+        fn scale(self, s: Lanes) -> V {
+            V {
+                x: self.x * s,
+                y: self.y * s,
+                z: self.z * s,
+            }
+        }
+
+        /// (x·x' + y·y') + z·z', glam's order.
+        #[inline(always)]
+        fn dot(self, o: V) -> Lanes {
+            self.x * o.x + self.y * o.y + self.z * o.z
+        }
+
+        /// glam's `cross`, term for term.
+        #[inline(always)]
+        fn cross(self, o: V) -> V {
+            V {
+                x: self.y * o.z - o.y * self.z,
+                y: self.z * o.x - o.z * self.x,
+                z: self.x * o.y - o.x * self.y,
+            }
+        }
+    }
+
+    /// Eight 3 × 3 matrices by columns.
+    #[derive(Clone, Copy)]
+    struct M {
+        x: V,
+        y: V,
+        z: V,
+    }
+
+    impl M {
+        /// glam's `mul_vec3`: ((x_axis v.x) + (y_axis v.y)) + (z_axis v.z).
+        #[inline(always)]
+        fn apply(&self, v: V) -> V {
+            self.x
+                .scale(v.x)
+                .add(self.y.scale(v.y))
+                .add(self.z.scale(v.z))
+        }
+
+        #[inline(always)]
+        fn mul(&self, o: &M) -> M {
+            M {
+                x: self.apply(o.x),
+                y: self.apply(o.y),
+                z: self.apply(o.z),
+            }
+        }
+
+        #[inline(always)]
+        fn transpose(&self) -> M {
+            let column = |x: Lanes, y: Lanes, z: Lanes| V { x, y, z };
+            M {
+                x: column(self.x.x, self.y.x, self.z.x),
+                y: column(self.x.y, self.y.y, self.z.y),
+                z: column(self.x.z, self.y.z, self.z.z),
+            }
+        }
+
+        /// P (d ⊙ Pᵀ x).
+        #[inline(always)]
+        fn sandwich(&self, d: V, x: V) -> V {
+            self.apply(d.mul(self.transpose().apply(x)))
+        }
+    }
+
+    /// The matrix of x ↦ x * r, as `frbi::matrix` (all lanes |r|² ≤ 10¹⁰⁰).
+    #[inline(always)]
+    fn matrix(r: V) -> M {
+        let rr = r.dot(r);
+        let one = Lanes::splat(1.0);
+        let s = one / (one + rr);
+        let c = (one - rr) * s;
+        let t = Lanes::splat(2.0) * s;
+        let (x, y, z) = (r.x, r.y, r.z);
+        let (xy, xz, yz) = (x * y, x * z, y * z);
+        M {
+            x: V {
+                x: c + t * x * x,
+                y: t * (xy + z),
+                z: t * (xz - y),
+            },
+            y: V {
+                x: t * (xy - z),
+                y: c + t * y * y,
+                z: t * (yz + x),
+            },
+            z: V {
+                x: t * (xz + y),
+                y: t * (yz - x),
+                z: c + t * z * z,
+            },
+        }
+    }
+
+    /// `DE::exp_rotation(ω, τ)`: the series of `half_tan_over` where
+    /// φ = |ωτ| < 10⁻³, the scalar function in the other lanes.
+    #[inline(always)]
+    fn exp_rotation(w: V, tau: f64) -> V {
+        let wt = w.scale(Lanes::splat(tau));
+        let phi = wt.dot(wt).sqrt();
+        let p2 = phi * phi;
+        let series = Lanes::splat(0.5) * ((Lanes::splat(1.0) + p2 / 12.0) + p2 * p2 / 120.0);
+        let r = wt.scale(series);
+        let small = phi.bits_below(1e-3);
+        if small == 0xff {
+            return r;
+        }
+        let (mut out, mut omega) = ([DVec3::ZERO; LANES], [DVec3::ZERO; LANES]);
+        r.write(&mut out);
+        w.write(&mut omega);
+        for l in 0..LANES {
+            if small & (1 << l) == 0 {
+                out[l] = DE::exp_rotation(omega[l], tau);
+            }
+        }
+        V::of(&out)
+    }
+
+    /// `compose_rotations(r1, r2)`: 1/s, or 1/ε where |s| < ε.
+    #[inline(always)]
+    fn compose(r1: V, r2: V) -> V {
+        let s = Lanes::splat(1.0) - r1.dot(r2);
+        let big_s = s.map(|s| {
+            if s.abs() < EPSILON {
+                1.0 / EPSILON
+            } else {
+                1.0 / s
+            }
+        });
+        r1.add(r2).sub(r1.cross(r2)).scale(big_s)
+    }
+
+    /// The templates' principal axes A (columns), moments J and 1/J.
+    #[inline(always)]
+    fn principal(inertia: &[&Inertia; LANES]) -> (M, V, V) {
+        let a = M {
+            x: V::of(&inertia.map(|i| i.axes[0])),
+            y: V::of(&inertia.map(|i| i.axes[1])),
+            z: V::of(&inertia.map(|i| i.axes[2])),
+        };
+        let j = V::of(&inertia.map(|i| DVec3::from(i.moments)));
+        let one = Lanes::splat(1.0);
+        let j_inv = V {
+            x: one / j.x,
+            y: one / j.y,
+            z: one / j.z,
+        };
+        (a, j, j_inv)
+    }
+
+    /// `mote_geom::rotate(x, r)` for a constant x, term for term.
+    #[inline(always)]
+    fn rotate(x: DVec3, r: V) -> V {
+        let x = V::splat(x);
+        let rr = r.dot(r);
+        let (one, two) = (Lanes::splat(1.0), Lanes::splat(2.0));
+        let num = x
+            .scale(one - rr)
+            .add(r.scale(two * x.dot(r)))
+            .sub(x.cross(r).scale(two));
+        let den = one + rr;
+        V {
+            x: num.x / den,
+            y: num.y / den,
+            z: num.z / den,
+        }
+    }
+
+    /// [`super::world8`]'s arithmetic (all |r|² ≤ 10¹⁰⁰).
+    pub(super) fn world(
+        rotation: &[DVec3; LANES],
+        position: &[DVec3; LANES],
+        centres0: &[DVec3],
+        dipole0: DVec3,
+        centres: &mut [DVec3],
+        dipole: &mut [DVec3; LANES],
+    ) {
+        let r = V::of(rotation);
+        let m = M {
+            x: rotate(DVec3::X, r),
+            y: rotate(DVec3::Y, r),
+            z: rotate(DVec3::Z, r),
+        };
+        let x = V::of(position);
+        let count = centres0.len();
+        let mut lanes = [DVec3::ZERO; LANES];
+        for (s, b) in centres0.iter().enumerate() {
+            x.add(m.apply(V::splat(*b))).write(&mut lanes);
+            for (l, c) in lanes.iter().enumerate() {
+                centres[l * count + s] = *c;
+            }
+        }
+        m.apply(V::splat(dipole0)).write(dipole);
+    }
+
+    /// `frbi::react` on eight lanes (all |r|² ≤ 10¹⁰⁰).
+    pub(super) fn react(
+        inertia: [&Inertia; LANES],
+        rotation: &[DVec3; LANES],
+        omega: &mut [DVec3; LANES],
+        velocity: &mut [DVec3; LANES],
+        impulse: &[DE; LANES],
+    ) {
+        let (a, _, j_inv) = principal(&inertia);
+        let p = matrix(V::of(rotation)).mul(&a);
+        let angular = V::of(&impulse.map(|h| h.omega));
+        p.sandwich(j_inv, angular).add(V::of(omega)).write(omega);
+        let inverse_mass = Lanes(inertia.map(|i| 1.0 / i.mass));
+        V::of(velocity)
+            .add(V::of(&impulse.map(|h| h.v)).scale(inverse_mass))
+            .write(velocity);
+    }
+
+    /// The free step of `frbi::free_step` (straight flight) on eight
+    /// lanes; false, with the group untouched, if a new rotation vector is
+    /// near a half turn.
+    pub(super) fn lanes(g: &mut Group, dt: f64, spin: SpinUpdate) -> bool {
+        let (a, j, j_inv) = principal(&g.inertia);
+        let tau = 0.5 * dt;
+        let w = V::of(g.omega);
+        let rotation = V::of(g.rotation);
+        let p = matrix(rotation).mul(&a);
+        let l = p.sandwich(j, w);
+        let r_c = exp_rotation(w, tau);
+        let p_c = matrix(r_c).mul(&p);
+        let dl = l.sub(p_c.sandwich(j, w));
+        let dw = p.sandwich(j_inv, dl);
+        let w_c = w.add(dw);
+        let rotation = compose(rotation, exp_rotation(w_c, dt));
+        // Not `bits_below`: a NaN lane goes on, as in the scalar step.
+        if rotation.dot(rotation).0.iter().any(|rr| *rr > 1e100) {
+            return false;
+        }
+        let position = V::of(g.position).add(V::of(g.velocity).scale(Lanes::splat(dt)));
+        let omega = match spin {
+            SpinUpdate::Seed => w_c.add(dw),
+            SpinUpdate::KeepMomentum => matrix(rotation).mul(&a).sandwich(j_inv, l),
+        };
+        rotation.write(g.rotation);
+        position.write(g.position);
+        omega.write(g.omega);
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -679,10 +1015,6 @@ mod tests {
                 &mut centres,
                 &mut dipole,
             );
-            if !mote_geom::simd::has_avx512() {
-                assert!(!vector_path);
-                continue;
-            }
             let near_half_turn = rotation.iter().any(|r| r.dot(*r) > 1e100);
             assert_eq!(vector_path, !near_half_turn, "case {case}");
             if !vector_path {
