@@ -10,7 +10,11 @@
 //! | `full` | id mol type q x y z |
 //! | `sphere` | id type diameter density x y z |
 //!
-//! each optionally followed by three image flags. Without the comment a row
+//! each optionally followed by three image flags. `Bonds` (`id type i j`)
+//! are read with their `Bond Coeffs` of style harmonic (`type K r0`,
+//! E = K (r − r₀)²), which a scene makes springs; angles, dihedrals and
+//! impropers are refused (mote has no such forces, and would drop them).
+//! Without the comment a row
 //! of 5 (or 8) values is `atomic` and one of 7 (or 10) `sphere`; other
 //! widths are refused with a message asking for the style. `Velocities`
 //! rows are `id vx vy vz`, with `wx wy wz` for spheres. mote's boxes are
@@ -115,6 +119,22 @@ pub struct DataFile {
     pub atoms: Vec<SphereAtom>,
     /// Names of atom types from `Atom Type Labels` (LAMMPS 2022 and later).
     pub type_labels: HashMap<u32, String>,
+    /// The `Bonds`, their atoms as indices into `atoms`.
+    pub bonds: Vec<Bond>,
+}
+
+/// A harmonic bond: E = K (r − r₀)² between two atoms (LAMMPS
+/// `bond_style harmonic`; its `K` includes the ½).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bond {
+    /// The bond type.
+    pub kind: u32,
+    /// The two atoms, as indices into [`DataFile::atoms`].
+    pub atoms: [usize; 2],
+    /// K of `Bond Coeffs` (energy per length squared).
+    pub k: f64,
+    /// r₀ of `Bond Coeffs`.
+    pub r0: f64,
 }
 
 /// Reads a data file from disk.
@@ -154,6 +174,12 @@ pub fn parse_as(
     let mut ids = HashMap::new();
     // `N atom types` of the header: types outside 1..=N are refused.
     let mut declared_types: Option<u64> = None;
+    // `N bonds`, `N bond types`; the Bonds section's line; each bond's
+    // (type, atom ids, line) until the atoms and coefficients are known.
+    let (mut declared_bonds, mut declared_bond_types) = (None::<u64>, None::<u64>);
+    let mut bonds_at: Option<usize> = None;
+    let mut bond_rows: Vec<(u32, [u64; 2], usize)> = Vec::new();
+    let mut bond_coeffs: HashMap<u32, (f64, f64)> = HashMap::new();
     for (k, raw) in lines {
         let line_no = k + 1;
         let line = raw.split('#').next().unwrap_or("").trim();
@@ -188,14 +214,29 @@ pub fn parse_as(
                 }
                 "Velocities" => "velocities",
                 "Masses" => "masses",
+                "Bonds" => {
+                    bonds_at.get_or_insert(line_no);
+                    "bonds"
+                }
+                "Bond" if words.get(1) == Some(&"Coeffs") => {
+                    let style = raw.split('#').nth(1).map(str::trim).unwrap_or("");
+                    if !style.is_empty() && style != "harmonic" {
+                        return Err(err(
+                            line_no,
+                            format!("Bond Coeffs # {style}: mote makes bonds springs, and reads bond style harmonic (K r0) only"),
+                        ));
+                    }
+                    "bond coeffs"
+                }
                 // What mote would drop: refused, never read as if absent.
-                "Bonds" | "Angles" | "Dihedrals" | "Impropers" => {
+                "Angles" | "Dihedrals" | "Impropers" => {
                     return Err(err(
                         line_no,
                         format!(
-                            "{}: mote reads a data file's atoms, not its topology, which would be dropped; \
-                             give bonds as [[spring]] pairs in the scene and remove the section",
-                            words[0]
+                            "{}: mote has no {} forces and would drop them; remove the section \
+                             (Bonds are read, as springs)",
+                            words[0],
+                            words[0].to_ascii_lowercase().trim_end_matches('s')
                         ),
                     ))
                 }
@@ -224,6 +265,18 @@ pub fn parse_as(
                 declared_types =
                     Some(n.parse().map_err(|_| {
                         err(line_no, format!("'{n}' is not a number of atom types"))
+                    })?)
+            }
+            ("", [n, "bonds"]) => {
+                declared_bonds = Some(
+                    n.parse()
+                        .map_err(|_| err(line_no, format!("'{n}' is not a number of bonds")))?,
+                )
+            }
+            ("", [n, "bond", "types"]) => {
+                declared_bond_types =
+                    Some(n.parse().map_err(|_| {
+                        err(line_no, format!("'{n}' is not a number of bond types"))
                     })?)
             }
             ("", [lo, hi, axis_lo, _]) if axis_lo.ends_with("lo") => {
@@ -380,6 +433,48 @@ pub fn parse_as(
                 }
                 data.atoms.push(atom);
             }
+            ("bonds", w) => {
+                let [_, kind, a, b] = w else {
+                    return Err(err(line_no, "a bond row needs id type atom1 atom2".into()));
+                };
+                let whole = |w: &str, what: &str| -> Result<u64, ParseError> {
+                    w.parse()
+                        .map_err(|_| err(line_no, format!("'{w}' is not {what}")))
+                };
+                let kind = whole(kind, "a bond type")?;
+                if kind == 0 || declared_bond_types.is_some_and(|n| kind > n) {
+                    return Err(err(
+                        line_no,
+                        format!(
+                            "bond type {kind}: the header declares types 1 to {}",
+                            declared_bond_types.unwrap_or(0)
+                        ),
+                    ));
+                }
+                let kind = u32::try_from(kind)
+                    .map_err(|_| err(line_no, format!("bond type {kind} is too large")))?;
+                let atoms = [whole(a, "an atom id")?, whole(b, "an atom id")?];
+                if atoms[0] == atoms[1] {
+                    return Err(err(line_no, format!("bond of atom {a} with itself")));
+                }
+                bond_rows.push((kind, atoms, line_no));
+            }
+            ("bond coeffs", w) => {
+                let [kind, k, r0] = w else {
+                    return Err(err(
+                        line_no,
+                        "a Bond Coeffs row of style harmonic needs type K r0".into(),
+                    ));
+                };
+                let kind: u32 = kind
+                    .parse()
+                    .map_err(|_| err(line_no, format!("'{kind}' is not a bond type")))?;
+                let (k, r0) = (num(k)?, num(r0)?);
+                if k < 0.0 || r0 < 0.0 {
+                    return Err(err(line_no, "K and r0 must not be negative".into()));
+                }
+                bond_coeffs.insert(kind, (k, r0));
+            }
             ("velocities", w) => {
                 let sphere = style == Some(AtomStyle::Sphere);
                 let need = if sphere { 7 } else { 4 };
@@ -405,6 +500,36 @@ pub fn parse_as(
                 }
             }
             _ => {}
+        }
+    }
+    for (kind, ids_of, line) in bond_rows {
+        let &(k, r0) = bond_coeffs.get(&kind).ok_or_else(|| {
+            err(
+                line,
+                format!("bond type {kind} has no Bond Coeffs (K r0 of style harmonic) in the file: mote makes each bond a spring of stiffness 2K and rest length r0"),
+            )
+        })?;
+        let index = |id: u64| {
+            ids.get(&id)
+                .copied()
+                .ok_or_else(|| err(line, format!("bond of unknown atom {id}")))
+        };
+        data.bonds.push(Bond {
+            kind,
+            atoms: [index(ids_of[0])?, index(ids_of[1])?],
+            k,
+            r0,
+        });
+    }
+    if let Some(n) = declared_bonds {
+        if n != data.bonds.len() as u64 {
+            return Err(err(
+                bonds_at.unwrap_or(0),
+                format!(
+                    "the header declares {n} bonds, the file lists {}",
+                    data.bonds.len()
+                ),
+            ));
         }
     }
     if general_given > 0 {

@@ -111,14 +111,47 @@ fn data_types_and_boxes_are_checked() {
     );
 }
 
-/// Topology is refused at its section, not dropped without a word.
+/// Bonds are read with their harmonic coefficients; what mote would drop
+/// (bonds without coefficients, another bond style, angles) is refused at
+/// its line, never dropped without a word.
 #[test]
-fn data_topology_is_refused_not_dropped() {
-    let bonded = DATA.replace("1 atom types\n", "1 atom types\n1 bonds\n1 bond types\n")
-        + "\nBonds\n\n1 1 1 2\n";
-    let e = lammps_data::parse(&bonded, "t").unwrap_err().to_string();
-    assert!(
-        e.contains("t:21: Bonds: mote reads a data file's atoms, not its topology"),
-        "{e}"
+fn data_bonds_are_read_and_other_topology_refused() {
+    let header = |t: &str| DATA.replace("1 atom types\n", &format!("1 atom types\n{t}"));
+    let bonded = header("1 bonds\n1 bond types\n")
+        + "\nBond Coeffs # harmonic\n\n1 50.0 0.8\n\nBonds\n\n1 1 2 1\n";
+    let d = lammps_data::parse(&bonded, "t").unwrap();
+    assert_eq!(d.bonds.len(), 1);
+    let b = d.bonds[0];
+    assert_eq!((b.kind, b.k, b.r0), (1, 50.0, 0.8));
+    assert_eq!(
+        [d.atoms[b.atoms[0]].id, d.atoms[b.atoms[1]].id],
+        [2, 1],
+        "atoms by id"
+    );
+    let no_coeffs = header("1 bonds\n1 bond types\n") + "\nBonds\n\n1 1 1 2\n";
+    refused(
+        lammps_data::parse(&no_coeffs, "t"),
+        23,
+        "has no Bond Coeffs",
+    );
+    let fene = bonded.replace("# harmonic", "# fene");
+    refused(
+        lammps_data::parse(&fene, "t"),
+        21,
+        "bond style harmonic (K r0) only",
+    );
+    let unknown = bonded.replace("1 1 2 1\n", "1 1 2 7\n");
+    refused(
+        lammps_data::parse(&unknown, "t"),
+        27,
+        "bond of unknown atom 7",
+    );
+    let miscounted = bonded.replace("1 bonds", "2 bonds");
+    refused(lammps_data::parse(&miscounted, "t"), 25, "declares 2 bonds");
+    let angles = header("") + "\nAngles\n\n1 1 1 2 1\n";
+    refused(
+        lammps_data::parse(&angles, "t"),
+        19,
+        "Angles: mote has no angle forces",
     );
 }

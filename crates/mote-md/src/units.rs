@@ -92,14 +92,27 @@ pub enum FileUnits {
     Lj,
 }
 
-/// What one unit of length, time, mass and charge of a file is in the
-/// scene's units.
+/// What one unit of length, time, mass, charge and energy of a file is in
+/// the scene's units. Energy is its own unit: LAMMPS's real (kcal/mol) and
+/// metal (eV) units do not derive it from mass, length and time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Scales {
     pub length: f64,
     pub time: f64,
     pub mass: f64,
     pub charge: f64,
+    pub energy: f64,
+}
+
+impl Scales {
+    /// A file in the scene's own units.
+    pub const SAME: Scales = Scales {
+        length: 1.0,
+        time: 1.0,
+        mass: 1.0,
+        charge: 1.0,
+        energy: 1.0,
+    };
 }
 
 impl FileUnits {
@@ -117,19 +130,21 @@ impl FileUnits {
         })
     }
 
-    /// The SI value of one unit of length, time, mass and charge (CODATA
-    /// 2018: e = 1.602176634e-19 C exactly, 1 g/mol per particle =
-    /// 1.66053906660e-27 kg, 1 statC = 3.335640952e-10 C); `None` for LJ.
+    /// The SI value of one unit of length, time, mass, charge and energy
+    /// (CODATA 2018: e = 1.602176634e-19 C exactly, 1 g/mol per particle =
+    /// 1.66053906660e-27 kg, 1 statC = 3.335640952e-10 C, 1 kcal/mol =
+    /// 4184 J / N_A, 1 eV = e·1 V); `None` for LJ.
     pub fn si(self) -> Option<Scales> {
         const E: f64 = 1.602_176_634e-19;
         const DALTON: f64 = 1.660_539_066_60e-27;
-        let (length, time, mass, charge) = match self {
-            FileUnits::Si => (1.0, 1.0, 1.0, 1.0),
-            FileUnits::Cgs => (1e-2, 1.0, 1e-3, 3.335_640_952e-10),
-            FileUnits::Real => (1e-10, 1e-15, DALTON, E),
-            FileUnits::Metal => (1e-10, 1e-12, DALTON, E),
-            FileUnits::Micro => (1e-6, 1e-6, 1e-15, 1e-12),
-            FileUnits::Nano => (1e-9, 1e-9, 1e-21, E),
+        const KCAL_PER_MOL: f64 = 4184.0 / 6.022_140_76e23;
+        let (length, time, mass, charge, energy) = match self {
+            FileUnits::Si => (1.0, 1.0, 1.0, 1.0, 1.0),
+            FileUnits::Cgs => (1e-2, 1.0, 1e-3, 3.335_640_952e-10, 1e-7),
+            FileUnits::Real => (1e-10, 1e-15, DALTON, E, KCAL_PER_MOL),
+            FileUnits::Metal => (1e-10, 1e-12, DALTON, E, E),
+            FileUnits::Micro => (1e-6, 1e-6, 1e-15, 1e-12, 1e-15),
+            FileUnits::Nano => (1e-9, 1e-9, 1e-21, E, 1e-21),
             FileUnits::Lj => return None,
         };
         Some(Scales {
@@ -137,6 +152,7 @@ impl FileUnits {
             time,
             mass,
             charge,
+            energy,
         })
     }
 
@@ -146,12 +162,7 @@ impl FileUnits {
     /// none).
     pub fn into(self, scene: UnitSystem) -> Result<Scales, String> {
         match (scene, self) {
-            (UnitSystem::Lj, FileUnits::Lj) => Ok(Scales {
-                length: 1.0,
-                time: 1.0,
-                mass: 1.0,
-                charge: 1.0,
-            }),
+            (UnitSystem::Lj, FileUnits::Lj) => Ok(Scales::SAME),
             (UnitSystem::Lj, _) | (UnitSystem::Si, FileUnits::Lj) => Err(
                 "reduced (lj) units and physical units do not convert into each other: \
                  a scene in lj units takes files in lj units, an si scene files in physical units"
@@ -181,6 +192,19 @@ mod file_units_tests {
         assert!((v_real - 274.1).abs() < 1e-9 && (v_metal - 274.1).abs() < 1e-9);
         assert!((39.948 * real.mass - 6.6335e-26).abs() < 1e-29);
         assert_eq!(real.charge, metal.charge);
+        // kcal/mol and eV: 1 eV = 23.0605 kcal/mol.
+        assert!((metal.energy / real.energy - 23.060_548).abs() < 1e-5);
+        // Where energy is derived (si, cgs, micro, nano) it is m l²/t².
+        for units in [
+            FileUnits::Si,
+            FileUnits::Cgs,
+            FileUnits::Micro,
+            FileUnits::Nano,
+        ] {
+            let k = units.si().unwrap();
+            let derived = k.mass * k.length * k.length / (k.time * k.time);
+            assert!((k.energy / derived - 1.0).abs() < 1e-12, "{units:?}");
+        }
         assert!(FileUnits::Real.into(UnitSystem::Lj).is_err());
         assert!(FileUnits::Lj.into(UnitSystem::Si).is_err());
         assert_eq!(FileUnits::Lj.into(UnitSystem::Lj).unwrap().length, 1.0);

@@ -335,3 +335,97 @@ fn a_file_in_real_units_comes_into_an_si_scene() {
         "{e}"
     );
 }
+
+/// A bead-spring file: `Bonds` with `Bond Coeffs # harmonic` become springs
+/// of stiffness 2K and rest length r₀ (LAMMPS's E = K (r − r₀)²), joined to
+/// the file's own atoms after the scene's other particles. The energy is
+/// LAMMPS's, Σ K (r − r₀)², and a stretched dimer swings through its
+/// compressed turning point after half a period, T = 2π/√(4K/m) (reduced
+/// mass m/2); replicating bonded atoms is refused; a file in real units
+/// brings K in kcal/mol/Å².
+#[test]
+fn bonds_of_a_data_file_become_springs() {
+    let dir = tempfile::tempdir().unwrap();
+    let chain = "chain\n\n3 atoms\n1 atom types\n2 bonds\n2 bond types\n\n\
+         -5 5 xlo xhi\n-5 5 ylo yhi\n-5 5 zlo zhi\n\nMasses\n\n1 1.0\n\n\
+         Atoms # bond\n\n1 1 1 0 0 0\n2 1 1 1.3 0 0\n3 1 1 1.3 1.0 0\n\n\
+         Bond Coeffs # harmonic\n\n1 50.0 1.0\n2 30.0 1.2\n\n\
+         Bonds\n\n1 1 1 2\n2 2 2 3\n";
+    std::fs::write(dir.path().join("chain.data"), chain).unwrap();
+    let scene = |extra: &str| {
+        format!(
+            "units = \"lj\"\n[run]\ndt = 0.0001\nsteps = 1\n\
+             [[particle]]\nposition = [4.0, 4.0, 4.0]\nmass = 1.0\n\
+             [[from_file]]\nfile = \"chain.data\"\nradius = 0.5\n{extra}"
+        )
+    };
+    let label = dir.path().join("scene.toml");
+    let label = label.to_str().unwrap();
+    let text = scene("");
+    let built = Scene::parse(&text, label)
+        .unwrap()
+        .build(&text, label, 1)
+        .unwrap();
+    let mut sim = built.simulation;
+    let o = mote_md::Observables::measure(&sim.system, &mut sim.forces);
+    let want = 50.0 * 0.3f64.powi(2) + 30.0 * 0.2f64.powi(2);
+    assert!(
+        (o.potential - want).abs() < 1e-12,
+        "{} vs {want}",
+        o.potential
+    );
+
+    // The first bond alone: released stretched by 0.3, it is compressed
+    // by 0.3 half a period later.
+    let dimer = chain
+        .replace("3 atoms", "2 atoms")
+        .replace("2 bonds", "1 bonds")
+        .replace("3 1 1 1.3 1.0 0\n", "")
+        .replace("2 2 2 3\n", "");
+    std::fs::write(dir.path().join("chain.data"), dimer).unwrap();
+    let built = Scene::parse(&text, label)
+        .unwrap()
+        .build(&text, label, 1)
+        .unwrap();
+    let mut sim = built.simulation;
+    let half_period = std::f64::consts::PI / (4.0f64 * 50.0).sqrt();
+    let steps = (half_period / sim.dt).round() as u64;
+    for _ in 0..steps {
+        sim.stepper.step(&mut sim.system, &mut sim.forces, sim.dt);
+    }
+    let p = &sim.system.particles.position;
+    let r = (p[2] - p[1]).length();
+    assert!((r - 0.7).abs() < 1e-3, "separation {r} after T/2");
+
+    let e = build(
+        dir.path(),
+        &scene("replicate = [2, 1, 1]\nperiodic = [true, true, true]\n"),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("scene.toml:") && e.contains("replicate copies atoms, not their 1 bonds"),
+        "{e}"
+    );
+
+    // Real units: K = 1 kcal/mol/Å², r₀ = 1.5 Å into SI.
+    let real = "real\n\n2 atoms\n1 atom types\n1 bonds\n1 bond types\n\n\
+        Masses\n\n1 12.011\n\nAtoms # full\n\n1 1 1 0 0 0 0\n2 1 1 0 1.5 0 0\n\n\
+        Bond Coeffs # harmonic\n\n1 1.0 1.5\n\nBonds\n\n1 1 1 2\n";
+    std::fs::write(dir.path().join("real.data"), real).unwrap();
+    let text = "units = \"si\"\n[run]\ndt = 1e-16\nsteps = 1\n\
+        [[from_file]]\nfile = \"real.data\"\nradius = 1e-10\nunits = \"real\"\n";
+    let built = Scene::parse(text, label)
+        .unwrap()
+        .build(text, label, 1)
+        .unwrap();
+    let mut sim = built.simulation;
+    sim.system.particles.position[1].x = 1.6e-10;
+    let o = mote_md::Observables::measure(&sim.system, &mut sim.forces);
+    let kcal_per_mol = 4184.0 / 6.022_140_76e23;
+    let want = kcal_per_mol * 0.1f64.powi(2); // K (0.1 Å)²
+    assert!(
+        (o.potential / want - 1.0).abs() < 1e-9,
+        "{} J vs {want} J",
+        o.potential
+    );
+}

@@ -256,11 +256,13 @@ pub struct DataSpec {
     pub color: [f64; 3],
 }
 
-/// The particles of a file, their species, and the file's box if it has one.
+/// The particles of a file, their species, the file's box if it has one,
+/// and its bonds as springs (indices within the file).
 type FromFile = (
     Vec<ParticleInit>,
     Vec<String>,
     Option<crate::boundary::Boundary>,
+    Vec<Spring>,
 );
 
 /// The particles of one `[[from_file]]`, their species and the file's box
@@ -277,12 +279,7 @@ fn from_file(
     scales: Option<crate::units::Scales>,
     at: &dyn Fn(String) -> ParseError,
 ) -> Result<FromFile, ParseError> {
-    let k = scales.unwrap_or(crate::units::Scales {
-        length: 1.0,
-        time: 1.0,
-        mass: 1.0,
-        charge: 1.0,
-    });
+    let k = scales.unwrap_or(crate::units::Scales::SAME);
     let speed = k.length / k.time;
     let io = |e: mote_io::IoError| match e {
         mote_io::IoError::Parse(p) if p.line > 0 => p,
@@ -373,7 +370,21 @@ fn from_file(
                 (None, None) => "X".to_string(),
             })
             .collect();
-        return Ok((out, names, boundary));
+        // E = K (r − r₀)² of bond_style harmonic is a spring of stiffness
+        // D = 2K (002 Eq. 4: F = D (r − l)); K is energy per length².
+        let stiffness = k.energy / (k.length * k.length);
+        let springs = data
+            .bonds
+            .iter()
+            .map(|b| Spring {
+                i: b.atoms[0],
+                j: b.atoms[1],
+                stiffness: 2.0 * b.k * stiffness,
+                damping: 0.0,
+                rest_length: b.r0 * k.length,
+            })
+            .collect();
+        return Ok((out, names, boundary, springs));
     }
     let frames = mote_io::trajectory::read_frames(path).map_err(io)?;
     let f = mote_io::trajectory::pick(&frames, s.frame, path).map_err(at)?;
@@ -430,7 +441,7 @@ fn from_file(
             _ => "X".to_string(),
         })
         .collect();
-    Ok((out, names, boundary))
+    Ok((out, names, boundary, Vec::new()))
 }
 
 /// LAMMPS' `replicate`: the particles copied `copies` times along the
@@ -912,7 +923,20 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
                     .map_err(|m| at(format!("units = \"{name}\": {m}")))?,
             ),
         };
-        let (mut made, mut names, mut file_box) = from_file(s, &path, data, scales, &at)?;
+        let (mut made, mut names, mut file_box, bonds) = from_file(s, &path, data, scales, &at)?;
+        if s.replicate.is_some() && !bonds.is_empty() {
+            return Err(at(format!(
+                "{}: replicate copies atoms, not their {} bonds (a bond across the box would join the wrong copies): replicate in LAMMPS and read its data file",
+                path.display(),
+                bonds.len()
+            )));
+        }
+        let first = inits.len();
+        springs.extend(bonds.into_iter().map(|b| Spring {
+            i: first + b.i,
+            j: first + b.j,
+            ..b
+        }));
         if let Some(copies) = s.replicate {
             let b = replicate(&mut made, &mut names, file_box, copies)
                 .map_err(|m| at(format!("{}: {m}", path.display())))?;
