@@ -291,7 +291,8 @@ pub(crate) fn table_observers(
             &sim.forces
                 .interactions
                 .iter()
-                .flat_map(|i| i.wall_forces())
+                .filter_map(|i| i.viewer())
+                .flat_map(|v| v.wall_forces())
                 .map(|w| w.0)
                 .collect::<Vec<_>>(),
             sim.system

@@ -27,6 +27,7 @@ pub mod soft_pack;
 pub mod thermostat;
 pub mod tree;
 pub mod units;
+pub mod viewer;
 
 pub use boundary::Boundary;
 pub use error::MdError;

@@ -91,7 +91,8 @@ impl Observables {
             wall_forces: ff
                 .interactions
                 .iter()
-                .flat_map(|i| i.wall_forces())
+                .filter_map(|i| i.viewer())
+                .flat_map(|v| v.wall_forces())
                 .collect(),
             kt: if nf > 0.0 {
                 2.0 * translational / nf

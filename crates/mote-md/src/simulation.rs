@@ -183,7 +183,8 @@ impl mote_run::Propagator for Simulation {
         self.forces
             .interactions
             .iter()
-            .flat_map(|i| i.walls(t))
+            .filter_map(|i| i.viewer())
+            .flat_map(|v| v.walls(t))
             .collect()
     }
 
@@ -219,7 +220,7 @@ impl mote_run::Propagator for Simulation {
                 .forces
                 .interactions
                 .iter_mut()
-                .find_map(|i| i.steer(other))
+                .find_map(|i| i.viewer_mut().and_then(|v| v.steer(other)))
                 .unwrap_or_else(|| Err(format!("{}: the scene has none", other.what()))),
         }
     }

@@ -284,7 +284,8 @@ fn settled_bed_weighs_on_its_walls() {
 fn ff_wall_force_z(ff: &ForceField) -> f64 {
     ff.interactions
         .iter()
-        .flat_map(|i| i.wall_forces())
+        .filter_map(|i| i.viewer())
+        .flat_map(|v| v.wall_forces())
         .map(|(_, f)| -f.z)
         .sum::<f64>()
 }

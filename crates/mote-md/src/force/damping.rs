@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Interaction, State, Virial};
+use super::{Interaction, State, ViewerHooks, Virial};
 
 /// Viscous drag with coefficient γ (force per velocity), the same for all particles.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -11,6 +11,14 @@ pub struct GlobalDamping {
 }
 
 impl Interaction for GlobalDamping {
+    fn viewer(&self) -> Option<&dyn ViewerHooks> {
+        Some(self)
+    }
+
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
+    }
+
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
@@ -30,6 +38,12 @@ impl Interaction for GlobalDamping {
         }
     }
 
+    fn potential_energy(&mut self, _state: &State) -> f64 {
+        0.0
+    }
+}
+
+impl ViewerHooks for GlobalDamping {
     fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
         match change {
             mote_run::Change::Damping(gamma) => {
@@ -39,9 +53,5 @@ impl Interaction for GlobalDamping {
             }
             _ => None,
         }
-    }
-
-    fn potential_energy(&mut self, _state: &State) -> f64 {
-        0.0
     }
 }

@@ -17,7 +17,7 @@
 
 use glam::DVec3;
 
-use super::{DirectGravity, Interaction, State, Virial};
+use super::{DirectGravity, Interaction, State, ViewerHooks, Virial};
 
 /// Coulomb's law between all pairs of charges, in open space.
 #[derive(Debug, Clone)]
@@ -91,6 +91,14 @@ impl ElectricField {
 }
 
 impl Interaction for ElectricField {
+    fn viewer(&self) -> Option<&dyn ViewerHooks> {
+        Some(self)
+    }
+
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
+    }
+
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
@@ -111,6 +119,23 @@ impl Interaction for ElectricField {
         }
     }
 
+    /// −Σ q E·r, or 0 where the box is periodic along the field (there the
+    /// potential is not defined).
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        let e = self.at(state.time);
+        if (0..3).any(|a| state.boundary.periodic[a] && self.amplitude[a] != 0.0) {
+            return 0.0;
+        }
+        -state
+            .position
+            .iter()
+            .zip(state.charges())
+            .map(|(r, q)| q * e.dot(*r))
+            .sum::<f64>()
+    }
+}
+
+impl ViewerHooks for ElectricField {
     fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
         let mote_run::Change::Field {
             kind: mote_run::FieldKind::Electric,
@@ -134,21 +159,6 @@ impl Interaction for ElectricField {
         self.amplitude = e;
         self.phase = 0.0;
         Some(Ok(text))
-    }
-
-    /// −Σ q E·r, or 0 where the box is periodic along the field (there the
-    /// potential is not defined).
-    fn potential_energy(&mut self, state: &State) -> f64 {
-        let e = self.at(state.time);
-        if (0..3).any(|a| state.boundary.periodic[a] && self.amplitude[a] != 0.0) {
-            return 0.0;
-        }
-        -state
-            .position
-            .iter()
-            .zip(state.charges())
-            .map(|(r, q)| q * e.dot(*r))
-            .sum::<f64>()
     }
 }
 

@@ -35,6 +35,7 @@ use rayon::prelude::*;
 use crate::boundary::Boundary;
 use crate::neighbor::VerletList;
 use crate::particles::System;
+pub use crate::viewer::ViewerHooks;
 
 /// The per-step context of every interaction: a read-only view of the
 /// state at which forces are evaluated (the integrator's stage, which need
@@ -202,23 +203,13 @@ pub trait Interaction: Send {
             Err(format!("{} carries no state", self.name()))
         }
     }
-    /// The force the particles exert on each wall of this interaction
-    /// (name, force) at the last evaluation; empty for interactions without
-    /// walls.
-    fn wall_forces(&self) -> Vec<(String, DVec3)> {
-        Vec::new()
+    /// The live viewer's hooks (walls, their loads, steering), where this
+    /// interaction has any.
+    fn viewer(&self) -> Option<&dyn ViewerHooks> {
+        None
     }
-    /// The walls of this interaction where they are at time `t` (for the
-    /// live viewer); empty for interactions without walls.
-    fn walls(&self, t: f64) -> Vec<mote_run::WallGeometry> {
-        let _ = t;
-        Vec::new()
-    }
-    /// Applies a change asked for from the live viewer when this
-    /// interaction owns what it sets: `Some(what changed)`, or
-    /// `Some(Err(why not))`; `None` when the change is not its business.
-    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
-        let _ = change;
+    /// [`Interaction::viewer`], to steer.
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
         None
     }
     /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation, for

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::{Interaction, State, Virial};
+use super::{Interaction, State, ViewerHooks, Virial};
 
 /// Uniform acceleration g acting on every particle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -11,6 +11,14 @@ pub struct UniformField {
 }
 
 impl Interaction for UniformField {
+    fn viewer(&self) -> Option<&dyn ViewerHooks> {
+        Some(self)
+    }
+
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
+    }
+
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
@@ -30,6 +38,18 @@ impl Interaction for UniformField {
         }
     }
 
+    /// U = −Σ m_i g·x_i.
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        -state
+            .position
+            .iter()
+            .zip(state.mass)
+            .map(|(x, m)| m * self.g.dot(*x))
+            .sum::<f64>()
+    }
+}
+
+impl ViewerHooks for UniformField {
     fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
         match change {
             mote_run::Change::Field {
@@ -47,15 +67,5 @@ impl Interaction for UniformField {
             }
             _ => None,
         }
-    }
-
-    /// U = −Σ m_i g·x_i.
-    fn potential_energy(&mut self, state: &State) -> f64 {
-        -state
-            .position
-            .iter()
-            .zip(state.mass)
-            .map(|(x, m)| m * self.g.dot(*x))
-            .sum::<f64>()
     }
 }

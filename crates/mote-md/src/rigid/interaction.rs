@@ -33,10 +33,9 @@ pub trait BodyInteraction: AsAny + Send + Sync {
     fn potential_energy(&mut self, _view: &BodyView<'_>, _t: f64) -> f64 {
         0.0
     }
-    /// Applies a change asked for from the live viewer when this
-    /// interaction owns what it sets (see `Interaction::steer`).
-    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
-        let _ = change;
+    /// The live viewer's hooks (steering the fields it owns), where this
+    /// interaction has any.
+    fn viewer_mut(&mut self) -> Option<&mut dyn crate::viewer::ViewerHooks> {
         None
     }
 

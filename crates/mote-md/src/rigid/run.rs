@@ -155,7 +155,7 @@ impl Propagator for RigidDynamics {
         self.frbi
             .interactions_mut()
             .iter_mut()
-            .find_map(|i| i.steer(change))
+            .find_map(|i| i.viewer_mut().and_then(|v| v.steer(change)))
             .unwrap_or_else(|| Err(format!("{}: the scene has none", change.what())))
     }
 

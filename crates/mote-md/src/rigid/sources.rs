@@ -18,6 +18,7 @@ use crate::force::dipolar::dipole_pair;
 use crate::force::latent::LatentImage;
 use crate::force::slab::ConductingPlanes;
 use crate::force::DirectGravity;
+use crate::viewer::ViewerHooks;
 
 /// A homogeneous field as a function of time.
 #[derive(Clone)]
@@ -91,10 +92,36 @@ pub struct ExternalFields {
 }
 
 impl BodyInteraction for ExternalFields {
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
+    }
+
     fn name(&self) -> &str {
         "external fields"
     }
 
+    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+        let (e, b) = (self.electric.at(t), self.magnetic.at(t));
+        let bodies = view.bodies;
+        for (i, w) in wrench.iter_mut().enumerate() {
+            let q = bodies.template(i).charge;
+            w.v += q * e;
+            w.omega += view.world.dipole[i].cross(b);
+        }
+    }
+
+    fn potential_energy(&mut self, view: &BodyView<'_>, t: f64) -> f64 {
+        let (e, b) = (self.electric.at(t), self.magnetic.at(t));
+        let bodies = view.bodies;
+        (0..bodies.len())
+            .map(|i| {
+                -bodies.template(i).charge * e.dot(bodies.position[i]) - view.world.dipole[i].dot(b)
+            })
+            .sum()
+    }
+}
+
+impl ViewerHooks for ExternalFields {
     fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
         use mote_run::FieldKind;
         let mote_run::Change::Field { kind, value } = change else {
@@ -120,26 +147,6 @@ impl BodyInteraction for ExternalFields {
             crate::force::vector_text(new)
         )))
     }
-
-    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
-        let (e, b) = (self.electric.at(t), self.magnetic.at(t));
-        let bodies = view.bodies;
-        for (i, w) in wrench.iter_mut().enumerate() {
-            let q = bodies.template(i).charge;
-            w.v += q * e;
-            w.omega += view.world.dipole[i].cross(b);
-        }
-    }
-
-    fn potential_energy(&mut self, view: &BodyView<'_>, t: f64) -> f64 {
-        let (e, b) = (self.electric.at(t), self.magnetic.at(t));
-        let bodies = view.bodies;
-        (0..bodies.len())
-            .map(|i| {
-                -bodies.template(i).charge * e.dot(bodies.position[i]) - view.world.dipole[i].dot(b)
-            })
-            .sum()
-    }
 }
 
 /// Uniform gravity: `F = m g`, potential `−m g·x`.
@@ -149,10 +156,29 @@ pub struct Gravity {
 }
 
 impl BodyInteraction for Gravity {
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
+    }
+
     fn name(&self) -> &str {
         "gravity"
     }
 
+    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+        for (i, w) in wrench.iter_mut().enumerate() {
+            w.v += view.bodies.template(i).mass() * self.g;
+        }
+    }
+
+    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
+        let b = view.bodies;
+        (0..b.len())
+            .map(|i| -b.template(i).mass() * self.g.dot(b.position[i]))
+            .sum()
+    }
+}
+
+impl ViewerHooks for Gravity {
     fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
         let mote_run::Change::Field {
             kind: mote_run::FieldKind::Gravity,
@@ -169,19 +195,6 @@ impl BodyInteraction for Gravity {
         );
         self.g = g;
         Some(Ok(text))
-    }
-
-    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
-        for (i, w) in wrench.iter_mut().enumerate() {
-            w.v += view.bodies.template(i).mass() * self.g;
-        }
-    }
-
-    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
-        let b = view.bodies;
-        (0..b.len())
-            .map(|i| -b.template(i).mass() * self.g.dot(b.position[i]))
-            .sum()
     }
 }
 
@@ -202,18 +215,12 @@ pub struct AirDrag {
 }
 
 impl BodyInteraction for AirDrag {
-    fn name(&self) -> &str {
-        "air drag"
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
     }
 
-    /// Damping sets the viscosity η of the Stokes parts.
-    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
-        let mote_run::Change::Damping(eta) = change else {
-            return None;
-        };
-        let text = format!("air viscosity η {} → {eta}", self.viscosity);
-        self.viscosity = *eta;
-        Some(Ok(text))
+    fn name(&self) -> &str {
+        "air drag"
     }
 
     fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
@@ -226,6 +233,18 @@ impl BodyInteraction for AirDrag {
             w.v -= (lin + quad) * u;
             w.omega -= 8.0 * PI * self.viscosity * r * r * r * b.omega[i];
         }
+    }
+}
+
+impl ViewerHooks for AirDrag {
+    /// Damping sets the viscosity η of the Stokes parts.
+    fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
+        let mote_run::Change::Damping(eta) = change else {
+            return None;
+        };
+        let text = format!("air viscosity η {} → {eta}", self.viscosity);
+        self.viscosity = *eta;
+        Some(Ok(text))
     }
 }
 

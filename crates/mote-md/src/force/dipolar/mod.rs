@@ -67,7 +67,7 @@ mod listed;
 mod portable;
 mod tiled;
 
-use super::{Interaction, Spin, State, Virial};
+use super::{Interaction, Spin, State, ViewerHooks, Virial};
 use crate::boundary::Boundary;
 use crate::neighbor::{Copy4, GhostList};
 use crate::units::UnitSystem;
@@ -903,6 +903,14 @@ impl Zeeman {
 }
 
 impl Interaction for Zeeman {
+    fn viewer(&self) -> Option<&dyn ViewerHooks> {
+        Some(self)
+    }
+
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
+    }
+
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
@@ -940,6 +948,17 @@ impl Interaction for Zeeman {
         }
     }
 
+    /// Σ_i −μ₀ m_i·H(r_i, t) (0 for a state without dipoles).
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        if state.dipole.len() == state.position.len() {
+            self.energy(state.position, state.dipole, state.time)
+        } else {
+            0.0
+        }
+    }
+}
+
+impl ViewerHooks for Zeeman {
     fn steer(&mut self, change: &mote_run::Change) -> Option<Result<String, String>> {
         let mote_run::Change::Field {
             kind: mote_run::FieldKind::Magnetic,
@@ -961,15 +980,6 @@ impl Interaction for Zeeman {
             crate::force::vector_text(h),
             crate::force::vector_text(new)
         )))
-    }
-
-    /// Σ_i −μ₀ m_i·H(r_i, t) (0 for a state without dipoles).
-    fn potential_energy(&mut self, state: &State) -> f64 {
-        if state.dipole.len() == state.position.len() {
-            self.energy(state.position, state.dipole, state.time)
-        } else {
-            0.0
-        }
     }
 }
 

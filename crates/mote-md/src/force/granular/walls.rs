@@ -7,7 +7,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::law::{ContactLaw, History};
-use crate::force::{Interaction, Spin, State, Virial};
+use crate::force::{Interaction, Spin, State, ViewerHooks, Virial};
 
 /// The shape of a wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -252,6 +252,14 @@ impl GranularWalls {
 }
 
 impl Interaction for GranularWalls {
+    fn viewer(&self) -> Option<&dyn ViewerHooks> {
+        Some(self)
+    }
+
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        Some(self)
+    }
+
     /// Not part of the pressure (see [`Interaction::virial`]).
     fn virial(&self) -> Option<f64> {
         Some(0.0)
@@ -265,22 +273,8 @@ impl Interaction for GranularWalls {
         "walls"
     }
 
-    fn walls(&self, t: f64) -> Vec<mote_run::WallGeometry> {
-        self.walls.iter().map(|w| w.geometry(t)).collect()
-    }
-
     fn exerts_torques(&self) -> bool {
         true
-    }
-
-    /// The force on each wall at the last evaluation: minus the sum of its
-    /// contact forces on the particles.
-    fn wall_forces(&self) -> Vec<(String, DVec3)> {
-        self.walls
-            .iter()
-            .zip(&self.wall_force)
-            .map(|(w, f)| (w.name.clone(), *f))
-            .collect()
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
@@ -349,5 +343,21 @@ impl Interaction for GranularWalls {
             }
         }
         u
+    }
+}
+
+impl ViewerHooks for GranularWalls {
+    fn walls(&self, t: f64) -> Vec<mote_run::WallGeometry> {
+        self.walls.iter().map(|w| w.geometry(t)).collect()
+    }
+
+    /// The force on each wall at the last evaluation: minus the sum of its
+    /// contact forces on the particles.
+    fn wall_forces(&self) -> Vec<(String, DVec3)> {
+        self.walls
+            .iter()
+            .zip(&self.wall_force)
+            .map(|(w, f)| (w.name.clone(), *f))
+            .collect()
     }
 }
