@@ -212,7 +212,9 @@ pub trait Interaction: Send {
     fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
         None
     }
-    /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation, for
+    /// The virial W = Σ_pairs r_ij · F_ij of the last force evaluation
+    /// (Lennard-Jones: of the last [`Interaction::potential_energy`], which
+    /// a measurement asks for first; NaN after a later force pass), for
     /// the pressure P V = N k T + W/3 of periodic systems; `None` where the
     /// interaction does not compute it (the pressure is then not given,
     /// rather than given without its part). External fields, damping and
