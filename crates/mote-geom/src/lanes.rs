@@ -146,16 +146,23 @@ pub fn pack_indices(bits: u8, first: u32, out: &mut [u32]) -> usize {
             );
             _mm256_storeu_si256(out.as_mut_ptr().cast(), index);
         }
+        bits.count_ones() as usize
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
-    {
-        let mut k = 0;
-        for l in 0..LANES as u32 {
-            out[k] = first + l;
-            k += usize::from(bits >> l & 1 == 1);
-        }
+    pack_indices_scalar(bits, first, out)
+}
+
+/// [`pack_indices`] without vector instructions: the build's fallback,
+/// and the reference the AVX2 path is tested against.
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
+#[inline(always)]
+fn pack_indices_scalar(bits: u8, first: u32, out: &mut [u32; LANES]) -> usize {
+    let mut k = 0;
+    for l in 0..LANES as u32 {
+        out[k] = first + l;
+        k += usize::from(bits >> l & 1 == 1);
     }
-    bits.count_ones() as usize
+    k
 }
 
 /// For each mask, the set lanes in increasing order (then zeros).
@@ -257,10 +264,17 @@ unsafe fn gather_xyz_unchecked(records: &[[f64; 4]], index: &[u32; LANES]) -> [L
 #[inline(always)]
 #[allow(unsafe_code)]
 unsafe fn gather_xyz_unchecked(records: &[[f64; 4]], index: &[u32; LANES]) -> [Lanes; 3] {
+    gather_xyz_scalar(records, index)
+}
+
+/// [`gather_xyz`] lane by lane: the build's fallback, and the reference
+/// the AVX2 path is tested against.
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
+#[inline(always)]
+fn gather_xyz_scalar(records: &[[f64; 4]], index: &[u32; LANES]) -> [Lanes; 3] {
     let mut out = [[0.0; LANES]; 3];
     for (m, &i) in index.iter().enumerate() {
-        // SAFETY: the caller checked every index.
-        let r = unsafe { records.get_unchecked(i as usize) };
+        let r = records[i as usize];
         for (c, o) in out.iter_mut().enumerate() {
             o[m] = r[c];
         }
@@ -314,6 +328,11 @@ mod tests {
         for (m, &i) in index.iter().enumerate() {
             assert_eq!([x.0[m], y.0[m], z.0[m]], records[i as usize][..3]);
         }
+        // The build's path (AVX2 on x86-64-v3) against the scalar one.
+        assert_eq!(
+            gather_xyz(&records, &index),
+            gather_xyz_scalar(&records, &index)
+        );
     }
 
     #[test]
@@ -332,6 +351,9 @@ mod tests {
                 .map(|l| 7 + l)
                 .collect();
             assert_eq!(out[..n], want[..], "mask {bits:08b}");
+            let mut scalar = [0u32; 8];
+            assert_eq!(pack_indices_scalar(bits, 7, &mut scalar), n);
+            assert_eq!(scalar[..n], out[..n], "mask {bits:08b}: scalar path");
         }
     }
 
