@@ -317,7 +317,7 @@ fn isostatic_at_ten_thousand() {
 }
 
 /// A packer resumed from any of its checkpoints, in growth or in the
-/// quasi-static finish, ends with the bits of the run that wrote them.
+/// quasi-static finish (at a cycle's top or inside one), ends with the bits of the run that wrote them.
 #[test]
 fn resumed_from_a_checkpoint_ends_bit_for_bit() {
     use mote_edmd::pack::{PackCheckpoints, PackState};
@@ -331,15 +331,23 @@ fn resumed_from_a_checkpoint_ends_bit_for_bit() {
         Ok(())
     };
     let mut cps = PackCheckpoints {
-        every: 4,
+        every: 3,
         save: &mut save,
     };
     let whole = p.run_with(|_| {}, Some(&mut cps)).unwrap();
     let (positions, radii) = (p.system().positions(), p.system().radii());
-    assert!(states.iter().any(|s| s.finishing) && states.iter().any(|s| !s.finishing));
+    assert!(
+        states.iter().any(|s| s.finishing.is_some())
+            && states.iter().any(|s| s.finishing.is_none())
+    );
+    // Growing, at a finish cycle's top, inside a cycle, and the last.
     let picks = [
-        states.iter().position(|s| !s.finishing).unwrap(),
-        states.iter().position(|s| s.finishing).unwrap(),
+        states.iter().position(|s| s.finishing.is_none()).unwrap(),
+        states.iter().position(|s| s.finishing == Some(0)).unwrap(),
+        states
+            .iter()
+            .position(|s| s.finishing.is_some_and(|k| k > 0))
+            .unwrap(),
         states.len() - 1,
     ];
     let dir = tempfile::tempdir().unwrap();
@@ -357,7 +365,7 @@ fn resumed_from_a_checkpoint_ends_bit_for_bit() {
             Ok(())
         };
         let mut cps = PackCheckpoints {
-            every: 4,
+            every: 3,
             save: &mut save,
         };
         let out = again.run_with(|_| {}, Some(&mut cps)).unwrap();
@@ -369,4 +377,32 @@ fn resumed_from_a_checkpoint_ends_bit_for_bit() {
         // And it writes the checkpoints the whole run wrote after k.
         assert_eq!(later, states[k + 1..]);
     }
+}
+
+/// A packing stepped one window at a time through the driver every run
+/// shares (with its end-of-run checkpoint) ends where [`Packer::run`]
+/// does: the same windows and the same spheres, bit for bit; each step
+/// closes one window, and the driver stops where the packer jammed.
+#[test]
+fn stepped_by_the_driver_as_run_whole() {
+    use mote_run::{Driver, Propagator};
+    let mut s = settings(150, 0.1, 9);
+    s.max_pressure = 1e8;
+    s.finish = Some(Finish::default());
+    let mut whole = Packer::<3>::new(s.clone()).unwrap();
+    let out = whole.run(|_| {}).unwrap();
+    assert_eq!(out.stop, Stop::Pressure);
+
+    let mut stepped = Packer::<3>::new(s).unwrap();
+    let mut steps = Vec::new();
+    let mut driver = Driver::new();
+    driver
+        .run(&mut stepped, |_| u64::MAX, |p| steps.push(p.step()))
+        .unwrap();
+    assert!(stepped.finished());
+    assert_eq!(stepped.stopped(), Some(Stop::Pressure));
+    assert_eq!(steps, (1..=out.history.len() as u64).collect::<Vec<_>>());
+    assert_eq!(stepped.windows(), &out.history[..]);
+    assert_eq!(stepped.system().positions(), whole.system().positions());
+    assert_eq!(stepped.system().radii(), whole.system().radii());
 }

@@ -30,6 +30,8 @@ pub(crate) fn trim_outputs(dir: &Path, step: u64, time: f64) -> Result<(), Front
     trim_table(&dir.join("observables.csv"), step, time)?;
     // A toning nip's table (rigid `[rigid.nip]`), where there is one.
     trim_table(&dir.join("nip.csv"), step, time)?;
+    // A packing's windows (by time: the table has no step column).
+    trim_table(&dir.join("packing.csv"), step, time)?;
     // Frames up to the checkpoint are kept verbatim (byte for byte).
     use mote_io::trajectory::{keep_until, Format};
     for format in [Format::Xyz, Format::Dump, Format::Gsd, Format::Vtk] {

@@ -244,7 +244,7 @@ impl<const D: usize> EngineRun for EventRun<D> {
         monitor.progress((f * 1000.0) as u64, 1000, "");
     }
 
-    fn ending(&self, e: mote_edmd::EdmdError) -> Result<Ending, FrontError> {
+    fn ending(&self, _: &mut Self::State, e: mote_edmd::EdmdError) -> Result<Ending, FrontError> {
         match e {
             mote_edmd::EdmdError::Interrupted { signal, .. } => Ok(Ending::Interrupted {
                 signal,

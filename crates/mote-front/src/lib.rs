@@ -210,17 +210,15 @@ pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, F
         // Checkpoints name their engine (point particles' older ones do not).
         let cp = mote_io::checkpoint::read(path)?;
         let mut options = options.clone();
-        if cp.option("engine") != Some("packing") {
-            let (dir, elsewhere) = lock::resume_folder(&cp, path);
-            if elsewhere {
-                monitor.note(&format!(
-                    "{}: continuing the run in its folder {}",
-                    path.display(),
-                    dir.display()
-                ));
-            }
-            options.output = Some(dir);
+        let (dir, elsewhere) = lock::resume_folder(&cp, path);
+        if elsewhere {
+            monitor.note(&format!(
+                "{}: continuing the run in its folder {}",
+                path.display(),
+                dir.display()
+            ));
         }
+        options.output = Some(dir);
         let options = &options;
         let result = match cp.option("engine") {
             Some("rigid") => rigid::resume(&cp, options, monitor),

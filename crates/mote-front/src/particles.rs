@@ -250,7 +250,7 @@ impl EngineRun for PointsRun {
         )
     }
 
-    fn ending(&self, e: MdError) -> Result<Ending, FrontError> {
+    fn ending(&self, _: &mut Self::State, e: MdError) -> Result<Ending, FrontError> {
         crate::rigid::md_ending(e)
     }
 

@@ -188,7 +188,7 @@ impl EngineRun for RigidRun {
         )
     }
 
-    fn ending(&self, e: MdError) -> Result<Ending, FrontError> {
+    fn ending(&self, _: &mut Self::State, e: MdError) -> Result<Ending, FrontError> {
         md_ending(e)
     }
 

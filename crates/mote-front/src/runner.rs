@@ -76,6 +76,11 @@ pub(crate) trait EngineRun {
     /// What the opening line says after `mote run LABEL: ` (size, method,
     /// length), before the seed and threads.
     fn opening(&self, state: &Self::State) -> String;
+    /// The opening line before the seed and threads: `mote run LABEL: `
+    /// and [`EngineRun::opening`].
+    fn headline(&self, label: &str, state: &Self::State) -> String {
+        format!("mote run {label}: {}", self.opening(state))
+    }
     /// Shows progress (called after every step and while priming).
     fn progress(&self, state: &Self::State, last_step: u64, monitor: &mut dyn Monitor) {
         let step = state.step();
@@ -85,7 +90,16 @@ pub(crate) trait EngineRun {
     }
     /// How a run that stopped with `e` ended: unstable or interrupted
     /// (the files so far kept), or an error.
-    fn ending(&self, e: <Self::State as Propagator>::Error) -> Result<Ending, FrontError>;
+    fn ending(
+        &self,
+        state: &mut Self::State,
+        e: <Self::State as Propagator>::Error,
+    ) -> Result<Ending, FrontError>;
+    /// How a run that reached its end ended (a packing a signal stopped
+    /// says so here).
+    fn ended(&self, _state: &Self::State) -> Ending {
+        Ending::Finished
+    }
     /// The lines that close a finished run.
     fn summary(
         &self,
@@ -201,9 +215,8 @@ pub(crate) fn run_engine<E: EngineRun>(
     }
     let last_step = engine.last_step(&state);
     monitor.start(&format!(
-        "mote run {}: {}, {}, {}",
-        input.label,
-        engine.opening(&state),
+        "{}, {}, {}",
+        engine.headline(&input.label, &state),
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase(),
     ));
@@ -231,6 +244,7 @@ pub(crate) fn run_engine<E: EngineRun>(
                 cpu,
             };
             outcome.summary = engine.summary(&state, &report, &done)?;
+            outcome.ending = engine.ended(&state);
             if let (Some(png), Some(frame)) = (&options.picture, state.frame()) {
                 mote_render::frame::picture(&frame, png, 1920, 1080)?;
                 outcome
@@ -238,7 +252,7 @@ pub(crate) fn run_engine<E: EngineRun>(
                     .push(format!("Picture of the final state: {}.", png.display()));
             }
         }
-        Err(e) => outcome.ending = engine.ending(e)?,
+        Err(e) => outcome.ending = engine.ending(&mut state, e)?,
     }
     Ok(outcome)
 }

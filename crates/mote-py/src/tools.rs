@@ -136,7 +136,7 @@ pub fn pack<'py>(
             named.extension()
         )));
     }
-    use mote_front::packing::{pack, Naming, PackFiles, PackingSpec};
+    use mote_front::packing::{pack, PackRequest, PackingSpec};
     let spec = PackingSpec {
         n,
         dimension,
@@ -152,40 +152,16 @@ pub fn pack<'py>(
         ..PackingSpec::default()
     };
     let (seed, _) = mote_front::seed::resolve(seed, None);
-    let settings = spec
-        .settings(seed, Naming::Options, std::path::Path::new("."))
-        .map_err(front_error)?;
-    let method = spec.method(Naming::Options).map_err(front_error)?;
-    let provenance = mote_io::Provenance {
-        program: format!("mote {} (Python)", env!("CARGO_PKG_VERSION")),
-        scene: format!("mote.pack(n={n}, dist={dist:?}, rate={rate})"),
+    let request = PackRequest {
+        output,
+        format,
+        picture: None,
+        checkpoint_every: None,
         seed,
     };
-    let _folder = match &output {
-        Some(dir) => Some(
-            mote_front::lock::RunFolder::fresh(dir, &provenance.scene, &provenance.scene)
-                .map_err(front_error)?,
-        ),
-        None => None,
-    };
-    let files = PackFiles {
-        xyz: output
-            .as_deref()
-            .map(|dir| mote_front::packing::packing_file(dir, format)),
-        ..PackFiles::default()
-    };
+    let label = format!("mote.pack(n={n}, dist={dist:?}, rate={rate})");
     let packed = py
-        .detach(|| {
-            pack(
-                dimension,
-                method,
-                settings,
-                None,
-                &files,
-                &provenance,
-                &mut mote_front::Silent,
-            )
-        })
+        .detach(|| pack(&spec, &label, &request, &mut mote_front::Silent))
         .map_err(front_error)?;
     let f = &packed.frame;
     let d = PyDict::new(py);

@@ -88,6 +88,11 @@ pub trait Propagator {
     }
     /// Advances one step.
     fn advance(&mut self) -> Result<(), Self::Error>;
+    /// Whether the propagator has reached an end of its own (a packing
+    /// that jammed): the run ends there, as at its last step.
+    fn finished(&self) -> bool {
+        false
+    }
     /// The first particle (index, what is wrong) whose state is not a
     /// finite number, if any.
     fn unstable(&self) -> Option<(usize, String)>;
@@ -296,7 +301,7 @@ impl<P: Propagator> Driver<P> {
         progress: &mut dyn FnMut(&P),
     ) -> Result<Option<P::Sample>, P::Error> {
         let mut last = None;
-        while state.step() < last_step {
+        while state.step() < last_step && !state.finished() {
             state.advance()?;
             let step = state.step();
             if let Some((particle, what)) = state.unstable() {
@@ -308,7 +313,7 @@ impl<P: Propagator> Driver<P> {
                 }
                 .into());
             }
-            let end = ends_run && step >= last_step;
+            let end = ends_run && (step >= last_step || state.finished());
             let due = |o: &dyn Observer<P>| end || step.is_multiple_of(o.every().max(1));
             if self.observers.iter().any(|o| due(o.as_ref())) {
                 let sample = state.measure();

@@ -694,6 +694,34 @@ fn killed_packing_resumes_bit_for_bit() {
     );
 }
 
+/// `mote pack` runs through the same loop: a packing written as GSD, killed
+/// after a checkpoint, resumes with `mote run --resume` into its folder and
+/// format, and ends with the uninterrupted run's packing and windows, byte
+/// for byte.
+#[test]
+fn a_killed_mote_pack_resumes_in_its_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--seed",
+        "3",
+        "pack",
+        "--n",
+        "400",
+        "--max-pressure",
+        "1e8",
+        "--format",
+        "gsd",
+        "--checkpoint-every",
+        "10",
+    ];
+    let (whole, at_kill, resumed) = whole_killed_resumed(dir.path(), &args, 20);
+    assert!(at_kill.step >= 20 && at_kill.step < whole.step);
+    assert_eq!(resumed.step, whole.step);
+    for file in ["packing.gsd", "packing.csv"] {
+        assert!(same_file(dir.path(), file), "{file} differs");
+    }
+}
+
 /// The toning nip killed mid-way resumes bit for bit: the checkpoint holds
 /// the Coulomb forces held between Ewald sums (`every = 5`), and the resume
 /// trims nip.csv as well as observables.csv and the trajectory.

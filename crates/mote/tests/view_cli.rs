@@ -144,3 +144,38 @@ fn ctrl_c_ends_a_live_run_and_the_server_keeping_the_files() {
     let last = std::fs::read_to_string(&table).unwrap();
     assert!(last.ends_with('\n'), "the table ends in a whole row");
 }
+
+/// A packing is watched live as any run is (it steps one pressure window
+/// at a time through the same loop): the page's session is live, the
+/// windows' table grows with no page open, and Ctrl-C ends it with the
+/// packing so far written.
+#[test]
+fn a_growing_packing_is_watched_live() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("grow.toml");
+    std::fs::write(
+        &scene,
+        "seed = 2\n[packing]\nn = 3000\nrate = 0.001\nmax_pressure = 1e12\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let (child, port) = start(&[scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let meta = get(port, "/api/meta");
+    assert!(meta.contains("\"live\":true"), "{meta}");
+    let table = out.join("packing.csv");
+    let rows = || {
+        std::fs::read_to_string(&table)
+            .map(|t| t.lines().filter(|l| !l.starts_with('#')).count())
+            .unwrap_or(0)
+    };
+    let t0 = std::time::Instant::now();
+    // the header and three windows
+    while rows() < 4 && t0.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert!(rows() >= 4, "the packing did not grow without a page");
+    let (status, err) = interrupt(child);
+    assert_eq!(status.code(), Some(0), "{err}");
+    let frames = mote_io::xyz::read_frames(&out.join("packing.xyz")).unwrap();
+    assert_eq!(frames.last().unwrap().positions.len(), 3000, "{err}");
+}

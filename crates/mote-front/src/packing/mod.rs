@@ -9,15 +9,21 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use mote_edmd::analyse::{bond_order, contacts, deepest_overlap};
-use mote_edmd::pack::{Finish, PackCheckpoints, PackSettings, PackState, Packer, SizeSpec, Stop};
+use std::cell::RefCell;
+
+use mote_edmd::pack::{Finish, PackSettings, SizeSpec};
 use mote_io::checkpoint::Checkpoint;
+use mote_io::trajectory::Format;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{refuse, FrontError};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
+mod growth;
 mod soft;
+
+pub use growth::Grown;
+use growth::Growth;
 
 /// What a packing is asked for, by either way in. The keys of a scene's
 /// `[packing]` table; `mote pack` spells them as options (`--dim` for
@@ -358,16 +364,12 @@ pub fn named_like_a_file(dir: &Path) -> Option<mote_io::trajectory::Format> {
     mote_io::trajectory::Format::of_path(dir).filter(|_| !dir.is_dir())
 }
 
-/// Where a packing goes: the XYZ file (the CSV and POV-Ray scene go beside
-/// it, same stem), a picture, checkpoints; and the checkpoint it resumes.
+/// Where a packing of the soft method goes: the packing file (the CSV and
+/// POV-Ray scene go beside it, same stem) and a picture.
 #[derive(Debug, Clone, Default)]
-pub struct PackFiles {
-    pub xyz: Option<PathBuf>,
-    pub picture: Option<PathBuf>,
-    pub checkpoints: Option<PackCheckpointFile>,
-    /// Continue this checkpoint's packing (the CSV is trimmed back to it
-    /// and appended to).
-    pub resume: Option<Checkpoint>,
+struct PackFiles {
+    xyz: Option<PathBuf>,
+    picture: Option<PathBuf>,
 }
 
 impl PackFiles {
@@ -403,43 +405,6 @@ impl PackFiles {
     }
 }
 
-/// Checkpoints of a packing: every `every` pressure windows to `path`, with
-/// the options and input of `template` (see [`checkpoint_template`]).
-#[derive(Debug, Clone)]
-pub struct PackCheckpointFile {
-    pub every: u64,
-    pub path: PathBuf,
-    pub template: Checkpoint,
-}
-
-/// What a packing's checkpoint records besides its state: the input as a
-/// `[packing]` scene (`label`, `text`), the seed, the schedule, where the
-/// packing goes and the folder its relative paths start from.
-pub fn checkpoint_template(
-    label: &str,
-    text: &str,
-    seed: u64,
-    every: u64,
-    xyz: &Path,
-    base: &Path,
-) -> Checkpoint {
-    // Relative paths are kept from the folder the run started in.
-    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    Checkpoint {
-        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
-        seed,
-        options: vec![
-            ("engine".into(), "packing".into()),
-            ("checkpoint-every".into(), every.to_string()),
-            ("output".into(), absolute(xyz).display().to_string()),
-            ("base".into(), absolute(base).display().to_string()),
-        ],
-        input_label: label.to_string(),
-        input_text: text.to_string(),
-        ..Checkpoint::default()
-    }
-}
-
 /// The options of `mote pack` as the text of a `[packing]` scene (what its
 /// checkpoints record as their input).
 pub fn spec_scene_text(spec: &PackingSpec, seed: u64) -> Result<String, FrontError> {
@@ -468,172 +433,164 @@ pub struct Packed {
     pub pressure: f64,
 }
 
-/// Grows the packing `settings` describe, writes `files` and says what it
-/// found (φ, pressure, why it stopped, contacts, order, overlaps). A
-/// signal stops it at the end of the current window with the packing so
-/// far written; an overlap beyond round-off is an error.
-pub fn pack(
-    dimension: usize,
-    method: Method,
-    settings: PackSettings,
-    tol: Option<f64>,
-    files: &PackFiles,
-    provenance: &mote_io::Provenance,
-    monitor: &mut dyn Monitor,
-) -> Result<Packed, FrontError> {
-    match (method, dimension) {
-        (Method::Soft { min_pressure }, _) => {
-            soft::pack_soft(settings, min_pressure, files, provenance, monitor)
-        }
-        (Method::Hard, 2) => pack_dim::<2>(settings, tol, files, provenance, monitor),
-        (Method::Hard, _) => pack_dim::<3>(settings, tol, files, provenance, monitor),
-    }
+/// What `mote pack` and Python's `mote.pack` ask for besides the packing.
+#[derive(Debug, Clone)]
+pub struct PackRequest {
+    /// The packing's folder (DIR/packing.EXT with its CSV, POV-Ray scene
+    /// and checkpoints); without one nothing is written.
+    pub output: Option<PathBuf>,
+    /// The packing file's format.
+    pub format: Format,
+    pub picture: Option<PathBuf>,
+    /// Pressure windows between checkpoints (needs `output`).
+    pub checkpoint_every: Option<u64>,
+    pub seed: u64,
 }
 
-fn pack_dim<const D: usize>(
-    settings: PackSettings,
-    tol: Option<f64>,
-    files: &PackFiles,
-    provenance: &mote_io::Provenance,
+/// Packs what `spec` asks for, as `mote pack` (`label`, the command as
+/// given) and Python do: growth through the one run (checkpoints, folder,
+/// progress as `mote run` has them), the soft method by its own loop; then
+/// what it found (φ, pressure, why it stopped, contacts, order, overlaps).
+/// A signal stops it at the end of the current window with the packing so
+/// far written; an overlap beyond round-off is an error.
+pub fn pack(
+    spec: &PackingSpec,
+    label: &str,
+    request: &PackRequest,
     monitor: &mut dyn Monitor,
 ) -> Result<Packed, FrontError> {
-    let max_pressure = settings.max_pressure;
-    let mut packer = match &files.resume {
-        Some(cp) => Packer::<D>::resume(settings, &PackState::from_checkpoint(cp, D)?)?,
-        None => Packer::<D>::new(settings)?,
-    };
-    let stem = files.stem()?;
-    let mut csv = match (&stem, &files.resume) {
-        (Some(s), Some(cp)) => {
-            let path = s.with("csv");
-            crate::checkpoints::trim_table(&path, u64::MAX, cp.time)?;
-            Some(mote_io::csv::CsvWriter::append(&path, 4)?)
-        }
-        (Some(s), None) => Some(mote_io::csv::CsvWriter::create(
-            &s.with("csv"),
-            provenance,
-            &["collisions", "time", "phi", "pressure"].map(String::from),
-            &["", "", "", ""].map(String::from),
-        )?),
-        (None, _) => None,
-    };
-    let mut save = |state: &PackState| -> Result<(), mote_edmd::EdmdError> {
-        if let Some(c) = &files.checkpoints {
-            mote_io::checkpoint::write(&c.path, &state.to_checkpoint(&c.template))?;
-        }
-        Ok(())
-    };
-    let mut checkpoints = files.checkpoints.as_ref().map(|c| PackCheckpoints {
-        every: c.every,
-        save: &mut save,
-    });
-    let cpu0 = crate::cpu::cpu_seconds();
-    let collisions0 = packer.collisions();
-    let mut csv_err = None;
-    let outcome = packer.run_with(
-        |s| {
-            if let Some(w) = csv.as_mut() {
-                if let Err(e) = w.row(&[s.collisions as f64, s.time, s.phi, s.pressure]) {
-                    csv_err.get_or_insert(e);
-                }
-            }
-            // Progress: log10 of the pressure towards the threshold.
-            let f = (s.pressure.max(1.0).log10() / max_pressure.log10()).clamp(0.0, 1.0);
-            monitor.progress(
-                (f * 1000.0) as u64,
-                1000,
-                &format!(
-                    "phi {:.5}  Z {:.3e}  {} collisions",
-                    s.phi, s.pressure, s.collisions
-                ),
-            );
-        },
-        checkpoints.as_mut(),
-    )?;
-    monitor.finish();
-    if let Some(e) = csv_err {
-        return Err(e.into());
-    }
-    let cpu = crate::cpu::cpu_seconds() - cpu0;
-    let sys = packer.system();
-    let simbox = *sys.simbox();
-    let (pos, radii) = (sys.positions(), sys.radii());
-    let overlap = deepest_overlap(&simbox, &pos, &radii);
-    let frame = mote_edmd::scene::frame(sys);
-    files.write(&frame, provenance)?;
-    let tol = tol.unwrap_or(1e3 / max_pressure);
-    let c = contacts(&simbox, &pos, &radii, tol);
-    let (q, _) = bond_order(&simbox, &pos, &radii, 1.2);
-    let stop = match outcome.stop {
-        Stop::Pressure => format!("reduced pressure passed {max_pressure:e} (jammed)"),
-        Stop::TargetPhi => "target packing fraction reached".to_string(),
-        Stop::Collisions => "collision budget spent".to_string(),
-        Stop::WallClock => "wall-clock limit reached".to_string(),
-        Stop::Interrupted => "run was interrupted by a signal (not jammed)".to_string(),
-    };
-    let mut summary = vec![
-        format!(
-            "{} {}: phi = {:.6}, reduced pressure Z = {:.3e}, stopped because the {stop}.",
-            sys.len(),
-            if D == 2 { "disks" } else { "spheres" },
-            outcome.phi,
-            outcome.pressure
-        ),
-        format!(
-            "{} collisions{} in {:.2} s CPU ({:.3e} per CPU-second), {} growth epochs.",
-            outcome.collisions,
-            if collisions0 > 0 {
-                format!(" ({} since the checkpoint)", outcome.collisions - collisions0)
-            } else {
-                String::new()
-            },
-            cpu,
-            (outcome.collisions - collisions0) as f64 / cpu.max(1e-9),
-            outcome.epochs
-        ),
-        format!(
-            "Contacts at relative gap {:e}: {} rattlers (< {} contacts), backbone mean contact number {:.4} (isostatic {}); {} = {:.4}.",
-            tol,
-            c.rattlers(),
-            D + 1,
-            c.backbone_z,
-            2 * D,
-            if D == 2 { "|psi6|" } else { "Q6" },
-            q
-        ),
-        match overlap {
-            None => "No overlaps (exact check over all pairs that can touch).".to_string(),
-            Some((_, _, g)) if g > -1e-12 => format!(
-                "No overlaps beyond round-off (exact check over all pairs that can touch; deepest |r|/sigma - 1 = {g:.1e})."
-            ),
-            Some((i, j, g)) => format!("OVERLAP: particles {i} and {j}, |r|/sigma - 1 = {g:.3e}."),
-        },
-    ];
-    if let Some(o) = &files.xyz {
-        summary.push(format!("Wrote {} (+ .csv, .pov).", o.display()));
-    }
-    if let Some((i, j, g)) = overlap {
-        if g <= -1e-9 {
+    let method = spec.method(Naming::Options)?;
+    let seed = request.seed;
+    if let Method::Soft { min_pressure } = method {
+        if request.checkpoint_every.is_some() {
             refuse!(
-                "particles {i} and {j} overlap by {:.3e} of their contact distance",
-                -g
+                "the soft method does not write checkpoints yet: run it without --checkpoint-every"
             );
         }
+        let settings = spec.settings(seed, Naming::Options, Path::new("."))?;
+        let text = spec_scene_text(spec, seed)?;
+        let _folder = match &request.output {
+            Some(dir) => Some(crate::lock::RunFolder::fresh(dir, label, &text)?),
+            None => None,
+        };
+        monitor.start(&format!("mote pack: {label}, seed {seed}"));
+        let files = PackFiles {
+            xyz: request
+                .output
+                .as_deref()
+                .map(|dir| packing_file(dir, request.format)),
+            picture: request.picture.clone(),
+        };
+        let packed = soft::pack_soft(
+            settings,
+            min_pressure,
+            &files,
+            &crate::provenance(label, seed),
+            monitor,
+        )
+        .map_err(|e| Naming::Options.locate(e));
+        monitor.finish();
+        return packed;
     }
-    let ending = match (outcome.stop, mote_io::system::stop_requested()) {
-        (Stop::Interrupted, Some(signal)) => Ending::Interrupted {
-            signal,
-            message: format!("interrupted by signal {signal}; the packing so far is written"),
-        },
-        _ => Ending::Finished,
+    let input = Input {
+        name: "pack".into(),
+        label: label.to_string(),
+        text: spec_scene_text(spec, seed)?,
+        plist: false,
+    };
+    let options = RunOptions {
+        output: request.output.clone(),
+        checkpoint_every: request.checkpoint_every,
+        picture: request.picture.clone(),
+        seed: Some(seed),
+        ..RunOptions::default()
+    };
+    let grown = RefCell::new(None);
+    let growth = Growing {
+        spec,
+        naming: Naming::Options,
+        base: PathBuf::from("."),
+        scene_seed: Some(seed),
+        scene_dir: None,
+        format: request.format,
+        writes: request.output.is_some(),
+        headline: Some(format!("mote pack: {label}")),
+        grown: &grown,
+    };
+    let outcome = growth.run(&input, &options, None, monitor);
+    monitor.finish();
+    packed(outcome?, grown)
+}
+
+/// A packing's outcome with the packing it left.
+fn packed(outcome: Outcome, grown: RefCell<Option<Grown>>) -> Result<Packed, FrontError> {
+    let Some(grown) = grown.into_inner() else {
+        return Err(FrontError::request(match outcome.ending {
+            Ending::Interrupted { message, .. } => message,
+            _ => "the packing ended without a result".into(),
+        }));
     };
     Ok(Packed {
-        summary,
-        ending,
-        frame,
-        phi: outcome.phi,
-        pressure: outcome.pressure,
+        summary: outcome.summary,
+        ending: outcome.ending,
+        frame: grown.frame,
+        phi: grown.phi,
+        pressure: grown.pressure,
     })
+}
+
+/// The parts of a [`Growth`] its dimension does not change.
+struct Growing<'a> {
+    spec: &'a PackingSpec,
+    naming: Naming<'a>,
+    base: PathBuf,
+    scene_seed: Option<u64>,
+    scene_dir: Option<String>,
+    format: Format,
+    writes: bool,
+    headline: Option<String>,
+    grown: &'a RefCell<Option<Grown>>,
+}
+
+impl Growing<'_> {
+    /// The growth through the one run, in its dimension.
+    fn run(
+        self,
+        input: &Input,
+        options: &RunOptions,
+        resumed: Option<&Checkpoint>,
+        monitor: &mut dyn Monitor,
+    ) -> Result<Outcome, FrontError> {
+        macro_rules! growth {
+            ($d:literal) => {
+                crate::runner::run_engine(
+                    Growth::<$d>::new(
+                        self.spec,
+                        self.naming,
+                        self.base,
+                        self.scene_seed,
+                        self.scene_dir,
+                        self.format,
+                        self.writes,
+                        self.headline,
+                        self.grown,
+                    ),
+                    input,
+                    options,
+                    resumed,
+                    monitor,
+                )
+            };
+        }
+        match self.spec.dimension {
+            2 => growth!(2),
+            3 => growth!(3),
+            d => refuse!(
+                "{}: must be 2 or 3",
+                self.naming.said("dimension", d, false)
+            ),
+        }
+    }
 }
 
 /// A packing's path without its extension, to which the CSV and POV-Ray
@@ -691,6 +648,14 @@ struct PackingOutput {
     dir: Option<String>,
 }
 
+impl PackingScene {
+    /// The scene of `source`, its errors at their line.
+    fn parse(source: mote_io::Source) -> Result<Self, FrontError> {
+        toml::from_str(source.text)
+            .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))
+    }
+}
+
 /// `mote run` on a scene with a `[packing]` table: the packing goes to
 /// `DIR/packing.xyz` (or the format of `--trajectory-format`; with .csv
 /// and .pov beside it).
@@ -713,8 +678,7 @@ pub(crate) fn run(
     )?;
     let source = mote_io::Source::new(&input.label, &input.text);
     source.finite_numbers().map_err(FrontError::Parse)?;
-    let scene: PackingScene = toml::from_str(&input.text)
-        .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))?;
+    let scene = PackingScene::parse(source)?;
     if scene.run.is_some() {
         refuse!(
             "{}:{}: [run] has nothing to set for a packing: {WHY_NO_TIME}",
@@ -722,83 +686,78 @@ pub(crate) fn run(
             source.key_line("run")
         );
     }
+    let spec = &scene.packing;
+    let format = options.trajectory_format(Format::Xyz)?;
+    if let Method::Soft { min_pressure } = spec.method(Naming::Scene(source))? {
+        return run_soft(
+            input,
+            options,
+            &scene,
+            source,
+            min_pressure,
+            format,
+            monitor,
+        );
+    }
+    let grown = RefCell::new(None);
+    Growing {
+        spec,
+        naming: Naming::Scene(source),
+        base: input.folder(),
+        scene_seed: scene.seed,
+        scene_dir: scene.output.dir.clone(),
+        format,
+        writes: true,
+        headline: None,
+        grown: &grown,
+    }
+    .run(input, options, None, monitor)
+}
+
+/// A `[packing]` scene of the soft method under `mote run`, by its own
+/// loop (no checkpoints, no live view yet).
+fn run_soft(
+    input: &Input,
+    options: &RunOptions,
+    scene: &PackingScene,
+    source: mote_io::Source,
+    min_pressure: f64,
+    format: Format,
+    monitor: &mut dyn Monitor,
+) -> Result<Outcome, FrontError> {
+    if options.checkpoint_every.is_some() {
+        refuse!(
+            "the soft method does not write checkpoints yet: run it without --checkpoint-every"
+        );
+    }
+    if options.live.is_set() {
+        refuse!("{}: the soft method runs its own loop and cannot be watched live yet: run it, then `mote view` its packing", input.label);
+    }
     let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
-    let base = input.folder();
     let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
     let spec = &scene.packing;
-    let settings = spec.settings(seed, Naming::Scene(source), &base)?;
-    let method = spec.method(Naming::Scene(source))?;
-    let xyz = packing_file(
-        &dir,
-        options.trajectory_format(mote_io::trajectory::Format::Xyz)?,
-    );
+    let settings = spec.settings(seed, Naming::Scene(source), &input.folder())?;
     let _folder = crate::lock::RunFolder::fresh(&dir, &input.label, &input.text)?;
-    let how = match method {
-        Method::Hard => format!("by growth (rate {}", spec.rate),
-        Method::Soft { min_pressure } => {
-            format!("by the soft method (down to P/K = {min_pressure:e}")
-        }
-    };
     monitor.start(&format!(
-        "mote run {}: packing {} {} {how}, {}), {}, {}",
+        "mote run {}: packing {} spheres by the soft method (down to P/K = {min_pressure:e}, {}), {}, {}",
         input.label,
         spec.n,
-        if spec.dimension == 2 {
-            "disks"
-        } else {
-            "spheres"
-        },
         spec.dist,
         crate::seed_phrase(seed, chosen),
         crate::threads_phrase()
     ));
     let files = PackFiles {
-        checkpoints: options.checkpoint_every.map(|every| PackCheckpointFile {
-            every,
-            path: dir.join("checkpoint.mote"),
-            template: checkpoint_template(&input.label, &input.text, seed, every, &xyz, &base),
-        }),
-        xyz: Some(xyz),
+        xyz: Some(packing_file(&dir, format)),
         picture: options.picture.clone(),
-        resume: None,
     };
-    packed_outcome(
-        Naming::Scene(source),
-        &input.label,
-        seed,
-        spec,
-        method,
+    let packed = soft::pack_soft(
         settings,
+        min_pressure,
         &files,
-        dir,
+        &crate::provenance(&input.label, seed),
         monitor,
     )
-}
-
-/// Packs and says what `mote run` says of it.
-#[allow(clippy::too_many_arguments)]
-fn packed_outcome(
-    naming: Naming,
-    label: &str,
-    seed: u64,
-    spec: &PackingSpec,
-    method: Method,
-    settings: PackSettings,
-    files: &PackFiles,
-    dir: PathBuf,
-    monitor: &mut dyn Monitor,
-) -> Result<Outcome, FrontError> {
-    let provenance = crate::provenance(label, seed);
-    let packed = pack(
-        spec.dimension,
-        method,
-        settings,
-        spec.tol,
-        files,
-        &provenance,
-        monitor,
-    )
-    .map_err(|e| naming.locate(e))?;
+    .map_err(|e| Naming::Scene(source).locate(e))?;
     Ok(Outcome {
         engine: Engine::Packing,
         seed,
@@ -809,7 +768,7 @@ fn packed_outcome(
 }
 
 /// Continues the packing a checkpoint came from (by `mote pack` or a
-/// `[packing]` scene): the same settings, seed, files and checkpoint
+/// `[packing]` scene): the same request, seed, folder and checkpoint
 /// schedule; the CSV is trimmed back to the checkpoint and the packing is
 /// written at the end as an uninterrupted run would have.
 pub(crate) fn resume(
@@ -817,69 +776,35 @@ pub(crate) fn resume(
     given: &RunOptions,
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
-    let option = |k: &str| {
-        cp.option(k).ok_or_else(|| {
-            FrontError::request(format!("the packing checkpoint has no option '{k}'"))
-        })
-    };
-    let source = mote_io::Source::new(&cp.input_label, &cp.input_text);
-    let scene: PackingScene = toml::from_str(&cp.input_text)
-        .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))?;
-    let every: u64 = option("checkpoint-every")?
-        .parse()
-        .map_err(|_| FrontError::request("checkpoint-every is not a whole number"))?;
-    let xyz = PathBuf::from(option("output")?);
-    let base = PathBuf::from(option("base")?);
-    let seed = cp.seed;
-    let spec = &scene.packing;
-    let settings = spec.settings(seed, Naming::Scene(source), &base)?;
-    let method = spec.method(Naming::Scene(source))?;
-    let dir = xyz
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."));
-    let _lock = crate::lock::FolderLock::take(&dir)?;
-    monitor.start(&format!(
-        "mote run --resume: packing {} from window {} ({} collisions), seed {seed}",
-        cp.input_label,
-        cp.step,
-        cp.carried
-            .iter()
-            .find(|(k, _)| *k == 2)
-            .and_then(|(_, run)| run.get(4))
-            .copied()
-            .unwrap_or(0.0)
-    ));
-    let path = given
-        .resume
-        .clone()
-        .unwrap_or_else(|| dir.join("checkpoint.mote"));
-    let files = PackFiles {
-        xyz: Some(xyz),
-        picture: given.picture.clone(),
-        checkpoints: Some(PackCheckpointFile {
-            every,
-            path,
-            template: checkpoint_template(
-                &cp.input_label,
-                &cp.input_text,
-                seed,
-                every,
-                &PathBuf::from(option("output")?),
-                &base,
-            ),
-        }),
-        resume: Some(cp.clone()),
-    };
-    packed_outcome(
-        Naming::Scene(source),
-        &cp.input_label,
-        seed,
-        spec,
-        method,
-        settings,
-        &files,
-        dir,
-        monitor,
-    )
+    if cp.option("name").is_none() {
+        refuse!(
+            "this packing checkpoint was written by an older mote, before packings ran through the loop every run shares; start the packing again"
+        );
+    }
+    let (input, options) = crate::checkpoints::restore(cp, given)?;
+    let source = mote_io::Source::new(&input.label, &input.text);
+    let scene = PackingScene::parse(source)?;
+    let format = cp
+        .option("packing-format")
+        .and_then(Format::named)
+        .unwrap_or(Format::Xyz);
+    let grown = RefCell::new(None);
+    Growing {
+        spec: &scene.packing,
+        naming: Naming::Scene(source),
+        base: cp
+            .option("base")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| input.folder()),
+        scene_seed: scene.seed,
+        scene_dir: scene.output.dir.clone(),
+        format,
+        writes: true,
+        headline: Some(format!(
+            "mote run --resume: packing {} from window {}",
+            input.label, cp.step
+        )),
+        grown: &grown,
+    }
+    .run(&input, &options, Some(cp), monitor)
 }

@@ -5,7 +5,7 @@ use mote_edmd::analyse::{contacts, stable_contacts};
 use mote_edmd::pack::{PackSettings, SizeSpec};
 
 use super::{PackFiles, Packed};
-use crate::error::{refuse, FrontError};
+use crate::error::FrontError;
 use crate::{Ending, Monitor};
 
 /// The SP method ([`mote_md::soft_pack`]): soft spheres compressed by a
@@ -23,11 +23,6 @@ pub(super) fn pack_soft(
 ) -> Result<Packed, FrontError> {
     use mote_md::soft_pack::{extrapolate, SoftPackSettings, SoftPacker};
     use rand::SeedableRng;
-    if files.checkpoints.is_some() || files.resume.is_some() {
-        refuse!(
-            "the soft method does not write checkpoints yet: run it without --checkpoint-every"
-        );
-    }
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(settings.seed);
     let n = match &settings.sizes {
         SizeSpec::Radii(r) => r.len(),

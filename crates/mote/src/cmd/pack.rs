@@ -5,7 +5,7 @@
 //! scene and optionally a PNG picture; `mote pack analyse FILE` reports the
 //! structure of a packing (`mote_edmd::analyse`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -13,8 +13,8 @@ use mote_edmd::analyse::{
     bond_order, contacts, deepest_overlap, pair_correlation, stable_contacts,
 };
 use mote_edmd::{Boundary, SimBox};
-use mote_front::packing::{packing_file, Naming, PackFiles, PackingSpec};
-use mote_front::{Ending, Monitor};
+use mote_front::packing::{Naming, PackRequest, PackingSpec};
+use mote_front::Ending;
 
 use super::GlobalOpts;
 use mote_front::Terminal;
@@ -210,8 +210,7 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         mote_front::check_picture_path(p)?;
     }
     let spec = a.spec();
-    let (seed, chosen) = mote_front::seed::resolve(global.seed, None);
-    let settings = spec.settings(seed, Naming::Options, Path::new("."))?;
+    let (seed, _) = mote_front::seed::resolve(global.seed, None);
     let method = spec.method(Naming::Options)?;
     let start = match &a.start {
         Some(file) => format!("--start {file}"),
@@ -229,63 +228,22 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
             format!("mote pack {start} --method soft --min-pressure {min_pressure:e}")
         }
     };
-    let mut terminal = Terminal::new(quiet);
-    terminal.start(&format!(
-        "mote pack: {label}, seed {seed}{}",
-        if chosen { " (chosen)" } else { "" }
-    ));
-    let provenance = mote_io::Provenance {
-        program: format!("mote {}", env!("CARGO_PKG_VERSION")),
-        scene: label.clone(),
-        seed,
-    };
-    let checkpoints = match (a.checkpoint_every, &a.output) {
-        (None, _) => None,
+    match (a.checkpoint_every, &a.output) {
         (Some(0), _) => anyhow::bail!("--checkpoint-every 0: give a number of windows ≥ 1"),
         (Some(_), None) => {
             anyhow::bail!("--checkpoint-every needs -o DIR: the packing is resumed into it")
         }
-        (Some(every), Some(dir)) => {
-            let text = mote_front::packing::spec_scene_text(&spec, seed)?;
-            Some(mote_front::packing::PackCheckpointFile {
-                every,
-                path: dir.join("checkpoint.mote"),
-                template: mote_front::packing::checkpoint_template(
-                    &label,
-                    &text,
-                    seed,
-                    every,
-                    &packing_file(dir, format),
-                    Path::new("."),
-                ),
-            })
-        }
-    };
-    // The folder is held as `mote run` holds a run's: locked and marked.
-    let _folder = match &a.output {
-        Some(dir) => Some(mote_front::lock::RunFolder::fresh(
-            dir,
-            &label,
-            &mote_front::packing::spec_scene_text(&spec, seed)?,
-        )?),
-        None => None,
-    };
-    let files = PackFiles {
-        xyz: a.output.as_deref().map(|dir| packing_file(dir, format)),
+        _ => {}
+    }
+    let request = PackRequest {
+        output: a.output.clone(),
+        format,
         picture: a.picture.clone(),
-        checkpoints,
-        resume: None,
+        checkpoint_every: a.checkpoint_every,
+        seed,
     };
-    let packed = mote_front::packing::pack(
-        spec.dimension,
-        method,
-        settings,
-        spec.tol,
-        &files,
-        &provenance,
-        &mut terminal,
-    )
-    .map_err(|e| Naming::Options.locate(e))?;
+    let mut terminal = Terminal::new(quiet);
+    let packed = mote_front::packing::pack(&spec, &label, &request, &mut terminal)?;
     if !quiet {
         for line in &packed.summary {
             say!("{line}");

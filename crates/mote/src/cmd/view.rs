@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::anyhow;
-use mote_front::{Engine, Input, RunOptions};
+use mote_front::{Input, RunOptions};
 use mote_view::live::{self, Session};
 use mote_view::App;
 
@@ -91,12 +91,6 @@ fn live_app(
     a: &ViewArgs,
 ) -> Result<(Arc<App>, String, std::thread::JoinHandle<()>), String> {
     let input = Input::read(&a.input).map_err(|e| e.to_string())?;
-    if input.engine() == Engine::Packing {
-        return Err(format!(
-            "{}: a packing runs its own loop: make it with `mote pack`, then `mote view` its trajectory",
-            a.input
-        ));
-    }
     let dir = input.run_dir(a.output.as_ref());
     let session = Session::new(input.label.clone(), dir.clone(), a.paused);
     let options = RunOptions {

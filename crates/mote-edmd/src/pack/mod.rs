@@ -30,6 +30,8 @@ use crate::init::{ball_volume, normal, random_placement, thermal_velocities};
 use crate::system::{Boundary, SimBox, System};
 use crate::EdmdError;
 
+mod propagator;
+
 /// A size distribution of the packed particles (diameters up to a common
 /// scale).
 #[derive(Debug, Clone, PartialEq)]
@@ -389,6 +391,15 @@ pub enum Stop {
 }
 
 impl Stop {
+    /// Every stop, in the order of their codes in a checkpoint (1, 2, …).
+    const ALL: [Stop; 5] = [
+        Stop::Pressure,
+        Stop::TargetPhi,
+        Stop::Collisions,
+        Stop::WallClock,
+        Stop::Interrupted,
+    ];
+
     pub fn name(&self) -> &'static str {
         match self {
             Stop::Pressure => "pressure",
@@ -443,11 +454,24 @@ pub struct Packer<const D: usize> {
     win_coll: u64,
     last_pressure: f64,
     history: Vec<Sample>,
-    /// Windows closed when the last checkpoint was taken.
-    checkpointed: u64,
-    /// Built from a checkpoint taken in the quasi-static finish: the run
-    /// goes on there.
-    resumed_in_finish: bool,
+    /// Growing, or where in the quasi-static finish.
+    phase: Phase,
+    /// Why the run ended, once it has.
+    stopped: Option<Stop>,
+    /// When the first step began (the wall-clock limit counts from it).
+    started: Option<Instant>,
+}
+
+/// Where a packer stands between two steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// Growing at the epoch's rate.
+    Growing,
+    /// In a cycle of the quasi-static finish: `relaxed` of its windows at
+    /// fixed radii are closed; `rebuilt` when the system was rebuilt for
+    /// the next (by a checkpoint, or a packer resumed from one), so the
+    /// cycle does not rebuild it again.
+    Finishing { relaxed: usize, rebuilt: bool },
 }
 
 /// Where a packing stands at a checkpoint. The system has just been rebuilt
@@ -463,8 +487,11 @@ pub struct PackState {
     /// Growth rate δ and horizon of the epoch the system was built for.
     pub delta: f64,
     pub horizon: f64,
-    /// Taken at the top of a cycle of the quasi-static finish.
-    pub finishing: bool,
+    /// Taken in the quasi-static finish: the relaxation windows of the
+    /// cycle closed by then (0 at the top of a cycle); `None` while growing.
+    pub finishing: Option<usize>,
+    /// Why the run had ended, if it had (a checkpoint of its last step).
+    pub stopped: Option<Stop>,
     pub t_before: f64,
     pub collisions: u64,
     pub epochs: u64,
@@ -497,7 +524,7 @@ impl PackState {
         let run = vec![
             self.delta,
             self.horizon,
-            f64::from(u8::from(self.finishing)),
+            self.finishing.map_or(0.0, |k| 1.0 + k as f64),
             self.t_before,
             self.collisions as f64,
             self.epochs as f64,
@@ -505,6 +532,9 @@ impl PackState {
             self.win_time,
             self.win_coll as f64,
             self.last_pressure,
+            self.stopped
+                .and_then(|stop| Stop::ALL.iter().position(|s| *s == stop))
+                .map_or(0.0, |k| 1.0 + k as f64),
         ];
         let history = self
             .history
@@ -544,7 +574,8 @@ impl PackState {
         let history = list(Self::HISTORY);
         let (size, radii) = (list(Self::SIZE), list(Self::RADII));
         let n = cp.positions.len();
-        if run.len() != 10
+        // Checkpoints before the run's stop was recorded have 10 numbers.
+        if !(run.len() == 10 || run.len() == 11)
             || history.len() % 4 != 0
             || size.len() != dimension
             || radii.len() != n
@@ -567,7 +598,18 @@ impl PackState {
             radii: radii.to_vec(),
             delta: run[0],
             horizon: run[1],
-            finishing: run[2] != 0.0,
+            finishing: match count(run[2])? {
+                0 => None,
+                k => Some(k as usize - 1),
+            },
+            stopped: match count(run.get(10).copied().unwrap_or(0.0))? {
+                0 => None,
+                k => Some(
+                    *Stop::ALL
+                        .get(k as usize - 1)
+                        .ok_or_else(|| bad("an unknown stop"))?,
+                ),
+            },
             t_before: run[3],
             collisions: count(run[4])?,
             epochs: count(run[5])?,
@@ -590,10 +632,9 @@ impl PackState {
     }
 }
 
-/// Checkpoints of a packing: `save` is called every `every` pressure
-/// windows (at the next point where the state can be rebuilt: a window's
-/// end while growing, a cycle's start in the finish) and when a signal
-/// stops the run.
+/// Checkpoints of a packing: `save` is called with [`Packer::checkpoint`]
+/// every `every` pressure windows (growing or in the finish) and when a
+/// signal stops the run.
 pub struct PackCheckpoints<'a> {
     pub every: u64,
     pub save: &'a mut dyn FnMut(&PackState) -> Result<(), EdmdError>,
@@ -725,8 +766,9 @@ impl<const D: usize> Packer<D> {
             win_coll: 0,
             last_pressure: f64::NAN,
             history: Vec::new(),
-            checkpointed: 0,
-            resumed_in_finish: false,
+            phase: Phase::Growing,
+            stopped: None,
+            started: None,
         })
     }
 
@@ -734,6 +776,23 @@ impl<const D: usize> Packer<D> {
     /// run that wrote it).
     pub fn resume(settings: PackSettings, state: &PackState) -> Result<Self, EdmdError> {
         let invalid = |m: &str| EdmdError::Invalid(format!("checkpoint of a packing: {m}"));
+        let phase = match (state.finishing, settings.finish) {
+            (None, _) => Phase::Growing,
+            (Some(k), Some(f)) if k <= f.relax_windows => Phase::Finishing {
+                relaxed: k,
+                rebuilt: true,
+            },
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "taken further into a finish cycle than its settings' relaxation windows",
+                ))
+            }
+            (Some(_), None) => {
+                return Err(invalid(
+                    "taken in the quasi-static finish, for settings without one",
+                ))
+            }
+        };
         let n = state.radii.len();
         if state.size.len() != D
             || state.positions.len() != n
@@ -787,14 +846,15 @@ impl<const D: usize> Packer<D> {
             win_time: state.win_time,
             win_coll: state.win_coll,
             last_pressure: state.last_pressure,
-            checkpointed: state.history.len() as u64,
             history: state.history.clone(),
-            resumed_in_finish: state.finishing,
+            phase,
+            stopped: state.stopped,
+            started: None,
         })
     }
 
     /// The state of a system just rebuilt (see [`PackState`]).
-    fn state(&self, delta: f64, horizon: f64, finishing: bool) -> PackState {
+    fn state(&self, delta: f64, horizon: f64) -> PackState {
         let sys = &self.sys;
         PackState {
             size: sys.simbox().size.to_vec(),
@@ -803,7 +863,15 @@ impl<const D: usize> Packer<D> {
             radii: sys.radii(),
             delta,
             horizon,
-            finishing,
+            finishing: match self.phase {
+                Phase::Growing => None,
+                Phase::Finishing { relaxed, .. } => Some(relaxed),
+            },
+            // A signal or the wall clock ends this run, not the packing:
+            // a run resumed from here goes on.
+            stopped: self
+                .stopped
+                .filter(|s| !matches!(s, Stop::Interrupted | Stop::WallClock)),
             t_before: self.t_before,
             collisions: self.collisions,
             epochs: self.epochs,
@@ -815,27 +883,28 @@ impl<const D: usize> Packer<D> {
         }
     }
 
-    /// Whether a checkpoint is due: a signal, or `every` windows closed
-    /// since the last one.
-    fn checkpoint_due(&self, cps: &Option<&mut PackCheckpoints>, signal: bool) -> bool {
-        cps.as_ref().is_some_and(|c| {
-            signal || self.history.len() as u64 >= self.checkpointed + c.every.max(1)
-        })
-    }
-
-    fn save(
-        &mut self,
-        cps: &mut Option<&mut PackCheckpoints>,
-        delta: f64,
-        horizon: f64,
-        finishing: bool,
-    ) -> Result<(), EdmdError> {
-        if let Some(c) = cps.as_mut() {
-            self.checkpointed = self.history.len() as u64;
-            let state = self.state(delta, horizon, finishing);
-            (c.save)(&state)?;
+    /// The state to checkpoint now: the system is rebuilt first (a new
+    /// epoch while growing; at fixed radii in the finish, unless it just
+    /// was), so that a packer resumed from it goes on from the same bits
+    /// as this one. Taking a checkpoint therefore changes the run's later
+    /// bits (as a rebuild does) but not its physics.
+    pub fn checkpoint(&mut self) -> Result<PackState, EdmdError> {
+        match self.phase {
+            Phase::Growing => {
+                let (delta, horizon) = self.new_epoch()?;
+                Ok(self.state(delta, horizon))
+            }
+            Phase::Finishing { relaxed, rebuilt } => {
+                if !rebuilt {
+                    self.restart(0.0, f64::INFINITY)?;
+                    self.phase = Phase::Finishing {
+                        relaxed,
+                        rebuilt: true,
+                    };
+                }
+                Ok(self.state(0.0, f64::INFINITY))
+            }
         }
-        Ok(())
     }
 
     /// The box, positions and radii of a given start, checked: finite,
@@ -971,10 +1040,7 @@ impl<const D: usize> Packer<D> {
 
     /// Ends the current pressure window: Z = 1 + Σ r·Δp / (2 K t) with K the
     /// window's mean, a sample, and the kinetic energy rescaled.
-    fn close_window(
-        &mut self,
-        progress: &mut impl FnMut(&Sample),
-    ) -> Result<(f64, f64), EdmdError> {
+    fn close_window(&mut self) -> Result<(f64, f64), EdmdError> {
         let ke_end = self.sys.kinetic_energy();
         if !ke_end.is_finite() || ke_end <= 0.0 {
             return Err(EdmdError::Invalid(format!(
@@ -992,7 +1058,6 @@ impl<const D: usize> Packer<D> {
             pressure: z,
         };
         self.history.push(sample);
-        progress(&sample);
         if (ke_end / self.ke_target - 1.0).abs() > 1e-12 {
             self.sys.scale_velocities((self.ke_target / ke_end).sqrt());
         }
@@ -1003,76 +1068,141 @@ impl<const D: usize> Packer<D> {
         Ok((z, t))
     }
 
-    /// The quasi-static finish ([`Finish`]). Signals and checkpoints are
-    /// taken at the start of a cycle, where the system is rebuilt anyway.
-    fn finish(
-        &mut self,
-        f: Finish,
-        window: u64,
-        start: Instant,
-        progress: &mut impl FnMut(&Sample),
-        cps: &mut Option<&mut PackCheckpoints>,
-    ) -> Result<Stop, EdmdError> {
-        // A packer resumed in the finish was built as the cycle's start.
-        let mut rebuilt = std::mem::take(&mut self.resumed_in_finish);
+    /// Collisions in a pressure window: `rescale_every` per particle.
+    fn window(&self) -> u64 {
+        ((self.settings.rescale_every * self.sys.len() as f64).round() as u64).max(1)
+    }
+
+    /// Whether the wall-clock limit has passed.
+    fn out_of_time(&self, start: Instant) -> bool {
+        self.settings
+            .wall_clock
+            .is_some_and(|limit| start.elapsed() >= limit)
+    }
+
+    /// One window of growth: collisions (new epochs as the old run out)
+    /// until the window closes, the target φ is reached, or a limit
+    /// passes; the finish begins when the window's pressure passes its
+    /// start.
+    fn grow_window(&mut self, start: Instant) -> Result<Option<Stop>, EdmdError> {
+        let window = self.window();
         loop {
-            // relax at fixed radii
-            if !rebuilt {
-                self.restart(0.0, f64::INFINITY)?;
-            }
-            rebuilt = false;
-            let signal = mote_io::system::stop_requested().is_some();
-            if self.checkpoint_due(cps, signal) {
-                self.save(cps, 0.0, f64::INFINITY, true)?;
-            }
-            if signal {
-                return Ok(Stop::Interrupted);
-            }
-            let (mut z, mut t_w) = (f64::NAN, 0.0);
-            for _ in 0..f.relax_windows {
-                let mut want = window;
-                if let Some(budget) = self.settings.max_collisions {
-                    if self.collisions >= budget {
-                        return Ok(Stop::Collisions);
-                    }
-                    want = want.min(budget - self.collisions);
+            let mut want = window - self.win_coll;
+            if let Some(budget) = self.settings.max_collisions {
+                if self.collisions >= budget {
+                    return Ok(Some(Stop::Collisions));
                 }
-                if self.collisions_within(want, f64::INFINITY, start).is_none() {
-                    self.harvest();
-                    return Ok(Stop::WallClock);
-                }
+                want = want.min(budget - self.collisions);
+            }
+            let t_target = match self.settings.target_phi {
+                Some(p) => self.time_of_phi(p),
+                None => f64::INFINITY,
+            };
+            let horizon = self.sys.horizon();
+            let t_end = t_target.min(horizon);
+            let Some(done) = self.collisions_within(want, t_end, start) else {
                 self.harvest();
-                if self.win_coll < window {
-                    continue;
-                }
-                (z, t_w) = self.close_window(progress)?;
-                if let Some(limit) = self.settings.wall_clock {
-                    if start.elapsed() >= limit {
-                        return Ok(Stop::WallClock);
-                    }
-                }
-            }
-            if z > self.settings.max_pressure {
-                return Ok(Stop::Pressure);
-            }
-            if !(z > 1.0 && t_w > 0.0) {
-                return Ok(Stop::Collisions);
-            }
-            // grow by step/Z over one window's duration
-            let delta = f.step / (z * t_w);
-            self.restart(delta, t_w)?;
-            let Some(done) = self.collisions_within(10 * window, t_w, start) else {
-                self.harvest();
-                return Ok(Stop::WallClock);
+                return Ok(Some(Stop::WallClock));
             };
             if !done {
-                self.sys.run_until(t_w);
+                // nothing more before t_end (or no events at all)
+                if t_end.is_finite() {
+                    self.sys.run_until(t_end);
+                }
+                if t_target <= horizon {
+                    self.harvest();
+                    return Ok(Some(Stop::TargetPhi));
+                }
+                self.new_epoch()?;
+                continue;
             }
             self.harvest();
-            self.win_virial = 0.0;
-            self.win_time = 0.0;
-            self.win_coll = 0;
+            if self.win_coll < window {
+                // the collision budget cut the window short
+                continue;
+            }
+            let (z, _) = self.close_window()?;
+            if z > self.settings.max_pressure {
+                return Ok(Some(Stop::Pressure));
+            }
+            if let Some(f) = self.settings.finish {
+                if z > f.start_pressure {
+                    self.phase = Phase::Finishing {
+                        relaxed: 0,
+                        rebuilt: false,
+                    };
+                    return Ok(None);
+                }
+            }
+            return Ok(self.out_of_time(start).then_some(Stop::WallClock));
         }
+    }
+
+    /// One window of the quasi-static finish ([`Finish`]): a cycle's
+    /// windows at fixed radii (the system rebuilt for them at the cycle's
+    /// top), and after the last of them the growth step of the cycle, or
+    /// the stop when the relaxed pressure passes the threshold.
+    fn finish_window(&mut self, f: Finish, start: Instant) -> Result<Option<Stop>, EdmdError> {
+        let Phase::Finishing { relaxed, rebuilt } = self.phase else {
+            unreachable!("a finish window while growing");
+        };
+        let window = self.window();
+        if relaxed == 0 && !rebuilt {
+            self.restart(0.0, f64::INFINITY)?;
+        }
+        let mut want = window;
+        if let Some(budget) = self.settings.max_collisions {
+            if self.collisions >= budget {
+                return Ok(Some(Stop::Collisions));
+            }
+            want = want.min(budget - self.collisions);
+        }
+        if self.collisions_within(want, f64::INFINITY, start).is_none() {
+            self.harvest();
+            return Ok(Some(Stop::WallClock));
+        }
+        self.harvest();
+        if self.win_coll < window {
+            // the budget is spent (or no collision is left at all)
+            return Ok(Some(Stop::Collisions));
+        }
+        let (z, t_w) = self.close_window()?;
+        let relaxed = relaxed + 1;
+        self.phase = Phase::Finishing {
+            relaxed,
+            rebuilt: false,
+        };
+        if self.out_of_time(start) {
+            return Ok(Some(Stop::WallClock));
+        }
+        if relaxed < f.relax_windows {
+            return Ok(None);
+        }
+        if z > self.settings.max_pressure {
+            return Ok(Some(Stop::Pressure));
+        }
+        if !(z > 1.0 && t_w > 0.0) {
+            return Ok(Some(Stop::Collisions));
+        }
+        // grow by step/Z over one window's duration
+        let delta = f.step / (z * t_w);
+        self.restart(delta, t_w)?;
+        let Some(done) = self.collisions_within(10 * window, t_w, start) else {
+            self.harvest();
+            return Ok(Some(Stop::WallClock));
+        };
+        if !done {
+            self.sys.run_until(t_w);
+        }
+        self.harvest();
+        self.win_virial = 0.0;
+        self.win_time = 0.0;
+        self.win_coll = 0;
+        self.phase = Phase::Finishing {
+            relaxed: 0,
+            rebuilt: false,
+        };
+        Ok(None)
     }
 
     /// [`System::run_collisions_until`] that gives up at the wall-clock
@@ -1098,95 +1228,100 @@ impl<const D: usize> Packer<D> {
         Some(true)
     }
 
+    /// One step of the packing: collisions until the next pressure window
+    /// closes (a window of `rescale_every` collisions per particle, growing
+    /// or in the finish), or until the run ends ([`Packer::stopped`]);
+    /// nothing once it has.
+    pub fn advance(&mut self) -> Result<(), EdmdError> {
+        if self.stopped.is_some() {
+            return Ok(());
+        }
+        let start = *self.started.get_or_insert_with(Instant::now);
+        self.stopped = match (self.phase, self.settings.finish) {
+            (Phase::Finishing { .. }, Some(f)) => self.finish_window(f, start)?,
+            _ => self.grow_window(start)?,
+        };
+        Ok(())
+    }
+
+    /// Why the run ended, once it has.
+    pub fn stopped(&self) -> Option<Stop> {
+        self.stopped
+    }
+
+    /// Ends the run early (a signal): [`Packer::advance`] then does nothing.
+    pub fn stop(&mut self, why: Stop) {
+        self.stopped.get_or_insert(why);
+    }
+
+    /// Pressure windows closed: the packing's steps.
+    pub fn windows(&self) -> &[Sample] {
+        &self.history
+    }
+
+    /// Simulated time since the start.
+    pub fn time(&self) -> f64 {
+        self.t_before + self.sys.time()
+    }
+
+    /// The reduced pressure of the last window (NaN before the first).
+    pub fn pressure(&self) -> f64 {
+        self.last_pressure
+    }
+
+    /// Growth epochs (systems built) so far.
+    pub fn epochs(&self) -> u64 {
+        self.epochs
+    }
+
+    /// What the run did: every particle brought to the present, the stop
+    /// (interrupted if none fired), φ, the last window's pressure.
+    pub fn outcome(&mut self) -> PackOutcome {
+        self.sys.synchronize();
+        PackOutcome {
+            stop: self.stopped.unwrap_or(Stop::Interrupted),
+            phi: self.sys.packing_fraction(),
+            pressure: self.last_pressure,
+            collisions: self.collisions,
+            time: self.time(),
+            epochs: self.epochs,
+            history: self.history.clone(),
+        }
+    }
+
     /// Runs until a stop criterion fires; `progress` sees every pressure
     /// window.
     pub fn run(&mut self, progress: impl FnMut(&Sample)) -> Result<PackOutcome, EdmdError> {
         self.run_with(progress, None)
     }
 
-    /// [`Packer::run`] with checkpoints.
+    /// [`Packer::run`] with checkpoints: one every `every` windows, and one
+    /// when a signal stops the run.
     pub fn run_with(
         &mut self,
         mut progress: impl FnMut(&Sample),
         mut cps: Option<&mut PackCheckpoints>,
     ) -> Result<PackOutcome, EdmdError> {
-        let start = Instant::now();
-        let n = self.sys.len() as f64;
-        let window = ((self.settings.rescale_every * n).round() as u64).max(1);
-        let stop = loop {
-            if self.resumed_in_finish {
-                let f = self.settings.finish.ok_or_else(|| {
-                    EdmdError::Invalid(
-                        "a checkpoint taken in the quasi-static finish, for settings without one"
-                            .into(),
-                    )
-                })?;
-                break self.finish(f, window, start, &mut progress, &mut cps)?;
+        while self.stopped.is_none() {
+            let seen = self.history.len();
+            self.advance()?;
+            for s in &self.history[seen..] {
+                progress(s);
             }
-            let mut want = window - self.win_coll;
-            if let Some(budget) = self.settings.max_collisions {
-                if self.collisions >= budget {
-                    break Stop::Collisions;
-                }
-                want = want.min(budget - self.collisions);
-            }
-            let t_target = match self.settings.target_phi {
-                Some(p) => self.time_of_phi(p),
-                None => f64::INFINITY,
-            };
-            let horizon = self.sys.horizon();
-            let t_end = t_target.min(horizon);
-            let Some(done) = self.collisions_within(want, t_end, start) else {
-                self.harvest();
-                break Stop::WallClock;
-            };
-            if !done {
-                // nothing more before t_end (or no events at all)
-                if t_end.is_finite() {
-                    self.sys.run_until(t_end);
-                }
-                if t_target <= horizon {
-                    self.harvest();
-                    break Stop::TargetPhi;
-                }
-                self.new_epoch()?;
-                continue;
-            }
-            self.harvest();
-            if self.win_coll >= window {
-                let (z, _) = self.close_window(&mut progress)?;
-                if z > self.settings.max_pressure {
-                    break Stop::Pressure;
-                }
-                if let Some(f) = self.settings.finish {
-                    if z > f.start_pressure {
-                        break self.finish(f, window, start, &mut progress, &mut cps)?;
-                    }
-                }
-            }
-            if let Some(limit) = self.settings.wall_clock {
-                if start.elapsed() >= limit {
-                    break Stop::WallClock;
-                }
+            if self.stopped.is_some() {
+                break;
             }
             let signal = mote_io::system::stop_requested().is_some();
-            if self.checkpoint_due(&cps, signal) {
-                let (delta, horizon) = self.new_epoch()?;
-                self.save(&mut cps, delta, horizon, false)?;
+            if let Some(c) = cps.as_mut() {
+                if signal || (self.history.len() as u64).is_multiple_of(c.every.max(1)) {
+                    let state = self.checkpoint()?;
+                    (c.save)(&state)?;
+                }
             }
             if signal {
-                break Stop::Interrupted;
+                self.stop(Stop::Interrupted);
             }
-        };
-        self.sys.synchronize();
-        Ok(PackOutcome {
-            stop,
-            phi: self.sys.packing_fraction(),
-            pressure: self.last_pressure,
-            collisions: self.collisions,
-            time: self.t_before + self.sys.time(),
-            epochs: self.epochs,
-            history: self.history.clone(),
-        })
+        }
+        Ok(self.outcome())
     }
 }
