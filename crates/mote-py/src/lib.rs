@@ -3,16 +3,17 @@
 //! Scenes go through the same front as `mote run` (`mote_front`), so a
 //! scene file, a TOML string and a Python dict are one format with one
 //! parser. A time-stepped scene becomes a [`Simulation`], a rigid one a
-//! [`RigidSimulation`], an event-driven one a [`HardSpheres`], each stepped
-//! through the front's stepper (mote's one run loop) and read (particle
-//! arrays of the first two are numpy views of mote's own memory); every
-//! engine runs whole through [`run`]; packings and the rod-packing
-//! estimator are functions.
+//! [`RigidSimulation`], an event-driven one a [`HardSpheres`], a packing
+//! one a [`Packing`], each stepped through the front's stepper (mote's one
+//! run loop) and read (particle arrays of the first two are numpy views of
+//! mote's own memory); every engine runs whole through [`run`]; `pack` (a
+//! packing from options) and the rod-packing estimator are functions.
 
 use pyo3::prelude::*;
 
 mod convert;
 mod hard_spheres;
+mod packing;
 mod rigid;
 mod simulation;
 mod stepping;
@@ -43,6 +44,7 @@ fn _mote(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulation::Simulation>()?;
     m.add_class::<rigid::RigidSimulation>()?;
     m.add_class::<hard_spheres::HardSpheres>()?;
+    m.add_class::<packing::Packing>()?;
     m.add_function(wrap_pyfunction!(tools::run, m)?)?;
     m.add_function(wrap_pyfunction!(tools::pack, m)?)?;
     m.add_function(wrap_pyfunction!(tools::rcp, m)?)?;

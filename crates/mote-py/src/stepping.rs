@@ -33,6 +33,10 @@ pub trait Stepped: Send {
     fn time(&self) -> f64;
     /// The number of particles (bodies for clumps).
     fn len(&self) -> usize;
+    /// Whether the run has reached an end of its own (a jammed packing).
+    fn finished(&self) -> bool {
+        false
+    }
 }
 
 /// Defines a Python simulation class once: the struct holding its engine
@@ -172,10 +176,15 @@ pub fn run_loop<T: HasEngine + pyo3::PyClass<Frozen = pyo3::pyclass::boolean_str
         let s = slf.borrow();
         let e = s.engine()?;
         let total = e.steps_for(steps, until)?;
+        let length = if total == u64::MAX {
+            "until it stops".to_string()
+        } else {
+            format!("{total} steps")
+        };
         (
             e.step(),
             total,
-            format!("mote (Python) {}, {total} steps", e.describe()),
+            format!("mote (Python) {}, {length}", e.describe()),
         )
     };
     if every == 0 {
@@ -195,6 +204,9 @@ pub fn run_loop<T: HasEngine + pyo3::PyClass<Frozen = pyo3::pyclass::boolean_str
             let s = slf.borrow();
             let mut guard = s.engine()?;
             let engine = &mut *guard;
+            if engine.finished() {
+                break;
+            }
             let last = done + n == total;
             let terminal = &mut terminal;
             py.detach(|| {

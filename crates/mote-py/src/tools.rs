@@ -57,6 +57,11 @@ pub fn run<'py>(
                 text: dict_to_toml(d)?,
                 plist: false,
             }
+        } else if let (Err(_), Ok(path)) =
+            (s.cast::<pyo3::types::PyString>(), s.extract::<PathBuf>())
+        {
+            // a path (pathlib.Path, os.PathLike)
+            mote_front::Input::read(&path.to_string_lossy()).map_err(front_error)?
         } else {
             let s: String = s.extract()?;
             if s.contains('\n') {

@@ -430,6 +430,7 @@ def test_every_simulation_class_steps_and_runs_the_same_way():
         (mote.Simulation, "steps"),
         (mote.RigidSimulation, "steps"),
         (mote.HardSpheres, "output intervals"),
+        (mote.Packing, "pressure windows"),
     ]:
         assert cls.step.__text_signature__ == "($self, n=1)"
         run = cls.run.__text_signature__
@@ -437,5 +438,65 @@ def test_every_simulation_class_steps_and_runs_the_same_way():
         assert run.endswith(", progress=False)"), run
         assert f"Advances `n` {unit}" in cls.step.__doc__
         assert f"The {unit} taken" in cls.steps.__doc__
-        for attribute in ("time", "steps", "__len__", "observables"):
+        for attribute in ("time", "steps", "__len__", "observables" if cls is not mote.Packing else "windows"):
             assert hasattr(cls, attribute), (cls, attribute)
+
+
+PACKING = """seed = 4
+[packing]
+n = 200
+dimension = 2
+dist = "bi:1.4:0.5"
+rate = 0.3
+max_pressure = 1e8
+"""
+
+
+def test_a_packing_steps_from_python_with_the_bits_of_mote_run(tmp_path):
+    p = mote.Packing.from_toml(PACKING)
+    assert (len(p), p.dimension, p.seed, p.steps, p.stopped) == (200, 2, 4, 0, None)
+    assert np.isnan(p.pressure)
+    # A window a step, in chunks with a callback, until it jams by itself.
+    p.step(3)
+    assert p.steps == 3 and p.stopped is None
+    seen = []
+    p.run(callback=lambda q: seen.append(q.steps), every=10)
+    assert p.stopped == "pressure" and p.pressure > 1e8
+    assert seen[0] == 13 and seen[-1] == p.steps
+    windows = p.windows
+    assert len(windows["phi"]) == p.steps
+    assert np.all(np.diff(windows["phi"]) >= 0) and windows["phi"][-1] == pytest.approx(p.phi)
+    # mote run of the same scene: the same packing and windows, bit for bit.
+    scene = tmp_path / "p.toml"
+    scene.write_text(PACKING)
+    out = mote.run(scene, output=tmp_path / "run")
+    assert out["ending"] == "finished"
+    table = csv_columns(tmp_path / "run" / "packing.csv")
+    for name in ["collisions", "time", "phi", "pressure"]:
+        assert np.array_equal(table[name], windows[name]), name
+    # and mote.pack with the same settings spelled as options
+    r = mote.pack(200, dimension=2, dist="bi:1.4:0.5", rate=0.3, max_pressure=1e8, seed=4)
+    assert np.array_equal(r["positions"], p.positions)
+    assert np.array_equal(r["radii"], p.radii)
+    with pytest.raises(ValueError, match="until it jams"):
+        p.run(until=1.0)
+
+
+def test_a_packing_refuses_what_it_cannot_do():
+    with pytest.raises(ValueError, match="not a packing scene"):
+        mote.Packing.from_toml(HARD_SPHERES)
+    with pytest.raises(ValueError, match="dimension = 4: must be 2 or 3"):
+        mote.Packing.from_toml("[packing]\nn = 100\ndimension = 4\n")
+    with pytest.raises(ValueError, match="soft"):
+        mote.Packing.from_toml("[packing]\nn = 100\nmethod = \"soft\"\n")
+
+
+def test_the_type_stubs_parse_and_name_every_class():
+    import ast
+    import pathlib
+
+    stubs = pathlib.Path(mote.__file__).with_name("_mote.pyi")
+    tree = ast.parse(stubs.read_text())
+    named = {n.name for n in tree.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
+    native = {n for n in mote.__all__ if hasattr(mote._mote, n)}
+    assert native <= named, native - named

@@ -767,6 +767,41 @@ fn run_soft(
     })
 }
 
+/// The packer a `[packing]` scene of the growth method starts (Python's
+/// `Packing`): the settings and seed `mote run` would use (`seed`
+/// replaces the scene's), in the scene's dimension; with the seed used.
+pub(crate) fn scene_packer(
+    input: &Input,
+    seed: Option<u64>,
+) -> Result<(crate::stepper::Packing, u64), FrontError> {
+    let source = mote_io::Source::new(&input.label, &input.text);
+    source.finite_numbers().map_err(FrontError::Parse)?;
+    let scene = PackingScene::parse(source)?;
+    let spec = &scene.packing;
+    let naming = Naming::Scene(source);
+    if let Method::Soft { .. } = spec.method(naming)? {
+        refuse!(
+            "{}:{}: [packing] method = \"soft\" runs its own loop and cannot be stepped yet: use mote.pack(method=\"soft\")",
+            source.file,
+            source.key_line("method")
+        );
+    }
+    let (seed, _) = crate::seed::resolve(seed, scene.seed);
+    let settings = spec.settings(seed, naming, &input.folder())?;
+    let locate = |e: mote_edmd::EdmdError| naming.locate(e.into());
+    let packer = match spec.dimension {
+        2 => crate::stepper::Packing::Disks(crate::stepper::Stepper::new(
+            mote_edmd::Packer::new(settings).map_err(locate)?,
+            1,
+        )),
+        _ => crate::stepper::Packing::Spheres(crate::stepper::Stepper::new(
+            mote_edmd::Packer::new(settings).map_err(locate)?,
+            1,
+        )),
+    };
+    Ok((packer, seed))
+}
+
 /// Continues the packing a checkpoint came from (by `mote pack` or a
 /// `[packing]` scene): the same request, seed, folder and checkpoint
 /// schedule; the CSV is trimmed back to the checkpoint and the packing is

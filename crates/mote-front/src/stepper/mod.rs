@@ -8,10 +8,12 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use mote_run::{Driver, Observer, Propagator};
 
 mod hard_spheres;
+mod packing;
 mod points;
 mod rigid;
 
 pub use hard_spheres::HardSpheres;
+pub use packing::Packing;
 pub use points::{PointSample, Points, Scalars, Vectors};
 pub use rigid::{BodyVectors, Rigid, RigidObservables};
 
@@ -123,7 +125,7 @@ where
         progress: &mut dyn FnMut(&P),
     ) -> Result<(), P::Error> {
         self.prepare()?;
-        let last = self.state.step() + n;
+        let last = self.state.step().saturating_add(n);
         self.driver
             .advance_to(&mut self.state, last, ends_run, progress)
             .map(|_| ())

@@ -3,13 +3,15 @@
 The scene format is the one of ``mote run`` (docs/scene-format.md), given as a
 file, a TOML string or a dict; ``Simulation`` steps time-stepped scenes,
 ``RigidSimulation`` rigid ones, ``HardSpheres`` event-driven ones,
-``run`` runs any engine whole, ``pack`` grows packings and ``rcp`` estimates
+``Packing`` packing scenes (a pressure window per step), ``run`` runs any
+engine whole, ``pack`` grows packings from options and ``rcp`` estimates
 random close packing fractions. See docs/python.md.
 """
 
 from ._mote import (  # noqa: F401
     HardSpheres,
     MoteError,
+    Packing,
     RigidSimulation,
     Simulation,
     UnstableError,
@@ -21,7 +23,7 @@ from ._mote import (  # noqa: F401
     run,
 )
 
-__all__ = ["HardSpheres", "MoteError", "RigidSimulation", "Simulation", "UnstableError", "pack", "rcp", "rcp_optimise", "render", "run"]
+__all__ = ["HardSpheres", "MoteError", "Packing", "RigidSimulation", "Simulation", "UnstableError", "pack", "rcp", "rcp_optimise", "render", "run"]
 
 
 def from_ase(atoms, scene=None, seed=None):

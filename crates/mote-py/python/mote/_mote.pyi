@@ -38,57 +38,7 @@ class Simulation:
         """Writes a checkpoint that ``Simulation.resume`` continues bit for bit."""
     def step(self, n: int = 1) -> None:
         """Advances ``n`` steps (the GIL is released meanwhile)."""
-    class HardSpheres:
-    """Event-driven hard disks or spheres (a scene with ``[event_driven]``):
-    free flight between exact elastic collisions. A step is one output
-    interval; ``run()`` goes to the scene's end in ``mote run``'s bits."""
-
-    @staticmethod
-    def from_file(path: Path, seed: Optional[int] = None, force: bool = False) -> "HardSpheres": ...
-    @staticmethod
-    def from_toml(text: str, seed: Optional[int] = None, name: str = "<string>", force: bool = False) -> "HardSpheres": ...
-    @staticmethod
-    def from_dict(scene: dict[str, Any], seed: Optional[int] = None, force: bool = False) -> "HardSpheres": ...
-    def step(self, n: int = 1) -> None:
-        """Advances n output intervals."""
     def run(
-        self,
-        steps: Optional[int] = None,
-        until: Optional[float] = None,
-        callback: Optional[Callable[["HardSpheres"], Any]] = None,
-        every: int = 1,
-        progress: bool = False,
-    ) -> None:
-        """steps output intervals, or to the scene's end; until is refused."""
-    @property
-    def time(self) -> float: ...
-    @property
-    def steps(self) -> int: ...
-    @property
-    def last_step(self) -> int: ...
-    @property
-    def dimension(self) -> int: ...
-    @property
-    def seed(self) -> int: ...
-    @property
-    def box(self) -> npt.NDArray[np.float64]:
-        """(D,) edge lengths of the box [0, L_0] x ..."""
-    def __len__(self) -> int: ...
-    @property
-    def positions(self) -> npt.NDArray[np.float64]:
-        """(N, D) positions now, a copy."""
-    @property
-    def velocities(self) -> npt.NDArray[np.float64]: ...
-    @property
-    def radii(self) -> npt.NDArray[np.float64]: ...
-    @property
-    def masses(self) -> npt.NDArray[np.float64]: ...
-    @property
-    def observables(self) -> dict[str, npt.NDArray[np.float64]]:
-        """The columns of mote run's observables.csv."""
-    def render(self, output: Optional[Path] = None, width: int = 800, height: int = 600) -> Optional[npt.NDArray[np.uint8]]: ...
-
-def run(
         self,
         steps: Optional[int] = None,
         until: Optional[float] = None,
@@ -145,6 +95,113 @@ def run(
     def observables(self) -> dict[str, npt.NDArray[np.float64]]:
         """The observables measured so far: time, kinetic, potential, total,
         rotational, kT, pressure, momentum, angular_momentum, magnetisation."""
+
+
+class HardSpheres:
+    """Event-driven hard disks or spheres (a scene with ``[event_driven]``):
+    free flight between exact elastic collisions. A step is one output
+    interval; ``run()`` goes to the scene's end in ``mote run``'s bits."""
+
+    @staticmethod
+    def from_file(path: Path, seed: Optional[int] = None, force: bool = False) -> "HardSpheres": ...
+    @staticmethod
+    def from_toml(text: str, seed: Optional[int] = None, name: str = "<string>", force: bool = False) -> "HardSpheres": ...
+    @staticmethod
+    def from_dict(scene: dict[str, Any], seed: Optional[int] = None, force: bool = False) -> "HardSpheres": ...
+    def step(self, n: int = 1) -> None:
+        """Advances n output intervals."""
+    def run(
+        self,
+        steps: Optional[int] = None,
+        until: Optional[float] = None,
+        callback: Optional[Callable[["HardSpheres"], Any]] = None,
+        every: int = 1,
+        progress: bool = False,
+    ) -> None:
+        """steps output intervals, or to the scene's end; until is refused."""
+    @property
+    def time(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def last_step(self) -> int: ...
+    @property
+    def dimension(self) -> int: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def box(self) -> npt.NDArray[np.float64]:
+        """(D,) edge lengths of the box [0, L_0] x ..."""
+    def __len__(self) -> int: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]:
+        """(N, D) positions now, a copy."""
+    @property
+    def velocities(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def radii(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def masses(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def observables(self) -> dict[str, npt.NDArray[np.float64]]:
+        """The columns of mote run's observables.csv."""
+    def render(self, output: Optional[Path] = None, width: int = 800, height: int = 600) -> Optional[npt.NDArray[np.uint8]]: ...
+
+
+class Packing:
+    """A packing grown from a ``[packing]`` scene (hard disks or spheres,
+    Lubachevsky–Stillinger): a step is one pressure window; ``run()`` grows
+    it until it stops by itself (jammed, the scene's ``phi``,
+    ``max_collisions`` or ``time_limit``), in ``mote run``'s bits."""
+
+    @staticmethod
+    def from_file(path: Path, seed: Optional[int] = None) -> "Packing": ...
+    @staticmethod
+    def from_toml(text: str, seed: Optional[int] = None, name: str = "<string>") -> "Packing": ...
+    @staticmethod
+    def from_dict(scene: dict[str, Any], seed: Optional[int] = None) -> "Packing": ...
+    def step(self, n: int = 1) -> None:
+        """Advances n pressure windows (fewer where the packing stops)."""
+    def run(
+        self,
+        steps: Optional[int] = None,
+        until: Optional[float] = None,
+        callback: Optional[Callable[["Packing"], Any]] = None,
+        every: int = 1,
+        progress: bool = False,
+    ) -> None:
+        """steps windows, or until the packing stops; until is refused."""
+    @property
+    def time(self) -> float: ...
+    @property
+    def steps(self) -> int: ...
+    @property
+    def dimension(self) -> int: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def stopped(self) -> Optional[str]:
+        """pressure (jammed), target-phi, collisions, wall-clock, or None while it grows."""
+    @property
+    def phi(self) -> float: ...
+    @property
+    def pressure(self) -> float:
+        """Reduced pressure Z = PV/(NkT) of the last window."""
+    @property
+    def collisions(self) -> int: ...
+    @property
+    def box(self) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float64]:
+        """(N, D) positions now, a copy."""
+    @property
+    def radii(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def windows(self) -> dict[str, npt.NDArray[np.float64]]:
+        """collisions, time, phi, pressure of every window (mote run's packing.csv)."""
+    def render(self, output: Optional[Path] = None, width: int = 800, height: int = 600) -> Optional[npt.NDArray[np.uint8]]: ...
+
 
 class RigidSimulation:
     """Rigid clumps of overlapping spheres (a scene with ``[rigid]``) stepped
