@@ -62,9 +62,10 @@ pub struct Run {
 /// energy drift so far, the events so far, the counters, and the time
 /// measuring began.
 mod carried {
-    pub const RADII: usize = 0;
-    pub const MASSES: usize = 1;
-    pub const RUN: usize = 2;
+    /// (name, index in checkpoints from before names)
+    pub const RADII: (&str, usize) = ("radii", 0);
+    pub const MASSES: (&str, usize) = ("masses", 1);
+    pub const RUN: (&str, usize) = ("run", 2);
 }
 
 /// The bookkeeping of a run that a checkpoint carries.
@@ -102,11 +103,9 @@ fn resumed<const D: usize>(
     simbox: SimBox<D>,
 ) -> Result<(System<D>, f64, u64, Ledger<D>), EdmdError> {
     let bad = |what: &str| EdmdError::Invalid(format!("checkpoint: {what}"));
-    let get = |k: usize| {
-        cp.carried
-            .iter()
-            .find(|(i, _)| *i == k)
-            .map(|(_, v)| v.clone())
+    let get = |(name, old): (&str, usize)| {
+        cp.carried_list(name, old)
+            .map(<[f64]>::to_vec)
             .ok_or_else(|| bad("radii, masses or the run's ledger missing"))
     };
     let (radii, masses, run) = (
@@ -425,9 +424,9 @@ impl<const D: usize> Propagator for EventDriven<D> {
         cp.positions = sys.positions().iter().map(to3).collect();
         cp.velocities = sys.velocities().iter().map(to3).collect();
         cp.carried = vec![
-            (carried::RADII, sys.radii()),
-            (carried::MASSES, sys.masses()),
-            (carried::RUN, run),
+            (carried::RADII.0.into(), sys.radii()),
+            (carried::MASSES.0.into(), sys.masses()),
+            (carried::RUN.0.into(), run),
         ];
         Ok(())
     }

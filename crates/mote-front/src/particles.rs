@@ -52,14 +52,11 @@ pub fn resume_state(
         }
     }
     let forces = &mut sim.forces;
-    let count = forces.interactions.len();
-    for (k, values) in &cp.carried {
-        let Some(interaction) = forces.interactions.get_mut(*k) else {
-            refuse!(
-                "{label}: the checkpoint carries state for interaction {k}, the scene has {count}"
-            );
-        };
-        interaction
+    let keys = forces.carried_keys();
+    let matched = mote_io::checkpoint::match_carried(cp, &keys)
+        .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
+    for (k, values) in matched {
+        forces.interactions[k]
             .restore_carried_state(values)
             .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
     }

@@ -35,12 +35,26 @@ pub struct Checkpoint {
     /// Angular velocities and carried angular accelerations (ω, α) of
     /// rotating particles; empty when nothing rotates.
     pub angular: Vec<[f64; 6]>,
-    /// What each interaction carries from step to step (contact
-    /// histories), by the interaction's index; empty lists are omitted.
-    pub carried: Vec<(usize, Vec<f64>)>,
+    /// What the engine carries from step to step besides the particles, by
+    /// name: each interaction's contact histories and lists under its key
+    /// ([`carried_keys`]), an engine's own tables (`radii`, `run`, ...);
+    /// empty lists are omitted. Checkpoints before names numbered them by
+    /// position: such a key is the number's digits.
+    pub carried: Vec<(String, Vec<f64>)>,
 }
 
 impl Checkpoint {
+    /// The carried list `name`, or (a checkpoint from before names) the one
+    /// numbered `old_index`.
+    pub fn carried_list(&self, name: &str, old_index: usize) -> Option<&[f64]> {
+        let old = old_index.to_string();
+        self.carried
+            .iter()
+            .find(|(k, _)| k == name)
+            .or_else(|| self.carried.iter().find(|(k, _)| *k == old))
+            .map(|(_, v)| v.as_slice())
+    }
+
     /// The value of option `key`.
     pub fn option(&self, key: &str) -> Option<&str> {
         self.options
@@ -97,9 +111,11 @@ pub fn write(path: &Path, cp: &Checkpoint) -> Result<(), IoError> {
         text.push_str(&w.join(" "));
         text.push('\n');
     }
-    for (index, values) in &cp.carried {
+    for (name, values) in &cp.carried {
         let lines = values.len().div_ceil(8);
-        text.push_str(&format!("carried {index} {} {lines}\n", values.len()));
+        // a name is one word of the record
+        let name = one_word(name);
+        text.push_str(&format!("carried {name} {} {lines}\n", values.len()));
         for chunk in values.chunks(8) {
             let w: Vec<String> = chunk.iter().map(|x| hex(*x)).collect();
             text.push_str(&w.join(" "));
@@ -215,16 +231,15 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
                 k += rows.len();
             }
             "carried" => {
-                let w: Vec<usize> = rest
-                    .split_whitespace()
-                    .map(|x| {
-                        x.parse()
-                            .map_err(|_| err(k, "carried needs: index count lines"))
-                    })
-                    .collect::<Result<_, _>>()?;
-                let [index, count, nlines] = w[..] else {
-                    return Err(err(k, "carried needs: index count lines").into());
+                let w: Vec<&str> = rest.split_whitespace().collect();
+                let [name, count, nlines] = w[..] else {
+                    return Err(err(k, "carried needs: name count lines").into());
                 };
+                let number = |x: &str| -> Result<usize, IoError> {
+                    x.parse()
+                        .map_err(|_| err(k, "carried needs: name count lines").into())
+                };
+                let (name, count, nlines) = (name.to_string(), number(count)?, number(nlines)?);
                 // Eight values a line: the lines there bound what is reserved.
                 let mut values = Vec::with_capacity(count.min(nlines.saturating_mul(8)));
                 for ln in k + 1..=k + nlines {
@@ -242,7 +257,7 @@ pub fn read(path: &Path) -> Result<Checkpoint, IoError> {
                     )
                     .into());
                 }
-                cp.carried.push((index, values));
+                cp.carried.push((name, values));
                 k += nlines;
             }
             "" => {}
@@ -290,6 +305,59 @@ fn table(
         .collect()
 }
 
+/// The keys under which a checkpoint carries the state of interactions
+/// named `names` (in order): the name with `_` for blanks (a key is one
+/// word of the file), and `name#2`, `name#3`, … for the second and later
+/// of one name.
+pub fn carried_keys<'a>(names: impl IntoIterator<Item = &'a str>) -> Vec<String> {
+    let mut keys: Vec<String> = Vec::new();
+    let mut seen: Vec<String> = Vec::new();
+    for name in names {
+        let word = one_word(name);
+        let count = seen.iter().filter(|n| **n == word).count();
+        keys.push(if count == 0 {
+            word.clone()
+        } else {
+            format!("{word}#{}", count + 1)
+        });
+        seen.push(word);
+    }
+    keys
+}
+
+/// `name` with `_` for each blank.
+fn one_word(name: &str) -> String {
+    name.chars()
+        .map(|c| if c.is_whitespace() { '_' } else { c })
+        .collect()
+}
+
+/// Which interaction (index into `keys`, see [`carried_keys`]) each
+/// carried list of `cp` belongs to; a key that names none is an error (a
+/// checkpoint of another scene), and a number is an index (checkpoints
+/// from before names).
+pub fn match_carried<'c>(
+    cp: &'c Checkpoint,
+    keys: &[String],
+) -> Result<Vec<(usize, &'c [f64])>, String> {
+    cp.carried
+        .iter()
+        .map(|(key, values)| {
+            let k = keys
+                .iter()
+                .position(|k| k == key)
+                .or_else(|| key.parse::<usize>().ok().filter(|k| *k < keys.len()))
+                .ok_or_else(|| {
+                    format!(
+                        "the checkpoint carries the state of '{key}', which this scene has no interaction for (it has: {})",
+                        if keys.is_empty() { "none".to_string() } else { keys.join(", ") }
+                    )
+                })?;
+            Ok((k, values.as_slice()))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -314,8 +382,8 @@ mod tests {
             accelerations: vec![[1e-9, -2.0, 3.5], [0.0, 0.0, 1.0]],
             angular: vec![[1.0, 2.0, 3.0, 4.0, 5.0, f64::MIN_POSITIVE]; 2],
             carried: vec![
-                (0, (0..11).map(|k| k as f64 / 7.0).collect()),
-                (2, vec![-0.0, f64::INFINITY]),
+                ("granular".into(), (0..11).map(|k| k as f64 / 7.0).collect()),
+                ("granular#2".into(), vec![-0.0, f64::INFINITY]),
             ],
         };
         write(&path, &cp).unwrap();
@@ -369,5 +437,42 @@ mod tests {
                 path.display()
             )
         );
+    }
+
+    /// Interactions are found by name wherever they stand; a repeated name
+    /// is numbered; an old numbered list is its index; a foreign one is an
+    /// error that says what the scene has.
+    #[test]
+    fn carried_lists_find_their_interaction_by_name() {
+        let keys = carried_keys(["springs", "granular", "granular", "walls"]);
+        assert_eq!(keys, ["springs", "granular", "granular#2", "walls"]);
+        assert_eq!(
+            carried_keys(["air drag", "air drag"]),
+            ["air_drag", "air_drag#2"]
+        );
+        let cp = Checkpoint {
+            carried: vec![
+                ("granular#2".into(), vec![1.0]),
+                ("springs".into(), vec![2.0]),
+                ("3".into(), vec![3.0]),
+            ],
+            ..Checkpoint::default()
+        };
+        let matched = match_carried(&cp, &keys).unwrap();
+        assert_eq!(
+            matched,
+            vec![(2, &[1.0][..]), (0, &[2.0][..]), (3, &[3.0][..])]
+        );
+        let other = Checkpoint {
+            carried: vec![("lennard-jones".into(), vec![1.0])],
+            ..Checkpoint::default()
+        };
+        let e = match_carried(&other, &keys).unwrap_err();
+        assert!(
+            e.contains("'lennard-jones'") && e.contains("springs, granular"),
+            "{e}"
+        );
+        assert_eq!(other.carried_list("lennard-jones", 0), Some(&[1.0][..]));
+        assert_eq!(cp.carried_list("walls", 3), Some(&[3.0][..]));
     }
 }

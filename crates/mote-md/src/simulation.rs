@@ -227,7 +227,7 @@ impl mote_run::Propagator for Simulation {
 
     /// Positions, velocities, the accelerations leap-frog carries (and the
     /// angular ones with ω when the particles turn), and what each
-    /// interaction carries (contact histories) under its index.
+    /// interaction carries (contact histories, lists) under its name.
     fn save(&mut self, cp: &mut mote_io::checkpoint::Checkpoint) -> Result<(), MdError> {
         let sys = &self.system;
         let p = &sys.particles;
@@ -237,12 +237,11 @@ impl mote_run::Propagator for Simulation {
             .zip(&sys.carried_angular_acceleration)
             .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
             .collect();
-        cp.carried = self
-            .forces
-            .interactions
-            .iter()
-            .enumerate()
-            .map(|(k, i)| (k, i.carried_state()))
+        let keys = self.forces.carried_keys();
+        cp.carried = keys
+            .into_iter()
+            .zip(&self.forces.interactions)
+            .map(|(key, i)| (key, i.carried_state()))
             .filter(|(_, v)| !v.is_empty())
             .collect();
         cp.time = sys.time;

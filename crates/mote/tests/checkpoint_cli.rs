@@ -232,10 +232,10 @@ trajectory_every = 0
 "#;
 
 /// The carried states as bits (NaN, the unused first slot, equals itself).
-fn carried_bits(carried: &[(usize, Vec<f64>)]) -> Vec<(usize, Vec<u64>)> {
+fn carried_bits(carried: &[(String, Vec<f64>)]) -> Vec<(String, Vec<u64>)> {
     carried
         .iter()
-        .map(|(k, v)| (*k, v.iter().map(|x| x.to_bits()).collect()))
+        .map(|(k, v)| (k.clone(), v.iter().map(|x| x.to_bits()).collect()))
         .collect()
 }
 
@@ -260,6 +260,9 @@ fn killed_granular_run_resumes_bit_for_bit() {
         at_kill.carried.iter().any(|(_, v)| v.len() > 1),
         "no contact history at the kill"
     );
+    // Histories are kept under their interaction's name, not its position.
+    let names: Vec<&str> = whole.carried.iter().map(|(k, _)| k.as_str()).collect();
+    assert!(names.contains(&"granular"), "{names:?}");
     assert_eq!(resumed.step, 4000);
     let bits = |v: &[[f64; 3]]| {
         v.iter()

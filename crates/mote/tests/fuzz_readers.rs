@@ -203,7 +203,7 @@ fn fuzz_all(count: usize) -> usize {
         velocities: frame().velocities,
         accelerations: frame().velocities,
         angular: vec![[1.0; 6]; 3],
-        carried: vec![(0, vec![1.0, 2.0, f64::NAN])],
+        carried: vec![("granular".into(), vec![1.0, 2.0, f64::NAN])],
     };
     mote_io::checkpoint::write(&cp_path, &cp).unwrap();
     let cp_text = std::fs::read(&cp_path).unwrap();

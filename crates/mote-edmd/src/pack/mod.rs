@@ -503,11 +503,12 @@ pub struct PackState {
 }
 
 impl PackState {
-    /// Ids of the carried lists of a packing's checkpoint.
-    const SIZE: usize = 0;
-    const RADII: usize = 1;
-    const RUN: usize = 2;
-    const HISTORY: usize = 3;
+    /// Names of the carried lists of a packing's checkpoint (and their
+    /// numbers in checkpoints from before names).
+    const SIZE: (&str, usize) = ("box", 0);
+    const RADII: (&str, usize) = ("radii", 1);
+    const RUN: (&str, usize) = ("run", 2);
+    const HISTORY: (&str, usize) = ("windows", 3);
 
     /// The state in `template` (options, input and seed already there):
     /// positions and velocities padded to 3 components, radii, box, the
@@ -547,10 +548,10 @@ impl PackState {
             positions: self.positions.iter().map(pad).collect(),
             velocities: self.velocities.iter().map(pad).collect(),
             carried: vec![
-                (Self::SIZE, self.size.clone()),
-                (Self::RADII, self.radii.clone()),
-                (Self::RUN, run),
-                (Self::HISTORY, history),
+                (Self::SIZE.0.into(), self.size.clone()),
+                (Self::RADII.0.into(), self.radii.clone()),
+                (Self::RUN.0.into(), run),
+                (Self::HISTORY.0.into(), history),
             ],
             ..template.clone()
         }
@@ -563,13 +564,7 @@ impl PackState {
         dimension: usize,
     ) -> Result<Self, EdmdError> {
         let bad = |m: &str| EdmdError::Invalid(format!("checkpoint of a packing: {m}"));
-        let list = |id: usize| {
-            cp.carried
-                .iter()
-                .find(|(k, _)| *k == id)
-                .map(|(_, v)| v.as_slice())
-                .unwrap_or(&[])
-        };
+        let list = |(name, old): (&str, usize)| cp.carried_list(name, old).unwrap_or(&[]);
         let run = list(Self::RUN);
         let history = list(Self::HISTORY);
         let (size, radii) = (list(Self::SIZE), list(Self::RADII));

@@ -295,6 +295,12 @@ impl ForceField {
         Self::default()
     }
 
+    /// The keys under which checkpoints carry each interaction's state:
+    /// its name, a repeated one numbered (`granular#2`).
+    pub fn carried_keys(&self) -> Vec<String> {
+        mote_io::checkpoint::carried_keys(self.interactions.iter().map(|i| i.name()))
+    }
+
     pub fn with(mut self, interaction: impl Interaction + 'static) -> Self {
         self.push(interaction);
         self

@@ -361,26 +361,31 @@ impl Frbi {
         b.time += dt;
     }
 
+    /// The keys of the interactions' carried state in checkpoints: their
+    /// names, a repeated one numbered (`mote_io::checkpoint::carried_keys`).
+    fn carried_keys(&self) -> Vec<String> {
+        mote_io::checkpoint::carried_keys(self.interactions.iter().map(|it| it.name()))
+    }
+
     /// What the interactions carry from step to step (contact histories),
-    /// by interaction index; interactions that carry nothing are left out.
-    pub fn carried_state(&self) -> Vec<(usize, Vec<f64>)> {
-        self.interactions
-            .iter()
-            .enumerate()
-            .map(|(k, it)| (k, it.carried_state()))
+    /// by interaction name; interactions that carry nothing are left out.
+    pub fn carried_state(&self) -> Vec<(String, Vec<f64>)> {
+        self.carried_keys()
+            .into_iter()
+            .zip(&self.interactions)
+            .map(|(key, it)| (key, it.carried_state()))
             .filter(|(_, v)| !v.is_empty())
             .collect()
     }
 
-    /// Gives each interaction back what [`Frbi::carried_state`] took.
-    pub fn restore_carried_state(&mut self, carried: &[(usize, Vec<f64>)]) -> Result<(), String> {
-        let count = self.interactions.len();
-        for (k, values) in carried {
-            let it = self
-                .interactions
-                .get_mut(*k)
-                .ok_or_else(|| format!("state for interaction {k}, but there are {count}"))?;
-            it.restore_carried_state(values)?;
+    /// Gives each interaction back what [`Frbi::carried_state`] took, found
+    /// by name.
+    pub fn restore_carried_state(
+        &mut self,
+        cp: &mote_io::checkpoint::Checkpoint,
+    ) -> Result<(), String> {
+        for (k, values) in mote_io::checkpoint::match_carried(cp, &self.carried_keys())? {
+            self.interactions[k].restore_carried_state(values)?;
         }
         Ok(())
     }

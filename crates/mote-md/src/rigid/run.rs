@@ -209,7 +209,7 @@ impl RigidDynamics {
         b.time = cp.time;
         self.step = cp.step;
         self.frbi
-            .restore_carried_state(&cp.carried)
+            .restore_carried_state(cp)
             .map_err(|m| ParseError::new(label, 0, format!("checkpoint: {m}")))?;
         Ok(())
     }
