@@ -159,10 +159,19 @@ impl EngineRun for PointsRun {
     fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<Simulation, FrontError> {
         let (args, label) = (&self.args, &self.input.label);
         let built = self.scene.build(&self.input.text, label, seed)?;
-        let length = match (args.steps, args.until, built.length) {
-            (Some(n), _, _) => RunLength::Steps(n),
-            (None, Some(t), _) => RunLength::Until(t),
-            (None, None, Some(l)) => l,
+        // Where the length was given, for its messages: an option, or the
+        // line of the scene's [run] key.
+        let (length, given) = match (args.steps, args.until, built.length) {
+            (Some(n), _, _) => (RunLength::Steps(n), label.to_string()),
+            (None, Some(t), _) => (RunLength::Until(t), label.to_string()),
+            (None, None, Some(l)) => {
+                let key = match l {
+                    RunLength::Steps(_) => "steps",
+                    RunLength::Until(_) => "until",
+                };
+                let source = mote_io::Source::new(label, &self.input.text);
+                (l, format!("{label}:{}", source.key_line(key)))
+            }
             (None, None, None) => refuse!("{label}: no run length: give --until T or --steps N"),
         };
         let mut sim = built.simulation;
@@ -174,10 +183,10 @@ impl EngineRun for PointsRun {
         }
         self.total_steps = length
             .steps_from(sim.system.time, sim.dt)
-            .map_err(|e| FrontError::request(format!("{label}: {e}")))?;
+            .map_err(|e| FrontError::request(format!("{given}: {e}")))?;
         if resumed.is_none() {
             mote_run::check_run_length(self.total_steps, sim.dt, args.force)
-                .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
+                .map_err(|m| FrontError::request(format!("{given}: {m}")))?;
         }
         if let Some(cp) = resumed {
             resume_state(cp, &mut sim, label)?;

@@ -108,8 +108,11 @@ impl EngineRun for RigidRun {
         self.nip = mote_nip::probe(&self.scene, text, label)?;
         let until_steps = |t: f64, dt: f64| {
             mote_run::steps_until(0.0, t, dt).ok_or_else(|| {
+                let n = mote_io::system::human_number;
                 MdError::Length(format!(
-                    "until {t} with dt = {dt:e}: not a number of steps a run can take"
+                    "until {} with dt = {}: not a number of steps a run can take",
+                    n(t),
+                    n(dt)
                 ))
             })
         };

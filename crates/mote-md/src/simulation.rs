@@ -27,8 +27,12 @@ impl RunLength {
         match self {
             RunLength::Steps(n) => Ok(n),
             RunLength::Until(end) => mote_run::steps_until(t, end, dt).ok_or_else(|| {
+                let n = mote_io::system::human_number;
                 MdError::Length(format!(
-                    "until {end} from t = {t} with dt = {dt:e}: not a number of steps a run can take"
+                    "until {} from t = {} with dt = {}: not a number of steps a run can take",
+                    n(end),
+                    n(t),
+                    n(dt)
                 ))
             }),
         }

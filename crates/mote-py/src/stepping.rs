@@ -142,7 +142,9 @@ pub fn time_steps(
         (Some(n), None) => Ok(n),
         (None, Some(t)) if t.is_finite() => mote_run::steps_until(time, t, dt).ok_or_else(|| {
             PyValueError::new_err(format!(
-                "until = {t} with dt = {dt}: not a number of steps a run can take"
+                "until = {} with dt = {}: not a number of steps a run can take",
+                mote_io::system::human_number(t),
+                mote_io::system::human_number(dt)
             ))
         }),
         (None, Some(t)) => Err(PyValueError::new_err(format!(

@@ -60,8 +60,9 @@ pub fn steps_until(t: f64, end: f64, dt: f64) -> Option<u64> {
 pub fn check_run_length(steps: u64, dt: f64, force: bool) -> Result<(), String> {
     if steps > MAX_STEPS && !force {
         return Err(format!(
-            "{steps} steps of dt = {dt:e}: more than {MAX_STEPS}, which is most likely a time step \
-             or an end time mistyped; give --force to run them"
+            "{steps} steps of dt = {}: more than {MAX_STEPS}, which is most likely a time step \
+             or an end time mistyped; give --force to run them",
+            mote_io::system::human_number(dt)
         ));
     }
     Ok(())

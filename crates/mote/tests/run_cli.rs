@@ -165,6 +165,31 @@ fn every_engine_runs_to_the_first_step_at_or_past_until() {
             "{out}"
         );
     }
+    // The same from a scene: its line is named, the numbers as people
+    // write them (not 301 digits of 1e300).
+    std::fs::write(
+        dir.path().join("far.toml"),
+        "[run]\nintegrator = \"leapfrog\"\ndt = 0.01\nuntil = 1e300\n[[particle]]\nposition = [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    let (code, out) = run(&["run", "far.toml", "-o", "x"]);
+    assert_eq!(code, Some(1), "{out}");
+    assert!(
+        out.contains("far.toml:4: until 1e300 from t = 0 with dt = 0.01: not a number of steps"),
+        "{out}"
+    );
+    let (code, out) = run(&[
+        "run",
+        "example:sun-earth",
+        "--dt",
+        "1e-9",
+        "--until",
+        "1.2",
+        "-o",
+        "x",
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(out.contains("steps of dt = 1e-9:"), "{out}");
 }
 
 /// `mote examples` lists every engine's examples under a heading each,

@@ -887,8 +887,9 @@ impl RigidScene {
                     return Err(err(
                         rspan,
                         format!(
-                            "[run] until = {t} with dt = {}: not a number of steps a run can take",
-                            run.dt
+                            "[run] until = {} with dt = {}: not a number of steps a run can take",
+                            mote_io::system::human_number(t),
+                            mote_io::system::human_number(run.dt)
                         ),
                     ))
                 }
