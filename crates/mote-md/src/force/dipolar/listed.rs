@@ -60,12 +60,13 @@ pub(super) fn row_portable(
     s
 }
 
-/// One row's force, torque and virial, eight neighbours at a time on
-/// [`Lanes`] ([`pair_lanes`]; no energy). Lanes past the row's end hold
-/// the row's own copy, at no distance, which the pair law leaves out; a
-/// neighbour at no distance gives a force that is not a number, as on the
-/// reference, so that two particles on one spot stop the run.
-pub(super) fn row_lanes(
+/// One row's force and torque, eight neighbours at a time on [`Lanes`]
+/// ([`pair_lanes`]; no energy, and the virial only with `VIRIAL`: the
+/// stepping pass leaves it out). Lanes past the row's end hold the row's
+/// own copy, at no distance, which the pair law leaves out; a neighbour at
+/// no distance gives a force that is not a number, as on the reference, so
+/// that two particles on one spot stop the run.
+pub(super) fn row_lanes<const VIRIAL: bool>(
     kern: &Kernel,
     k: usize,
     row: &[u32],
@@ -92,7 +93,9 @@ pub(super) fn row_lanes(
             force[c] = force[c] + p.force[c];
             torque[c] = torque[c] + p.torque_i[c];
         }
-        virial = virial + p.virial;
+        if VIRIAL {
+            virial = virial + p.virial;
+        }
     });
     let sum = |v: [Lanes; 3]| DVec3::new(v[0].sum(), v[1].sum(), v[2].sum());
     RowSum {
@@ -128,7 +131,7 @@ fn row(
             super::avx512::list_row(kern, k, list.row(r), &list.position, moment, energy)
         },
         Isa::Portable if energy => row_portable(kern, k, list.row(r), &list.position, moment),
-        Isa::Portable => row_lanes(kern, k, list.row(r), &list.position, moment),
+        Isa::Portable => row_lanes::<false>(kern, k, list.row(r), &list.position, moment),
     }
 }
 

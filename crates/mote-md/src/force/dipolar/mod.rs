@@ -398,7 +398,9 @@ impl DipoleDipole {
     }
 
     /// Adds forces and torques at positions `pos` with moments `dipoles`
-    /// (in this interaction's box); returns the virial Σ r_ij·F_ij.
+    /// (in this interaction's box); returns the virial Σ r_ij·F_ij of all
+    /// pairs in open space, and NaN with a cut-off, whose stepping pass
+    /// leaves the virial out (the energy's pass measures it: [`Interaction::virial`]).
     pub fn forces_and_torques(
         &mut self,
         pos: &[DVec3],
@@ -421,9 +423,12 @@ impl DipoleDipole {
     ) -> f64 {
         assert_eq!(pos.len(), dipoles.len(), "one dipole per particle");
         self.virial = if self.cutoff.is_finite() {
-            let (virial, _) = self.cut_off_rows(pos, dipoles, boundary, true, false);
+            // The stepping pass sums forces and torques only; the virial is
+            // measured with the energy, which `Observables::measure` asks
+            // for first. Until then it is not a number, never a stale one.
+            self.cut_off_rows(pos, dipoles, boundary, true, false);
             self.add_sorted(force, torque);
-            virial
+            f64::NAN
         } else {
             self.all_pairs_forces(pos, dipoles, force, torque)
         };
@@ -440,7 +445,9 @@ impl DipoleDipole {
     fn energy_in(&mut self, pos: &[DVec3], dipoles: &[DVec3], boundary: &Boundary) -> f64 {
         assert_eq!(pos.len(), dipoles.len(), "one dipole per particle");
         if self.cutoff.is_finite() {
-            return self.cut_off_rows(pos, dipoles, boundary, false, true).1;
+            let (virial, energy) = self.cut_off_rows(pos, dipoles, boundary, false, true);
+            self.virial = virial;
+            return energy;
         }
         let kern = self.kernel();
         let n = pos.len();
