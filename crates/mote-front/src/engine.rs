@@ -62,6 +62,38 @@ impl Engine {
         }
     }
 
+    /// The tables that name an engine: a scene holds at most one (none is
+    /// a point-particle scene).
+    const TABLES: [(&'static str, Engine); 3] = [
+        ("rigid", Engine::Rigid),
+        ("event_driven", Engine::EventDriven),
+        ("packing", Engine::Packing),
+    ];
+
+    /// Refuses a scene with two engine tables (`[rigid]` and `[packing]`,
+    /// say), naming the second's line and the engine the first chose: a
+    /// scene runs one engine. Text that is not TOML is left to the parser
+    /// that names its line.
+    pub fn check_one(label: &str, text: &str) -> Result<(), crate::FrontError> {
+        let Ok(table) = text.parse::<toml::Table>() else {
+            return Ok(());
+        };
+        let source = mote_io::Source::new(label, text);
+        let mut named = Engine::TABLES
+            .iter()
+            .filter(|(key, _)| table.contains_key(*key))
+            .map(|&(key, engine)| (source.table_line(key), key, engine))
+            .collect::<Vec<_>>();
+        named.sort_by_key(|n| n.0);
+        if let [(first_line, first, engine), (line, second, _), ..] = named[..] {
+            return Err(crate::FrontError::request(format!(
+                "{label}:{line}: [{second}] beside [{first}] (line {first_line}): a scene runs one engine, and [{first}] chose {}; give each its own scene",
+                engine.title()
+            )));
+        }
+        Ok(())
+    }
+
     /// The heading `mote examples` groups this engine's examples under.
     pub fn title(self) -> &'static str {
         match self {
@@ -95,5 +127,21 @@ mod tests {
             Engine::Particles
         );
         assert_eq!(Engine::of_scene("[rigid]\n"), Engine::Rigid);
+    }
+
+    #[test]
+    fn a_scene_with_two_engine_tables_is_refused_at_the_second() {
+        let text = "seed = 1\n[packing]\nn = 100\n\n[event_driven]\nn = 10\n";
+        let e = Engine::check_one("two.toml", text).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "two.toml:5: [event_driven] beside [packing] (line 2): a scene runs one engine"
+            ),
+            "{e}"
+        );
+        assert!(Engine::check_one("one.toml", "[rigid]\n[run]\ndt = 1.0\n").is_ok());
+        for e in crate::examples::all() {
+            assert!(Engine::check_one(&e.name, &e.text).is_ok(), "{}", e.name);
+        }
     }
 }

@@ -243,6 +243,9 @@ pub fn run_input(
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
     options.check_values()?;
+    if !input.plist {
+        Engine::check_one(&input.label, &input.text)?;
+    }
     let result = match input.engine() {
         Engine::Particles => particles::run(Some(input.clone()), options, monitor),
         Engine::Rigid => rigid::run(input, options, monitor),

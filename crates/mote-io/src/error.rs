@@ -107,6 +107,21 @@ impl<'a> Source<'a> {
             + 1
     }
 
+    /// One-based line of the header of table `key` (`[key]`, `[key.sub]`,
+    /// `[[key]]`), else where `key = ` is set ([`Source::key_line`]).
+    pub fn table_line(&self, key: &str) -> usize {
+        for (k, l) in self.text.lines().enumerate() {
+            let t = l.trim_start().trim_start_matches('[').trim_start();
+            if l.trim_start().starts_with('[')
+                && t.strip_prefix(key)
+                    .is_some_and(|rest| rest.starts_with(']') || rest.starts_with('.'))
+            {
+                return k + 1;
+            }
+        }
+        self.key_line(key)
+    }
+
     /// One-based line where `key = ` is first set (or an array of tables
     /// `[[...key...]]` starts); 1 if nowhere. For messages about a value
     /// found only after parsing.
