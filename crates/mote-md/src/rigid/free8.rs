@@ -1,9 +1,12 @@
 //! The FRBI's free step ([`super::frbi::free_step`]), its kick and the
 //! world frame for eight bodies at once — in AVX-512 where the CPU has it,
-//! else on [`mote_geom::lanes::Lanes`] (AVX2 on the x86-64-v3 build, NEON
-//! on aarch64): the same operations in the same order, each on eight lanes
-//! (one body per lane). No operation is fused or reassociated, so every
-//! lane gets the bits the scalar step gives, on both paths (tested).
+//! else portably (AVX2 on the x86-64-v3 build, NEON on aarch64): the kick
+//! and the world frame on [`mote_geom::lanes::Lanes`], the free step four
+//! bodies at a time (its 3 × 3 matrices of eight lanes would be eighteen
+//! AVX2 registers, and spilled, it ran 21 % slower). The same operations
+//! in the same order, one body per lane; no operation is fused or
+//! reassociated, so every lane gets the bits the scalar step gives, on
+//! every path (tested).
 //!
 //! Groups with a rotation vector near a half turn (|r|² > 10¹⁰⁰, where the
 //! rotation matrix takes another formula) go through the scalar step; so
@@ -556,6 +559,8 @@ mod avx512 {
 /// scalar step's, in its order, so every lane has its bits (the tests
 /// below hold both paths to them).
 mod portable {
+    use std::ops::{Add, Div, Mul, Sub};
+
     use glam::DVec3;
     use mote_geom::lanes::Lanes;
     use mote_geom::{Inertia, DE, EPSILON};
@@ -563,43 +568,160 @@ mod portable {
     use super::{Group, LANES};
     use crate::rigid::frbi::SpinUpdate;
 
-    /// Eight vectors, one per lane.
-    #[derive(Clone, Copy)]
-    struct V {
-        x: Lanes,
-        y: Lanes,
-        z: Lanes,
+    /// What the free step needs of its lanes: eight ([`Lanes`]: the kick
+    /// and the world frame) or four ([`Four`]: the free step, whose 3 × 3
+    /// matrices of eight lanes spill out of AVX2's sixteen registers).
+    pub(super) trait Lane:
+        Copy
+        + Add<Output = Self>
+        + Sub<Output = Self>
+        + Mul<Output = Self>
+        + Div<Output = Self>
+        + Mul<f64, Output = Self>
+        + Div<f64, Output = Self>
+    {
+        /// The number of lanes.
+        const N: usize;
+        fn splat(x: f64) -> Self;
+        fn from_fn(f: impl FnMut(usize) -> f64) -> Self;
+        fn lane(self, l: usize) -> f64;
+        fn sqrt(self) -> Self;
+        fn map(self, f: impl Fn(f64) -> f64) -> Self;
+        /// Bit l set where lane l is below `bound` (NaN is not).
+        fn bits_below(self, bound: f64) -> u8;
     }
 
-    impl V {
+    impl Lane for Lanes {
+        const N: usize = LANES;
         #[inline(always)]
-        fn of(v: &[DVec3; LANES]) -> Self {
-            let coordinate = |k: usize| Lanes(std::array::from_fn(|l| v[l][k]));
-            V {
-                x: coordinate(0),
-                y: coordinate(1),
-                z: coordinate(2),
+        fn splat(x: f64) -> Self {
+            Lanes::splat(x)
+        }
+        #[inline(always)]
+        fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
+            Lanes(std::array::from_fn(f))
+        }
+        #[inline(always)]
+        fn lane(self, l: usize) -> f64 {
+            self.0[l]
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            Lanes::sqrt(self)
+        }
+        #[inline(always)]
+        fn map(self, f: impl Fn(f64) -> f64) -> Self {
+            Lanes::map(self, f)
+        }
+        #[inline(always)]
+        fn bits_below(self, bound: f64) -> u8 {
+            Lanes::bits_below(self, bound)
+        }
+    }
+
+    /// Four f64 lanes: one AVX2 register.
+    #[derive(Clone, Copy)]
+    pub(super) struct Four([f64; 4]);
+
+    macro_rules! four_op {
+        ($trait:ident, $f:ident, $op:tt) => {
+            impl $trait for Four {
+                type Output = Four;
+                #[inline(always)]
+                fn $f(self, o: Four) -> Four {
+                    Four(std::array::from_fn(|l| self.0[l] $op o.0[l]))
+                }
             }
+            impl $trait<f64> for Four {
+                type Output = Four;
+                #[inline(always)]
+                fn $f(self, o: f64) -> Four {
+                    Four(std::array::from_fn(|l| self.0[l] $op o))
+                }
+            }
+        };
+    }
+    four_op!(Add, add, +);
+    four_op!(Sub, sub, -);
+    four_op!(Mul, mul, *);
+    four_op!(Div, div, /);
+
+    impl Lane for Four {
+        const N: usize = 4;
+        #[inline(always)]
+        fn splat(x: f64) -> Self {
+            Four([x; 4])
+        }
+        #[inline(always)]
+        fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
+            Four(std::array::from_fn(f))
+        }
+        #[inline(always)]
+        fn lane(self, l: usize) -> f64 {
+            self.0[l]
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            Four(self.0.map(f64::sqrt))
+        }
+        #[inline(always)]
+        fn map(self, f: impl Fn(f64) -> f64) -> Self {
+            Four(self.0.map(f))
+        }
+        #[inline(always)]
+        fn bits_below(self, bound: f64) -> u8 {
+            let mut bits = 0;
+            for (l, x) in self.0.iter().enumerate() {
+                bits |= u8::from(*x < bound) << l;
+            }
+            bits
+        }
+    }
+
+    /// N vectors, one per lane.
+    #[derive(Clone, Copy)]
+    struct V<L> {
+        x: L,
+        y: L,
+        z: L,
+    }
+
+    impl<L: Lane> V<L> {
+        /// Lane l from `f(l)`.
+        #[inline(always)]
+        fn from_fn(f: impl Fn(usize) -> DVec3) -> Self {
+            V {
+                x: L::from_fn(|l| f(l).x),
+                y: L::from_fn(|l| f(l).y),
+                z: L::from_fn(|l| f(l).z),
+            }
+        }
+
+        /// The first N vectors of `v`, one per lane.
+        #[inline(always)]
+        fn of(v: &[DVec3]) -> Self {
+            Self::from_fn(|l| v[l])
         }
 
         #[inline(always)]
         fn splat(v: DVec3) -> Self {
             V {
-                x: Lanes::splat(v.x),
-                y: Lanes::splat(v.y),
-                z: Lanes::splat(v.z),
+                x: L::splat(v.x),
+                y: L::splat(v.y),
+                z: L::splat(v.z),
+            }
+        }
+
+        /// Into the first N entries of `out`.
+        #[inline(always)]
+        fn write(self, out: &mut [DVec3]) {
+            for (l, o) in out.iter_mut().take(L::N).enumerate() {
+                *o = DVec3::new(self.x.lane(l), self.y.lane(l), self.z.lane(l));
             }
         }
 
         #[inline(always)]
-        fn write(self, out: &mut [DVec3; LANES]) {
-            for (l, o) in out.iter_mut().enumerate() {
-                *o = DVec3::new(self.x.0[l], self.y.0[l], self.z.0[l]);
-            }
-        }
-
-        #[inline(always)]
-        fn add(self, o: V) -> V {
+        fn add(self, o: Self) -> Self {
             V {
                 x: self.x + o.x,
                 y: self.y + o.y,
@@ -608,7 +730,7 @@ mod portable {
         }
 
         #[inline(always)]
-        fn sub(self, o: V) -> V {
+        fn sub(self, o: Self) -> Self {
             V {
                 x: self.x - o.x,
                 y: self.y - o.y,
@@ -618,7 +740,7 @@ mod portable {
 
         /// Component by component (glam's `DVec3 * DVec3`).
         #[inline(always)]
-        fn mul(self, o: V) -> V {
+        fn mul(self, o: Self) -> Self {
             V {
                 x: self.x * o.x,
                 y: self.y * o.y,
@@ -627,7 +749,7 @@ mod portable {
         }
 
         #[inline(always)]
-        fn scale(self, s: Lanes) -> V {
+        fn scale(self, s: L) -> Self {
             V {
                 x: self.x * s,
                 y: self.y * s,
@@ -637,13 +759,13 @@ mod portable {
 
         /// (x·x' + y·y') + z·z', glam's order.
         #[inline(always)]
-        fn dot(self, o: V) -> Lanes {
+        fn dot(self, o: Self) -> L {
             self.x * o.x + self.y * o.y + self.z * o.z
         }
 
         /// glam's `cross`, term for term.
         #[inline(always)]
-        fn cross(self, o: V) -> V {
+        fn cross(self, o: Self) -> Self {
             V {
                 x: self.y * o.z - o.y * self.z,
                 y: self.z * o.x - o.z * self.x,
@@ -652,18 +774,18 @@ mod portable {
         }
     }
 
-    /// Eight 3 × 3 matrices by columns.
+    /// N 3 × 3 matrices by columns.
     #[derive(Clone, Copy)]
-    struct M {
-        x: V,
-        y: V,
-        z: V,
+    struct M<L> {
+        x: V<L>,
+        y: V<L>,
+        z: V<L>,
     }
 
-    impl M {
+    impl<L: Lane> M<L> {
         /// glam's `mul_vec3`: ((x_axis v.x) + (y_axis v.y)) + (z_axis v.z).
         #[inline(always)]
-        fn apply(&self, v: V) -> V {
+        fn apply(&self, v: V<L>) -> V<L> {
             self.x
                 .scale(v.x)
                 .add(self.y.scale(v.y))
@@ -671,7 +793,7 @@ mod portable {
         }
 
         #[inline(always)]
-        fn mul(&self, o: &M) -> M {
+        fn mul(&self, o: &Self) -> Self {
             M {
                 x: self.apply(o.x),
                 y: self.apply(o.y),
@@ -680,8 +802,8 @@ mod portable {
         }
 
         #[inline(always)]
-        fn transpose(&self) -> M {
-            let column = |x: Lanes, y: Lanes, z: Lanes| V { x, y, z };
+        fn transpose(&self) -> Self {
+            let column = |x: L, y: L, z: L| V { x, y, z };
             M {
                 x: column(self.x.x, self.y.x, self.z.x),
                 y: column(self.x.y, self.y.y, self.z.y),
@@ -691,19 +813,19 @@ mod portable {
 
         /// P (d ⊙ Pᵀ x).
         #[inline(always)]
-        fn sandwich(&self, d: V, x: V) -> V {
+        fn sandwich(&self, d: V<L>, x: V<L>) -> V<L> {
             self.apply(d.mul(self.transpose().apply(x)))
         }
     }
 
     /// The matrix of x ↦ x * r, as `frbi::matrix` (all lanes |r|² ≤ 10¹⁰⁰).
     #[inline(always)]
-    fn matrix(r: V) -> M {
+    fn matrix<L: Lane>(r: V<L>) -> M<L> {
         let rr = r.dot(r);
-        let one = Lanes::splat(1.0);
+        let one = L::splat(1.0);
         let s = one / (one + rr);
         let c = (one - rr) * s;
-        let t = Lanes::splat(2.0) * s;
+        let t = L::splat(2.0) * s;
         let (x, y, z) = (r.x, r.y, r.z);
         let (xy, xz, yz) = (x * y, x * z, y * z);
         M {
@@ -728,20 +850,21 @@ mod portable {
     /// `DE::exp_rotation(ω, τ)`: the series of `half_tan_over` where
     /// φ = |ωτ| < 10⁻³, the scalar function in the other lanes.
     #[inline(always)]
-    fn exp_rotation(w: V, tau: f64) -> V {
-        let wt = w.scale(Lanes::splat(tau));
+    fn exp_rotation<L: Lane>(w: V<L>, tau: f64) -> V<L> {
+        let wt = w.scale(L::splat(tau));
         let phi = wt.dot(wt).sqrt();
         let p2 = phi * phi;
-        let series = Lanes::splat(0.5) * ((Lanes::splat(1.0) + p2 / 12.0) + p2 * p2 / 120.0);
+        let series = L::splat(0.5) * ((L::splat(1.0) + p2 / 12.0) + p2 * p2 / 120.0);
         let r = wt.scale(series);
-        let small = phi.bits_below(1e-3);
-        if small == 0xff {
+        let all = (1u16 << L::N) - 1;
+        let small = u16::from(phi.bits_below(1e-3));
+        if small == all {
             return r;
         }
         let (mut out, mut omega) = ([DVec3::ZERO; LANES], [DVec3::ZERO; LANES]);
         r.write(&mut out);
         w.write(&mut omega);
-        for l in 0..LANES {
+        for l in 0..L::N {
             if small & (1 << l) == 0 {
                 out[l] = DE::exp_rotation(omega[l], tau);
             }
@@ -751,8 +874,8 @@ mod portable {
 
     /// `compose_rotations(r1, r2)`: 1/s, or 1/ε where |s| < ε.
     #[inline(always)]
-    fn compose(r1: V, r2: V) -> V {
-        let s = Lanes::splat(1.0) - r1.dot(r2);
+    fn compose<L: Lane>(r1: V<L>, r2: V<L>) -> V<L> {
+        let s = L::splat(1.0) - r1.dot(r2);
         let big_s = s.map(|s| {
             if s.abs() < EPSILON {
                 1.0 / EPSILON
@@ -765,14 +888,14 @@ mod portable {
 
     /// The templates' principal axes A (columns), moments J and 1/J.
     #[inline(always)]
-    fn principal(inertia: &[&Inertia; LANES]) -> (M, V, V) {
+    fn principal<L: Lane>(inertia: &[&Inertia]) -> (M<L>, V<L>, V<L>) {
         let a = M {
-            x: V::of(&inertia.map(|i| i.axes[0])),
-            y: V::of(&inertia.map(|i| i.axes[1])),
-            z: V::of(&inertia.map(|i| i.axes[2])),
+            x: V::from_fn(|l| inertia[l].axes[0]),
+            y: V::from_fn(|l| inertia[l].axes[1]),
+            z: V::from_fn(|l| inertia[l].axes[2]),
         };
-        let j = V::of(&inertia.map(|i| DVec3::from(i.moments)));
-        let one = Lanes::splat(1.0);
+        let j = V::from_fn(|l| DVec3::from(inertia[l].moments));
+        let one = L::splat(1.0);
         let j_inv = V {
             x: one / j.x,
             y: one / j.y,
@@ -783,10 +906,10 @@ mod portable {
 
     /// `mote_geom::rotate(x, r)` for a constant x, term for term.
     #[inline(always)]
-    fn rotate(x: DVec3, r: V) -> V {
+    fn rotate<L: Lane>(x: DVec3, r: V<L>) -> V<L> {
         let x = V::splat(x);
         let rr = r.dot(r);
-        let (one, two) = (Lanes::splat(1.0), Lanes::splat(2.0));
+        let (one, two) = (L::splat(1.0), L::splat(2.0));
         let num = x
             .scale(one - rr)
             .add(r.scale(two * x.dot(r)))
@@ -808,7 +931,7 @@ mod portable {
         centres: &mut [DVec3],
         dipole: &mut [DVec3; LANES],
     ) {
-        let r = V::of(rotation);
+        let r = V::<Lanes>::of(rotation);
         let m = M {
             x: rotate(DVec3::X, r),
             y: rotate(DVec3::Y, r),
@@ -834,24 +957,31 @@ mod portable {
         velocity: &mut [DVec3; LANES],
         impulse: &[DE; LANES],
     ) {
-        let (a, _, j_inv) = principal(&inertia);
+        let (a, _, j_inv) = principal::<Lanes>(&inertia);
         let p = matrix(V::of(rotation)).mul(&a);
-        let angular = V::of(&impulse.map(|h| h.omega));
+        let angular = V::from_fn(|l| impulse[l].omega);
         p.sandwich(j_inv, angular).add(V::of(omega)).write(omega);
         let inverse_mass = Lanes(inertia.map(|i| 1.0 / i.mass));
         V::of(velocity)
-            .add(V::of(&impulse.map(|h| h.v)).scale(inverse_mass))
+            .add(V::from_fn(|l| impulse[l].v).scale(inverse_mass))
             .write(velocity);
     }
 
-    /// The free step of `frbi::free_step` (straight flight) on eight
-    /// lanes; false, with the group untouched, if a new rotation vector is
-    /// near a half turn.
-    pub(super) fn lanes(g: &mut Group, dt: f64, spin: SpinUpdate) -> bool {
-        let (a, j, j_inv) = principal(&g.inertia);
+    /// The new rotation vectors, positions and angular velocities of the
+    /// first N bodies of a group's arrays (`frbi::free_step`, straight
+    /// flight); `None` if a new rotation vector is near a half turn.
+    #[allow(clippy::type_complexity)]
+    #[inline(always)]
+    fn step<L: Lane>(
+        inertia: &[&Inertia],
+        (rotation, position, omega, velocity): (&[DVec3], &[DVec3], &[DVec3], &[DVec3]),
+        dt: f64,
+        spin: SpinUpdate,
+    ) -> Option<(V<L>, V<L>, V<L>)> {
+        let (a, j, j_inv) = principal::<L>(inertia);
         let tau = 0.5 * dt;
-        let w = V::of(g.omega);
-        let rotation = V::of(g.rotation);
+        let w = V::of(omega);
+        let rotation = V::of(rotation);
         let p = matrix(rotation).mul(&a);
         let l = p.sandwich(j, w);
         let r_c = exp_rotation(w, tau);
@@ -861,17 +991,45 @@ mod portable {
         let w_c = w.add(dw);
         let rotation = compose(rotation, exp_rotation(w_c, dt));
         // Not `bits_below`: a NaN lane goes on, as in the scalar step.
-        if rotation.dot(rotation).0.iter().any(|rr| *rr > 1e100) {
-            return false;
+        let rr = rotation.dot(rotation);
+        if (0..L::N).any(|l| rr.lane(l) > 1e100) {
+            return None;
         }
-        let position = V::of(g.position).add(V::of(g.velocity).scale(Lanes::splat(dt)));
+        let position = V::of(position).add(V::of(velocity).scale(L::splat(dt)));
         let omega = match spin {
             SpinUpdate::Seed => w_c.add(dw),
             SpinUpdate::KeepMomentum => matrix(rotation).mul(&a).sandwich(j_inv, l),
         };
-        rotation.write(g.rotation);
-        position.write(g.position);
-        omega.write(g.omega);
+        Some((rotation, position, omega))
+    }
+
+    /// The free step of `frbi::free_step` (straight flight) on the eight
+    /// bodies of a group, four lanes at a time; false, with the group
+    /// untouched, if a new rotation vector is near a half turn.
+    pub(super) fn lanes(g: &mut Group, dt: f64, spin: SpinUpdate) -> bool {
+        let half = |k: usize| {
+            let at = 4 * k..4 * k + 4;
+            step::<Four>(
+                &g.inertia[at.clone()],
+                (
+                    &g.rotation[at.clone()],
+                    &g.position[at.clone()],
+                    &g.omega[at.clone()],
+                    &g.velocity[at],
+                ),
+                dt,
+                spin,
+            )
+        };
+        let (Some(first), Some(second)) = (half(0), half(1)) else {
+            return false;
+        };
+        for (k, (rotation, position, omega)) in [first, second].into_iter().enumerate() {
+            let at = 4 * k..4 * k + 4;
+            rotation.write(&mut g.rotation[at.clone()]);
+            position.write(&mut g.position[at.clone()]);
+            omega.write(&mut g.omega[at]);
+        }
         true
     }
 }
