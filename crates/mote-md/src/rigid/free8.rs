@@ -1,9 +1,10 @@
 //! The FRBI's free step ([`super::frbi::free_step`]), its kick and the
 //! world frame for eight bodies at once — in AVX-512 where the CPU has it,
 //! else portably (AVX2 on the x86-64-v3 build, NEON on aarch64): the kick
-//! and the world frame on [`mote_geom::lanes::Lanes`], the free step four
-//! bodies at a time (its 3 × 3 matrices of eight lanes would be eighteen
-//! AVX2 registers, and spilled, it ran 21 % slower). The same operations
+//! on [`mote_geom::lanes::Lanes`], the free step and the world frame four
+//! bodies at a time (their 3 × 3 matrices of eight lanes would be eighteen
+//! AVX2 registers, and spilled, the free step ran 21 % slower; the kick
+//! gained nothing from four). The same operations
 //! in the same order, one body per lane; no operation is fused or
 //! reassociated, so every lane gets the bits the scalar step gives, on
 //! every path (tested).
@@ -568,9 +569,9 @@ mod portable {
     use super::{Group, LANES};
     use crate::rigid::frbi::SpinUpdate;
 
-    /// What the free step needs of its lanes: eight ([`Lanes`]: the kick
-    /// and the world frame) or four ([`Four`]: the free step, whose 3 × 3
-    /// matrices of eight lanes spill out of AVX2's sixteen registers).
+    /// What the rigid arithmetic needs of its lanes: eight ([`Lanes`]: the
+    /// kick) or four ([`Four`]: the free step and the world frame, whose
+    /// 3 × 3 matrices of eight lanes spill out of AVX2's sixteen registers).
     pub(super) trait Lane:
         Copy
         + Add<Output = Self>
@@ -931,22 +932,26 @@ mod portable {
         centres: &mut [DVec3],
         dipole: &mut [DVec3; LANES],
     ) {
-        let r = V::<Lanes>::of(rotation);
-        let m = M {
-            x: rotate(DVec3::X, r),
-            y: rotate(DVec3::Y, r),
-            z: rotate(DVec3::Z, r),
-        };
-        let x = V::of(position);
+        // Four bodies at a time: a matrix of four lanes is nine registers.
         let count = centres0.len();
-        let mut lanes = [DVec3::ZERO; LANES];
-        for (s, b) in centres0.iter().enumerate() {
-            x.add(m.apply(V::splat(*b))).write(&mut lanes);
-            for (l, c) in lanes.iter().enumerate() {
-                centres[l * count + s] = *c;
+        for half in 0..2 {
+            let at = 4 * half..4 * half + 4;
+            let r = V::<Four>::of(&rotation[at.clone()]);
+            let m = M {
+                x: rotate(DVec3::X, r),
+                y: rotate(DVec3::Y, r),
+                z: rotate(DVec3::Z, r),
+            };
+            let x = V::of(&position[at.clone()]);
+            let mut lanes = [DVec3::ZERO; 4];
+            for (s, b) in centres0.iter().enumerate() {
+                x.add(m.apply(V::splat(*b))).write(&mut lanes);
+                for (l, c) in lanes.iter().enumerate() {
+                    centres[(4 * half + l) * count + s] = *c;
+                }
             }
+            m.apply(V::splat(dipole0)).write(&mut dipole[at]);
         }
-        m.apply(V::splat(dipole0)).write(dipole);
     }
 
     /// `frbi::react` on eight lanes (all |r|² ≤ 10¹⁰⁰).
