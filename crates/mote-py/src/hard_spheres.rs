@@ -201,13 +201,8 @@ simulation_class! {
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let e = self.engine()?;
-        let rows = e.run.samples();
-        let d = PyDict::new(py);
-        for (k, (name, _unit)) in e.run.columns().iter().enumerate() {
-            let column: Vec<f64> = rows.iter().map(|r| r[k]).collect();
-            d.set_item(*name, PyArray1::from_vec(py, column))?;
-        }
-        Ok(d)
+        let names = e.run.columns().iter().map(|(name, _unit)| *name);
+        crate::tools::columns(py, names, &e.run.samples())
     }
 
     /// Ray-traces the current state as `mote run --picture` does: a
@@ -220,11 +215,7 @@ simulation_class! {
         width: u32,
         height: u32,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let frame = self.engine()?.run.frame();
-        let image = py
-            .detach(|| mote_render::frame::picture_image(&frame, width, height))
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        crate::tools::image_out(py, image, output)
+        crate::tools::picture(py, &self.engine()?.run.frame(), output, width, height)
     }
 
     fn __repr__(&self) -> PyResult<String> {

@@ -198,12 +198,7 @@ simulation_class! {
     #[getter]
     fn windows<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let rows = self.engine()?.run.windows();
-        let d = PyDict::new(py);
-        for (k, name) in mote_front::stepper::Packing::WINDOW_COLUMNS.iter().enumerate() {
-            let column: Vec<f64> = rows.iter().map(|r| r[k]).collect();
-            d.set_item(*name, PyArray1::from_vec(py, column))?;
-        }
-        Ok(d)
+        crate::tools::columns(py, mote_front::stepper::Packing::WINDOW_COLUMNS, &rows)
     }
 
     /// Ray-traces the current state as `mote run --picture` does: a
@@ -216,11 +211,7 @@ simulation_class! {
         width: u32,
         height: u32,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let frame = self.engine()?.run.frame();
-        let image = py
-            .detach(|| mote_render::frame::picture_image(&frame, width, height))
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        crate::tools::image_out(py, image, output)
+        crate::tools::picture(py, &self.engine()?.run.frame(), output, width, height)
     }
 
     fn __repr__(&self) -> PyResult<String> {

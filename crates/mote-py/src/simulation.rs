@@ -347,11 +347,7 @@ simulation_class! {
         width: u32,
         height: u32,
     ) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let frame = self.engine()?.frame();
-        let image = py
-            .detach(|| mote_render::frame::picture_image(&frame, width, height))
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        crate::tools::image_out(py, image, output)
+        crate::tools::picture(py, &self.engine()?.frame(), output, width, height)
     }
 
     fn __repr__(&self) -> PyResult<String> {

@@ -265,6 +265,36 @@ pub fn image_out<'py>(
     }
 }
 
+/// Ray-traces `frame` as `mote run --picture` does (the GIL released):
+/// what every class's `render` returns ([`image_out`]).
+pub fn picture<'py>(
+    py: Python<'py>,
+    frame: &mote_io::xyz::Frame,
+    output: Option<PathBuf>,
+    width: u32,
+    height: u32,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let image = py
+        .detach(|| mote_render::frame::picture_image(frame, width, height))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    image_out(py, image, output)
+}
+
+/// A table as a dict of numpy columns: `names[k]` holds entry k of every
+/// row (the observables of `HardSpheres`, the windows of `Packing`).
+pub fn columns<'py>(
+    py: Python<'py>,
+    names: impl IntoIterator<Item = &'static str>,
+    rows: &[impl AsRef<[f64]>],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, name) in names.into_iter().enumerate() {
+        let column: Vec<f64> = rows.iter().map(|r| r.as_ref()[k]).collect();
+        d.set_item(name, PyArray1::from_vec(py, column))?;
+    }
+    Ok(d)
+}
+
 /// Ray-traces a frame of a trajectory file (`.xyz`, `.dump`, `.gsd`,
 /// `.vtp`/`.pvd`; `frame` counts from 0, negative from the end, default
 /// the last) as `mote run --picture` does: coloured by species, shadows,
@@ -284,10 +314,7 @@ pub fn render<'py>(
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let f =
         mote_io::trajectory::pick(&frames, frame, &trajectory).map_err(PyValueError::new_err)?;
-    let image = py
-        .detach(|| mote_render::frame::picture_image(f, width, height))
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    image_out(py, image, output)
+    picture(py, f, output, width, height)
 }
 
 /// The size distribution that packs densest (or closest to `target`) by
