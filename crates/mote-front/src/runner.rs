@@ -41,6 +41,12 @@ pub(crate) trait EngineRun {
 
     /// The scene's seed, if it names one.
     fn scene_seed(&self) -> Option<u64>;
+    /// Whether the scene's seed was chosen for it (`mote pack` without
+    /// `--seed` writes the seed it drew into the scene it runs), so the
+    /// opening line says so.
+    fn seed_chosen(&self) -> bool {
+        false
+    }
     /// The scene's `[output] dir`, if it names one.
     fn scene_dir(&self) -> Option<&String>;
     /// The propagator, ready to step: built from the scene with `seed`,
@@ -151,6 +157,7 @@ pub(crate) fn run_engine<E: EngineRun>(
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
     let (seed, chosen) = crate::seed::resolve(options.seed, engine.scene_seed());
+    let chosen = chosen || engine.seed_chosen();
     let dir = input.output_dir(options.output.as_ref(), engine.scene_dir());
     let mut state = engine.build(seed, resumed)?;
     if resumed.is_none() && !options.force {

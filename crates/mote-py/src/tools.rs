@@ -156,13 +156,14 @@ pub fn pack<'py>(
         min_pressure,
         ..PackingSpec::default()
     };
-    let (seed, _) = mote_front::seed::resolve(seed, None);
+    let (seed, seed_chosen) = mote_front::seed::resolve(seed, None);
     let request = PackRequest {
         output,
         format,
         picture: None,
         checkpoint_every: None,
         seed,
+        seed_chosen,
     };
     let label = format!("mote.pack(n={n}, dist={dist:?}, rate={rate})");
     let packed = py

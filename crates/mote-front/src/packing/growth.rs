@@ -40,6 +40,8 @@ pub(crate) struct Growth<'a, const D: usize> {
     /// resolve against.
     pub base: PathBuf,
     pub scene_seed: Option<u64>,
+    /// The seed was drawn for this run (no `--seed`).
+    pub seed_chosen: bool,
     pub scene_dir: Option<String>,
     /// The packing file's format.
     pub format: Format,
@@ -64,7 +66,7 @@ impl<'a, const D: usize> Growth<'a, D> {
         spec: &'a PackingSpec,
         naming: Naming<'a>,
         base: PathBuf,
-        scene_seed: Option<u64>,
+        (scene_seed, seed_chosen): (Option<u64>, bool),
         scene_dir: Option<String>,
         format: Format,
         writes: bool,
@@ -76,6 +78,7 @@ impl<'a, const D: usize> Growth<'a, D> {
             naming,
             base,
             scene_seed,
+            seed_chosen,
             scene_dir,
             format,
             writes,
@@ -160,6 +163,10 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
 
     fn scene_seed(&self) -> Option<u64> {
         self.scene_seed
+    }
+
+    fn seed_chosen(&self) -> bool {
+        self.seed_chosen
     }
 
     fn scene_dir(&self) -> Option<&String> {

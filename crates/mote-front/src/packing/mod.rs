@@ -445,6 +445,8 @@ pub struct PackRequest {
     /// Pressure windows between checkpoints (needs `output`).
     pub checkpoint_every: Option<u64>,
     pub seed: u64,
+    /// The seed was drawn for this packing (none was given).
+    pub seed_chosen: bool,
 }
 
 /// Packs what `spec` asks for, as `mote pack` (`label`, the command as
@@ -473,7 +475,10 @@ pub fn pack(
             Some(dir) => Some(crate::lock::RunFolder::fresh(dir, label, &text)?),
             None => None,
         };
-        monitor.start(&format!("mote pack: {label}, seed {seed}"));
+        monitor.start(&format!(
+            "mote pack: {label}, {}",
+            crate::seed_phrase(seed, request.seed_chosen)
+        ));
         let files = PackFiles {
             xyz: request
                 .output
@@ -511,6 +516,7 @@ pub fn pack(
         naming: Naming::Options,
         base: PathBuf::from("."),
         scene_seed: Some(seed),
+        seed_chosen: request.seed_chosen,
         scene_dir: None,
         format: request.format,
         writes: request.output.is_some(),
@@ -545,6 +551,7 @@ struct Growing<'a> {
     naming: Naming<'a>,
     base: PathBuf,
     scene_seed: Option<u64>,
+    seed_chosen: bool,
     scene_dir: Option<String>,
     format: Format,
     writes: bool,
@@ -568,7 +575,7 @@ impl Growing<'_> {
                         self.spec,
                         self.naming,
                         self.base,
-                        self.scene_seed,
+                        (self.scene_seed, self.seed_chosen),
                         self.scene_dir,
                         self.format,
                         self.writes,
@@ -705,6 +712,7 @@ pub(crate) fn run(
         naming: Naming::Scene(source),
         base: input.folder(),
         scene_seed: scene.seed,
+        seed_chosen: false,
         scene_dir: scene.output.dir.clone(),
         format,
         writes: true,
@@ -832,6 +840,7 @@ pub(crate) fn resume(
             .map(PathBuf::from)
             .unwrap_or_else(|| input.folder()),
         scene_seed: scene.seed,
+        seed_chosen: false,
         scene_dir: scene.output.dir.clone(),
         format,
         writes: true,

@@ -210,7 +210,7 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         mote_front::check_picture_path(p)?;
     }
     let spec = a.spec();
-    let (seed, _) = mote_front::seed::resolve(global.seed, None);
+    let (seed, seed_chosen) = mote_front::seed::resolve(global.seed, None);
     let method = spec.method(Naming::Options)?;
     let start = match &a.start {
         Some(file) => format!("--start {file}"),
@@ -241,6 +241,7 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         picture: a.picture.clone(),
         checkpoint_every: a.checkpoint_every,
         seed,
+        seed_chosen,
     };
     let mut terminal = Terminal::new(quiet);
     let packed = mote_front::packing::pack(&spec, &label, &request, &mut terminal)?;
