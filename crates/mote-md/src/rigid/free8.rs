@@ -560,124 +560,12 @@ mod avx512 {
 /// scalar step's, in its order, so every lane has its bits (the tests
 /// below hold both paths to them).
 mod portable {
-    use std::ops::{Add, Div, Mul, Sub};
-
     use glam::DVec3;
-    use mote_geom::lanes::Lanes;
+    use mote_geom::lanes::{Four, Lane, Lanes};
     use mote_geom::{Inertia, DE, EPSILON};
 
     use super::{Group, LANES};
     use crate::rigid::frbi::SpinUpdate;
-
-    /// What the rigid arithmetic needs of its lanes: eight ([`Lanes`]: the
-    /// kick) or four ([`Four`]: the free step and the world frame, whose
-    /// 3 × 3 matrices of eight lanes spill out of AVX2's sixteen registers).
-    pub(super) trait Lane:
-        Copy
-        + Add<Output = Self>
-        + Sub<Output = Self>
-        + Mul<Output = Self>
-        + Div<Output = Self>
-        + Mul<f64, Output = Self>
-        + Div<f64, Output = Self>
-    {
-        /// The number of lanes.
-        const N: usize;
-        fn splat(x: f64) -> Self;
-        fn from_fn(f: impl FnMut(usize) -> f64) -> Self;
-        fn lane(self, l: usize) -> f64;
-        fn sqrt(self) -> Self;
-        fn map(self, f: impl Fn(f64) -> f64) -> Self;
-        /// Bit l set where lane l is below `bound` (NaN is not).
-        fn bits_below(self, bound: f64) -> u8;
-    }
-
-    impl Lane for Lanes {
-        const N: usize = LANES;
-        #[inline(always)]
-        fn splat(x: f64) -> Self {
-            Lanes::splat(x)
-        }
-        #[inline(always)]
-        fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
-            Lanes(std::array::from_fn(f))
-        }
-        #[inline(always)]
-        fn lane(self, l: usize) -> f64 {
-            self.0[l]
-        }
-        #[inline(always)]
-        fn sqrt(self) -> Self {
-            Lanes::sqrt(self)
-        }
-        #[inline(always)]
-        fn map(self, f: impl Fn(f64) -> f64) -> Self {
-            Lanes::map(self, f)
-        }
-        #[inline(always)]
-        fn bits_below(self, bound: f64) -> u8 {
-            Lanes::bits_below(self, bound)
-        }
-    }
-
-    /// Four f64 lanes: one AVX2 register.
-    #[derive(Clone, Copy)]
-    pub(super) struct Four([f64; 4]);
-
-    macro_rules! four_op {
-        ($trait:ident, $f:ident, $op:tt) => {
-            impl $trait for Four {
-                type Output = Four;
-                #[inline(always)]
-                fn $f(self, o: Four) -> Four {
-                    Four(std::array::from_fn(|l| self.0[l] $op o.0[l]))
-                }
-            }
-            impl $trait<f64> for Four {
-                type Output = Four;
-                #[inline(always)]
-                fn $f(self, o: f64) -> Four {
-                    Four(std::array::from_fn(|l| self.0[l] $op o))
-                }
-            }
-        };
-    }
-    four_op!(Add, add, +);
-    four_op!(Sub, sub, -);
-    four_op!(Mul, mul, *);
-    four_op!(Div, div, /);
-
-    impl Lane for Four {
-        const N: usize = 4;
-        #[inline(always)]
-        fn splat(x: f64) -> Self {
-            Four([x; 4])
-        }
-        #[inline(always)]
-        fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
-            Four(std::array::from_fn(f))
-        }
-        #[inline(always)]
-        fn lane(self, l: usize) -> f64 {
-            self.0[l]
-        }
-        #[inline(always)]
-        fn sqrt(self) -> Self {
-            Four(self.0.map(f64::sqrt))
-        }
-        #[inline(always)]
-        fn map(self, f: impl Fn(f64) -> f64) -> Self {
-            Four(self.0.map(f))
-        }
-        #[inline(always)]
-        fn bits_below(self, bound: f64) -> u8 {
-            let mut bits = 0;
-            for (l, x) in self.0.iter().enumerate() {
-                bits |= u8::from(*x < bound) << l;
-            }
-            bits
-        }
-    }
 
     /// N vectors, one per lane.
     #[derive(Clone, Copy)]
