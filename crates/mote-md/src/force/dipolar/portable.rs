@@ -1,12 +1,12 @@
 //! The dipole pair law (004 Eq. 8) with its fused LJ repulsion on eight
 //! pairs at a time ([`Lanes`]): the portable kernel of the all-pairs tiles,
-//! which the build's target vectorises. Masks are selects: a pair beyond
+//! which the build's target vectorises, 1/r by [`Lane::rsqrt`]. Masks are selects: a pair beyond
 //! the dipolar cut-off adds no dipolar term, one beyond the repulsion's
 //! none of it, and an empty lane (zero separation, zero moment) nothing at
 //! all. The cut-off rows use it too (`listed::row_lanes`), their
 //! neighbours gathered by `lanes::gather_xyz`.
 
-use mote_geom::lanes::Lanes;
+use mote_geom::lanes::{Lane, Lanes};
 
 use super::Kernel;
 
@@ -27,10 +27,13 @@ pub(super) fn pair_lanes(kern: &Kernel, d: [Lanes; 3], a: [f64; 3], b: [Lanes; 3
     let [ax, ay, az] = a;
     let [bx, by, bz] = b;
     let r2 = dx * dx + dy * dy + dz * dz;
-    let inv_r2 = r2.recip_or_zero();
+    // 1/r by multiplications alone (`Lane::rsqrt`: no square root or
+    // division, the slowest instructions of AVX2), 0 for an empty lane.
+    let inv_r = r2.rsqrt().where_positive(r2);
+    let inv_r2 = inv_r * inv_r;
     // k where the dipolar part reaches (r² < r_c²), else 0.
     let k = r2.select_within(kern.rc2, kern.k, 0.0);
-    let inv_r3 = k * inv_r2 * inv_r2.sqrt();
+    let inv_r3 = k * inv_r2 * inv_r;
     let inv_r5 = inv_r3 * inv_r2;
     let a_r = dx * ax + dy * ay + dz * az;
     let b_r = bx * dx + by * dy + bz * dz;

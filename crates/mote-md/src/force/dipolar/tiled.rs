@@ -134,14 +134,12 @@ pub(super) fn reacting_row_portable(
         }
         w = w + p.virial;
         let k = j0 - base;
-        for l in 0..live {
-            r.fx[k + l] -= p.force[0].0[l];
-            r.fy[k + l] -= p.force[1].0[l];
-            r.fz[k + l] -= p.force[2].0[l];
-            r.tx[k + l] += p.torque_j[0].0[l];
-            r.ty[k + l] += p.torque_j[1].0[l];
-            r.tz[k + l] += p.torque_j[2].0[l];
-        }
+        p.force[0].subtract_from(&mut r.fx, k, live);
+        p.force[1].subtract_from(&mut r.fy, k, live);
+        p.force[2].subtract_from(&mut r.fz, k, live);
+        p.torque_j[0].add_to(&mut r.tx, k, live);
+        p.torque_j[1].add_to(&mut r.ty, k, live);
+        p.torque_j[2].add_to(&mut r.tz, k, live);
         j0 += live;
     }
     (
