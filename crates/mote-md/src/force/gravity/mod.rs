@@ -22,6 +22,7 @@ mod avx512;
 mod portable;
 
 use glam::DVec3;
+use mote_geom::lanes::Lanes;
 use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
@@ -210,15 +211,28 @@ impl DirectGravity {
                 let mut i = base;
                 while i < end_i {
                     let (rx, ry, rz) = (&mut row.rx[..], &mut row.ry[..], &mut row.rz[..]);
-                    // Off the diagonal two rows share every j block: with
-                    // AVX-512 they go through the loop together, which
-                    // halves the loads and stores of the reactions (the
-                    // arithmetic, and so every bit, is that of two single rows).
-                    #[cfg(target_arch = "x86_64")]
-                    if isa == Isa::Avx512 && jt > t && i + 1 < end_i {
-                        // SAFETY: as for `avx512::pairs` below, for both rows.
-                        let (a0, a1) = unsafe {
-                            avx512::pairs2(i, jt * tile, j_end, soa, eps2, base, rx, ry, rz)
+                    // Off the diagonal two rows share every j block: they go
+                    // through the loop together, which halves the loads and
+                    // stores of the reactions (the arithmetic, and so every
+                    // bit, is that of two single rows on the same lanes).
+                    if jt > t && i + 1 < end_i {
+                        let (a0, a1) = match isa {
+                            // SAFETY: as for `avx512::pairs` below, for both rows.
+                            #[cfg(target_arch = "x86_64")]
+                            Isa::Avx512 => unsafe {
+                                avx512::pairs2(i, jt * tile, j_end, soa, eps2, base, rx, ry, rz)
+                            },
+                            Isa::Portable => portable::pairs2::<Lanes>(
+                                i,
+                                jt * tile,
+                                j_end,
+                                soa,
+                                eps2,
+                                base,
+                                rx,
+                                ry,
+                                rz,
+                            ),
                         };
                         row.own[i - base] += a0;
                         row.own[i + 1 - base] += a1;
