@@ -83,70 +83,70 @@ pub(super) struct TileRow {
     reactions: Reactions,
 }
 
-/// Force, torque and virial share of row i over partners
-/// `j_start..j_end` (those below `n`), each pair's reaction (−F, τ_j)
-/// added to `r` at `j − base`: the portable twin of the AVX-512 rows,
-/// eight partners at a time on [`Lanes`].
+/// Force, torque and virial shares of rows i, i + 1, …, i + Q − 1, row
+/// i + q over partners `starts[q]..j_end` (those below `n`; `starts`
+/// ascending), each pair's reaction (−F, τ_j) added to `r` at `j − base`:
+/// the portable twin of the AVX-512 rows, eight partners at a time on
+/// [`Lanes`]. The Q rows share each block's loads and reaction updates,
+/// row by row in order (every reaction the bits of Q single rows).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn reacting_row_portable(
+pub(super) fn reacting_rows_portable<const Q: usize>(
     kern: &Kernel,
     s: &Soa,
     i: usize,
-    j_start: usize,
+    starts: [usize; Q],
     j_end: usize,
     n: usize,
     base: usize,
     r: &mut Reactions,
-) -> (DVec3, DVec3, f64) {
-    let a = [s.mx[i], s.my[i], s.mz[i]];
+) -> [(DVec3, DVec3, f64); Q] {
+    let a: [[f64; 3]; Q] = std::array::from_fn(|q| [s.mx[i + q], s.my[i + q], s.mz[i + q]]);
+    let centre: [[f64; 3]; Q] = std::array::from_fn(|q| [s.x[i + q], s.y[i + q], s.z[i + q]]);
     let j_max = j_end.min(n);
     let zero = Lanes::splat(0.0);
-    let (mut f, mut t, mut w) = ([zero; 3], [zero; 3], zero);
-    let mut j0 = j_start;
+    let (mut f, mut t, mut w) = ([[zero; 3]; Q], [[zero; 3]; Q], [zero; Q]);
+    let mut j0 = starts[0];
     while j0 < j_max {
-        // Lanes past the row's end hold no separation and no moment.
         let live = (j_max - j0).min(LANES);
-        let apart = |v: &[f64], centre: f64| {
-            let d = Lanes::load(v, j0, live).map(|x| centre - x);
-            if live == LANES {
-                d
-            } else {
-                d * Lanes::load(&[1.0; LANES], 0, live)
-            }
-        };
-        let p = pair_lanes(
-            kern,
-            [
-                apart(&s.x, s.x[i]),
-                apart(&s.y, s.y[i]),
-                apart(&s.z, s.z[i]),
-            ],
-            a,
-            [
-                Lanes::load(&s.mx, j0, live),
-                Lanes::load(&s.my, j0, live),
-                Lanes::load(&s.mz, j0, live),
-            ],
-        );
-        for c in 0..3 {
-            f[c] = f[c] + p.force[c];
-            t[c] = t[c] + p.torque_i[c];
-        }
-        w = w + p.virial;
+        let rj = [&s.x, &s.y, &s.z].map(|v| Lanes::load(v, j0, live));
+        let b = [&s.mx, &s.my, &s.mz].map(|v| Lanes::load(v, j0, live));
         let k = j0 - base;
-        p.force[0].subtract_from(&mut r.fx, k, live);
-        p.force[1].subtract_from(&mut r.fy, k, live);
-        p.force[2].subtract_from(&mut r.fz, k, live);
-        p.torque_j[0].add_to(&mut r.tx, k, live);
-        p.torque_j[1].add_to(&mut r.ty, k, live);
-        p.torque_j[2].add_to(&mut r.tz, k, live);
+        for q in 0..Q {
+            let mut d: [Lanes; 3] = std::array::from_fn(|c| rj[c].map(|x| centre[q][c] - x));
+            // Lanes past the row's end, or before the row's start, hold no
+            // separation and no moment.
+            if live < LANES || j0 < starts[q] {
+                let keep = Lanes(std::array::from_fn(|l| {
+                    if l < live && j0 + l >= starts[q] {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }));
+                d = d.map(|d| d * keep);
+            }
+            let p = pair_lanes(kern, d, a[q], b);
+            for c in 0..3 {
+                f[q][c] = f[q][c] + p.force[c];
+                t[q][c] = t[q][c] + p.torque_i[c];
+            }
+            w[q] = w[q] + p.virial;
+            p.force[0].subtract_from(&mut r.fx, k, live);
+            p.force[1].subtract_from(&mut r.fy, k, live);
+            p.force[2].subtract_from(&mut r.fz, k, live);
+            p.torque_j[0].add_to(&mut r.tx, k, live);
+            p.torque_j[1].add_to(&mut r.ty, k, live);
+            p.torque_j[2].add_to(&mut r.tz, k, live);
+        }
         j0 += live;
     }
-    (
-        DVec3::new(f[0].sum(), f[1].sum(), f[2].sum()),
-        DVec3::new(t[0].sum(), t[1].sum(), t[2].sum()),
-        w.sum(),
-    )
+    std::array::from_fn(|q| {
+        (
+            DVec3::new(f[q][0].sum(), f[q][1].sum(), f[q][2].sum()),
+            DVec3::new(t[q][0].sum(), t[q][1].sum(), t[q][2].sum()),
+            w[q].sum(),
+        )
+    })
 }
 
 impl DipoleDipole {
@@ -189,18 +189,23 @@ impl DipoleDipole {
                         continue;
                     }
                     let r = &mut row.reactions;
-                    // With AVX-512 two rows share each block's loads and
-                    // reaction updates (the arithmetic of two single rows).
-                    #[cfg(target_arch = "x86_64")]
-                    if isa == Isa::Avx512 && i + 1 < end_i {
+                    // Two rows share each block's loads and reaction
+                    // updates (the arithmetic of two single rows).
+                    if i + 1 < end_i {
                         let starts = [j_start, block.max(i + 2)];
-                        // SAFETY: the CPU supports AVX-512F (`isa`); the
-                        // arrays have the padded length npad ≥ block_end, a
-                        // multiple of 8, and the reactions cover base..npad.
-                        let sums = unsafe {
-                            super::avx512::reacting_rows::<2>(
+                        let sums = match isa {
+                            // SAFETY: the CPU supports AVX-512F (`isa`); the
+                            // arrays have the padded length npad ≥ block_end, a
+                            // multiple of 8, and the reactions cover base..npad.
+                            #[cfg(target_arch = "x86_64")]
+                            Isa::Avx512 => unsafe {
+                                super::avx512::reacting_rows::<2>(
+                                    &kern, soa, i, starts, block_end, n, base, r,
+                                )
+                            },
+                            Isa::Portable => reacting_rows_portable::<2>(
                                 &kern, soa, i, starts, block_end, n, base, r,
-                            )
+                            ),
                         };
                         for (q, (f, tq, w)) in sums.into_iter().enumerate() {
                             let own = &mut row.own[i + q - base];
@@ -226,9 +231,16 @@ impl DipoleDipole {
                                 r,
                             )[0]
                         },
-                        Isa::Portable => {
-                            reacting_row_portable(&kern, soa, i, j_start, block_end, n, base, r)
-                        }
+                        Isa::Portable => reacting_rows_portable::<1>(
+                            &kern,
+                            soa,
+                            i,
+                            [j_start],
+                            block_end,
+                            n,
+                            base,
+                            r,
+                        )[0],
                     };
                     let own = &mut row.own[i - base];
                     own.0 += f;
