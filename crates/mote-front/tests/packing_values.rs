@@ -24,25 +24,8 @@ fn valid() -> Vec<std::ops::Range<f64>> {
     ]
 }
 
-fn hostile() -> impl Strategy<Value = f64> {
-    prop_oneof![
-        Just(0.0),
-        Just(-1.0),
-        Just(1e-300),
-        Just(1e300),
-        Just(f64::MIN_POSITIVE),
-        Just(f64::MAX),
-        -1e3..1e3f64,
-    ]
-}
-
 fn values() -> impl Strategy<Value = Vec<f64>> {
-    (valid(), prop::collection::vec((0..7usize, hostile()), 0..3)).prop_map(|(mut v, bad)| {
-        for (i, x) in bad {
-            v[i] = x;
-        }
-        v
-    })
+    mote_testkit::with_hostile(valid())
 }
 
 fn scene(v: &[f64]) -> String {

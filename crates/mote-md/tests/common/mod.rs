@@ -32,15 +32,4 @@ pub fn run_until(sim: &mut Simulation, t: f64) {
 
 /// A number a careless or hostile user might write in a scene, for the
 /// property tests over scene values (`scene_values`, `rigid_scene_values`).
-pub fn hostile() -> impl proptest::strategy::Strategy<Value = f64> {
-    use proptest::prelude::*;
-    prop_oneof![
-        Just(0.0),
-        Just(-1.0),
-        Just(1e-300),
-        Just(1e300),
-        Just(f64::MIN_POSITIVE),
-        Just(f64::MAX),
-        -1e3..1e3f64,
-    ]
-}
+pub use mote_testkit::hostile;
