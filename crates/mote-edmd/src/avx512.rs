@@ -12,22 +12,7 @@
 
 use std::arch::x86_64::*;
 
-/// What the neighbour scan needs to know about the particle `i` itself
-/// (advanced to `now`) and the box.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Probe<const D: usize> {
-    pub x: [f64; D],
-    pub v: [f64; D],
-    /// Radius at time 0 (the records hold radii at time 0 too).
-    pub r: f64,
-    pub now: f64,
-    pub size: [f64; D],
-    pub half: [f64; D],
-    pub periodic: [bool; D],
-    /// Growth factor 1 + δ·now and rate δ (1 and 0 without growth).
-    pub g: f64,
-    pub delta: f64,
-}
+pub(crate) use crate::system::Probe;
 
 /// Whether this CPU can run [`earliest`].
 pub(crate) fn available() -> bool {

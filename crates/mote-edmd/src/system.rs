@@ -33,6 +33,7 @@ use crate::cells::{Cells, ListPos};
 use crate::queue::EventQueue;
 use crate::vecd::{add_scaled, dot, sub};
 use crate::EdmdError;
+use mote_geom::lanes::{Lanes, LANES};
 use serde::{Deserialize, Serialize};
 
 /// What one axis of the box does at its faces.
@@ -244,6 +245,8 @@ pub struct System<const D: usize> {
     skin_cap: f64,
     /// Scan neighbour lists with AVX-512 (same results as the scalar loop).
     simd: bool,
+    /// The neighbour scan on [`Lanes`] where AVX-512 is not used.
+    lanes: bool,
 }
 
 /// Time until two particles at relative position `r` with relative velocity
@@ -311,6 +314,112 @@ fn approach_root(a: f64, b: f64, c: f64) -> f64 {
     } else {
         f64::INFINITY
     }
+}
+
+/// What the vector neighbour scans need to know about the particle `i`
+/// itself (advanced to `now`) and the box.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Probe<const D: usize> {
+    pub x: [f64; D],
+    pub v: [f64; D],
+    /// Radius at time 0 (the records hold radii at time 0 too).
+    pub r: f64,
+    pub now: f64,
+    pub size: [f64; D],
+    pub half: [f64; D],
+    pub periodic: [bool; D],
+    /// Growth factor 1 + δ·now and rate δ (1 and 0 without growth).
+    pub g: f64,
+    pub delta: f64,
+}
+
+/// The earliest contact time with the particles of `list` and its position
+/// in `list`, or (+∞, None): the scalar scan of `System::predict` eight
+/// neighbours at a time on [`Lanes`] (every CPU; AVX2 on the x86-64-v3
+/// build), each lane the scalar loop's operations in its order (no fused
+/// multiply–adds, the same selects), so every time is the scalar's to the
+/// bit and the earliest is the same partner, ties to the first in the list.
+fn earliest_lanes<const D: usize, const GROW: bool>(
+    p: &[Particle<D>],
+    list: &[u32],
+    own: usize,
+    probe: &Probe<D>,
+) -> (f64, Option<usize>) {
+    let mut best = f64::INFINITY;
+    let mut at = None;
+    for (block, chunk) in list.chunks(LANES).enumerate() {
+        let m = chunk.len();
+        // Lanes past the list's end read the particle's own record; their
+        // times are discarded below.
+        let rec: [&Particle<D>; LANES] =
+            std::array::from_fn(|k| &p[if k < m { chunk[k] as usize } else { own }]);
+        let field = |f: &dyn Fn(&Particle<D>) -> f64| Lanes(rec.map(f));
+        let dtj = Lanes::splat(probe.now) - field(&|q| q.t);
+        let rj = field(&|q| q.r);
+        let mut r = [Lanes::splat(0.0); D];
+        let mut v = [Lanes::splat(0.0); D];
+        for d in 0..D {
+            let (xj, vj) = (field(&|q| q.x[d]), field(&|q| q.v[d]));
+            r[d] = Lanes::splat(probe.x[d]) - (xj + vj * dtj);
+            v[d] = Lanes::splat(probe.v[d]) - vj;
+            if probe.periodic[d] {
+                let (half, size) = (probe.half[d], probe.size[d]);
+                let up = r[d].map(|x| if x > half { size } else { 0.0 });
+                let down = r[d].map(|x| if x < -half { size } else { 0.0 });
+                r[d] = r[d] - up + down;
+            }
+        }
+        let dot =
+            |a: &[Lanes; D], b: &[Lanes; D]| (0..D).fold(Lanes::splat(0.0), |s, d| s + a[d] * b[d]);
+        let t = if GROW {
+            let sigma0 = rj + probe.r;
+            let (sigma, sdot) = (sigma0 * probe.g, sigma0 * probe.delta);
+            let b = dot(&r, &v) - sigma * sdot;
+            let a = dot(&v, &v) - sdot * sdot;
+            let c = dot(&r, &r) - sigma * sigma;
+            Lanes(std::array::from_fn(|k| {
+                growing_root(a.0[k], b.0[k], c.0[k])
+            }))
+        } else {
+            let sigma = rj + probe.r;
+            let c = dot(&r, &r) - sigma * sigma;
+            approach_root_lanes(dot(&v, &v), dot(&r, &v), c)
+        };
+        let mut t = t.0;
+        t[m..].fill(f64::INFINITY);
+        // The first lane of the smallest time (NaN is never earlier).
+        let (k, tmin) =
+            t.iter().enumerate().fold(
+                (0, f64::INFINITY),
+                |(k, b), (l, &x)| if x < b { (l, x) } else { (k, b) },
+            );
+        if tmin < best {
+            best = tmin;
+            at = Some(LANES * block + k);
+        }
+    }
+    (best, at)
+}
+
+/// [`approach_root`] lane by lane, with selects.
+#[inline(always)]
+fn approach_root_lanes(a: Lanes, b: Lanes, c: Lanes) -> Lanes {
+    let disc = b * b - a * c;
+    let root = c / (b.map(|x| -x) + disc.map(|x| x.max(0.0)).sqrt());
+    let t = Lanes(std::array::from_fn(|k| {
+        if c.0[k] <= 0.0 {
+            0.0
+        } else {
+            root.0[k]
+        }
+    }));
+    Lanes(std::array::from_fn(|k| {
+        if (b.0[k] < 0.0) & (disc.0[k] >= 0.0) {
+            t.0[k]
+        } else {
+            f64::INFINITY
+        }
+    }))
 }
 
 /// Whether the AVX-512 neighbour scan runs here (x86-64 with AVX-512F, and
@@ -518,6 +627,7 @@ impl<const D: usize> System<D> {
             list_factor: g_end,
             skin_cap,
             simd: simd_available::<D>(),
+            lanes: !simd_available::<D>(),
         };
         for i in 0..n {
             for d in 0..D {
@@ -992,7 +1102,7 @@ impl<const D: usize> System<D> {
         }
         #[cfg(target_arch = "x86_64")]
         if self.simd {
-            let probe = crate::avx512::Probe {
+            let probe = Probe {
                 x: xi,
                 v: vi,
                 r: ri,
@@ -1013,6 +1123,31 @@ impl<const D: usize> System<D> {
                     &probe,
                 )
             };
+            if let Some(k) = k {
+                if t < best {
+                    best = t;
+                    partner = self.nbr[base + k];
+                }
+            }
+            return self.schedule(i, best, ev, partner);
+        }
+        if self.lanes {
+            let (t, k) = earliest_lanes::<D, GROW>(
+                &self.p,
+                &self.nbr[base..base + nn],
+                i,
+                &Probe {
+                    x: xi,
+                    v: vi,
+                    r: ri,
+                    now,
+                    size,
+                    half,
+                    periodic,
+                    g,
+                    delta,
+                },
+            );
             if let Some(k) = k {
                 if t < best {
                     best = t;
@@ -1080,11 +1215,13 @@ impl<const D: usize> System<D> {
         self.queue.update(i, self.now + dt);
     }
 
-    /// Turns the AVX-512 neighbour scan off or back on (where the CPU has
-    /// it); results do not change, only speed. For tests and timings.
+    /// Turns the vector neighbour scans (AVX-512 where the CPU has it, else
+    /// eight neighbours at a time on [`Lanes`]) off or back on: results do
+    /// not change, only speed. For tests and timings.
     #[doc(hidden)]
     pub fn set_simd(&mut self, on: bool) {
         self.simd = on && simd_available::<D>();
+        self.lanes = on && !self.simd;
     }
 
     /// Adds to the lists of `i` (and symmetrically to theirs) every particle
