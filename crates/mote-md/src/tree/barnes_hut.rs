@@ -20,6 +20,7 @@
 //! count.
 
 use glam::DVec3;
+use mote_geom::lanes::{Lane, Lanes as Eight};
 use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
@@ -401,6 +402,15 @@ fn particles<const POT: bool>(x: DVec3, id: f64, list: &[ParticleBlock], eps2: f
     let mut az = [0.0; LANES];
     let mut ap = [0.0; LANES];
     for b in list {
+        // 1/r of the block's eight by multiplications (`Lane::rsqrt`), in
+        // a loop of its own so that both loops stay straight.
+        let mut r2 = [0.0; LANES];
+        for k in 0..LANES {
+            let (dx, dy, dz) = (b.x[k] - x.x, b.y[k] - x.y, b.z[k] - x.z);
+            let d2 = dx * dx + dy * dy + dz * dz + eps2;
+            r2[k] = if b.id[k] == id || d2 <= 0.0 { 1.0 } else { d2 };
+        }
+        let inv = Eight(r2).rsqrt().0;
         for k in 0..LANES {
             let dx = b.x[k] - x.x;
             let dy = b.y[k] - x.y;
@@ -408,8 +418,7 @@ fn particles<const POT: bool>(x: DVec3, id: f64, list: &[ParticleBlock], eps2: f
             let r2 = dx * dx + dy * dy + dz * dz + eps2;
             let skip = b.id[k] == id || r2 <= 0.0;
             let w = if skip { 0.0 } else { b.s[k] };
-            let r2 = if skip { 1.0 } else { r2 };
-            let inv = 1.0 / r2.sqrt();
+            let inv = inv[k];
             let winv = w * inv;
             let winv3 = winv * inv * inv;
             ax[k] += winv3 * dx;
@@ -433,6 +442,12 @@ fn cells<const POT: bool, const DIP: bool>(x: DVec3, list: &[CellBlock], eps2: f
     let mut ap = [0.0; LANES];
     for b in list {
         let c = &b.c;
+        let mut r2 = [0.0; LANES];
+        for (k, r2) in r2.iter_mut().enumerate() {
+            let (rx, ry, rz) = (x.x - c[0][k], x.y - c[1][k], x.z - c[2][k]);
+            *r2 = rx * rx + ry * ry + rz * rz + eps2;
+        }
+        let inv_r = Eight(r2).rsqrt().0;
         for k in 0..LANES {
             let rx = x.x - c[0][k];
             let ry = x.y - c[1][k];
@@ -445,8 +460,7 @@ fn cells<const POT: bool, const DIP: bool>(x: DVec3, list: &[CellBlock], eps2: f
             };
             let (qxx, qyy, qzz, qxy, qxz, qyz) =
                 (c[7][k], c[8][k], c[9][k], c[10][k], c[11][k], c[12][k]);
-            let r2 = rx * rx + ry * ry + rz * rz + eps2;
-            let inv = 1.0 / r2.sqrt();
+            let inv = inv_r[k];
             let inv2 = inv * inv;
             let inv3 = inv * inv2;
             let inv5 = inv3 * inv2;
