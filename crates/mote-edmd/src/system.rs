@@ -1100,58 +1100,37 @@ impl<const D: usize> System<D> {
         for k in 0..nn {
             prefetch(&self.p[self.nbr[base + k] as usize]);
         }
+        let probe = Probe {
+            x: xi,
+            v: vi,
+            r: ri,
+            now,
+            size,
+            half,
+            periodic,
+            g,
+            delta,
+        };
+        let list = &self.nbr[base..base + nn];
+        // The vector scans, where they run: AVX-512, else eight at a time
+        // on `Lanes`; the same bits as the scalar loop below.
+        let mut scanned = None;
         #[cfg(target_arch = "x86_64")]
         if self.simd {
-            let probe = Probe {
-                x: xi,
-                v: vi,
-                r: ri,
-                now,
-                size,
-                half,
-                periodic,
-                g,
-                delta,
-            };
             // SAFETY: `simd` is set only where AVX-512F exists; list entries
             // and `i` index `p`, whose records are 64-byte lines of 8 doubles.
-            let (t, k) = unsafe {
-                crate::avx512::earliest::<D, GROW>(
-                    self.p.as_ptr() as *const f64,
-                    i,
-                    &self.nbr[base..base + nn],
-                    &probe,
-                )
-            };
-            if let Some(k) = k {
-                if t < best {
-                    best = t;
-                    partner = self.nbr[base + k];
-                }
-            }
-            return self.schedule(i, best, ev, partner);
+            scanned = Some(unsafe {
+                crate::avx512::earliest::<D, GROW>(self.p.as_ptr() as *const f64, i, list, &probe)
+            });
         }
-        if self.lanes {
-            let (t, k) = earliest_lanes::<D, GROW>(
-                &self.p,
-                &self.nbr[base..base + nn],
-                i,
-                &Probe {
-                    x: xi,
-                    v: vi,
-                    r: ri,
-                    now,
-                    size,
-                    half,
-                    periodic,
-                    g,
-                    delta,
-                },
-            );
+        if scanned.is_none() && self.lanes {
+            scanned = Some(earliest_lanes::<D, GROW>(&self.p, list, i, &probe));
+        }
+        if let Some((t, k)) = scanned {
             if let Some(k) = k {
                 if t < best {
                     best = t;
-                    partner = self.nbr[base + k];
+                    partner = list[k];
                 }
             }
             return self.schedule(i, best, ev, partner);
