@@ -179,8 +179,6 @@ pub trait Lane:
     fn lane(self, l: usize) -> f64;
     /// `f` of every lane.
     fn map(self, f: impl Fn(f64) -> f64) -> Self;
-    /// `f` of lane l of `a` and of `b`, for every l.
-    fn from_pairs(a: Self, b: Self, f: impl Fn(f64, f64) -> f64) -> Self;
     /// √x, lane by lane.
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -243,10 +241,6 @@ macro_rules! lane_width {
             #[inline(always)]
             fn lane_sum(self) -> f64 {
                 self.0.iter().fold(0.0, |acc, x| acc + x)
-            }
-            #[inline(always)]
-            fn from_pairs(a: Self, b: Self, f: impl Fn(f64, f64) -> f64) -> Self {
-                a.zip(b, f)
             }
             #[inline(always)]
             fn where_positive(self, gate: Self) -> Self {
@@ -326,9 +320,9 @@ fn rsqrt_avx2<const Q: usize>(x: &mut [f64]) -> bool {
     }
 }
 
-/// The bits of 2^(3·1022/2)·(1 + μ) that make [`rsqrt_estimate`] a 3.4 %
-/// approximation of 1/√x over all normal x (Lomont 2003, "Fast inverse
-/// square root", the constant for doubles).
+/// Lomont's constant for doubles (C. Lomont 2003, "Fast inverse square
+/// root"): with it, [`rsqrt_estimate`] is within 3.4 % of 1/√x for every
+/// normal x.
 const RSQRT_MAGIC: u64 = 0x5fe6_eb50_c7b5_37a9;
 
 /// Newton–Raphson steps after [`rsqrt_estimate`]: a relative error e
@@ -349,7 +343,6 @@ const RSQRT_STEPS: usize = 4;
 )]
 #[inline(always)]
 fn rsqrt_portable<L: Lane>(x: L) -> Option<L> {
-    // `&`, not `&&`: every lane tested, no branch but the one.
     let mut normal = true;
     for l in 0..L::N {
         let x = x.lane(l);
