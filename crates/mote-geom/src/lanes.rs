@@ -184,12 +184,6 @@ pub trait Lane:
     fn sqrt(self) -> Self {
         self.map(f64::sqrt)
     }
-    /// Lanes `start..start + N` of `v`.
-    fn load_full(v: &[f64], start: usize) -> Self;
-    /// `out[start + l] -= lane l` for every lane.
-    fn subtract_full(self, out: &mut [f64], start: usize);
-    /// The lanes added in order 0, 1, …, N − 1.
-    fn lane_sum(self) -> f64;
     /// Lane l where lane l of `gate` is > 0, else 0 (a lane of a pair at
     /// no distance, or an empty lane, then adds nothing).
     fn where_positive(self, gate: Self) -> Self;
@@ -227,20 +221,6 @@ macro_rules! lane_width {
             #[inline(always)]
             fn map(self, f: impl Fn(f64) -> f64) -> Self {
                 $lanes(self.0.map(f))
-            }
-            #[inline(always)]
-            fn load_full(v: &[f64], start: usize) -> Self {
-                let lanes: &[f64; $n] = v[start..start + $n].try_into().unwrap();
-                $lanes(*lanes)
-            }
-            #[inline(always)]
-            fn subtract_full(self, out: &mut [f64], start: usize) {
-                let o: &mut [f64; $n] = (&mut out[start..start + $n]).try_into().unwrap();
-                *o = ($lanes(*o) - self).0;
-            }
-            #[inline(always)]
-            fn lane_sum(self) -> f64 {
-                self.0.iter().fold(0.0, |acc, x| acc + x)
             }
             #[inline(always)]
             fn where_positive(self, gate: Self) -> Self {

@@ -22,7 +22,6 @@ mod avx512;
 mod portable;
 
 use glam::DVec3;
-use mote_geom::lanes::Lanes;
 use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
@@ -222,17 +221,9 @@ impl DirectGravity {
                             Isa::Avx512 => unsafe {
                                 avx512::pairs2(i, jt * tile, j_end, soa, eps2, base, rx, ry, rz)
                             },
-                            Isa::Portable => portable::pairs2::<Lanes>(
-                                i,
-                                jt * tile,
-                                j_end,
-                                soa,
-                                eps2,
-                                base,
-                                rx,
-                                ry,
-                                rz,
-                            ),
+                            Isa::Portable => {
+                                portable::pairs2(i, jt * tile, j_end, soa, eps2, base, rx, ry, rz)
+                            }
                         };
                         row.own[i - base] += a0;
                         row.own[i + 1 - base] += a1;

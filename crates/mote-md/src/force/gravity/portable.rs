@@ -52,14 +52,14 @@ pub(super) fn pairs(
 }
 
 /// [`pairs`] for rows i and i + 1 over the same j range (its ends
-/// multiples of the lane count `L::N`): both rows' pulls returned,
-/// the reactions of row i then of row i + 1 subtracted per j block (every
-/// reaction the bits of two single rows). Two rows share each j block's
-/// loads and reaction stores, and give the out-of-order core two
-/// independent 1/√r² chains. Run on eight lanes ([`Lanes`]): on four
-/// ([`mote_geom::lanes::Four`]) the same kernel took twice as long.
+/// multiples of [`LANES`]): both rows' pulls returned, the reactions of row
+/// i then of row i + 1 subtracted per j block (every reaction the bits of
+/// two single rows). Two rows share each j block's loads and reaction
+/// stores, and give the out-of-order core two independent 1/√r² chains
+/// (on [`mote_geom::lanes::Four`], one AVX2 register, the same kernel took
+/// twice as long).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn pairs2<L: Lane>(
+pub(super) fn pairs2(
     i: usize,
     j_start: usize,
     j_end: usize,
@@ -70,23 +70,19 @@ pub(super) fn pairs2<L: Lane>(
     ry: &mut [f64],
     rz: &mut [f64],
 ) -> (DVec3, DVec3) {
-    debug_assert!(j_start.is_multiple_of(L::N) && j_end.is_multiple_of(L::N));
-    let row = |i: usize| [p.x[i], p.y[i], p.z[i]].map(L::splat);
+    debug_assert!(j_start.is_multiple_of(LANES) && j_end.is_multiple_of(LANES));
+    let row = |i: usize| [p.x[i], p.y[i], p.z[i]].map(Lanes::splat);
     let (r0, r1) = (row(i), row(i + 1));
     let (m0, m1) = (p.m[i], p.m[i + 1]);
-    let zero = L::splat(0.0);
+    let zero = Lanes::splat(0.0);
     let (mut a0, mut a1) = ([zero; 3], [zero; 3]);
-    for j in (j_start..j_end).step_by(L::N) {
-        let rj = [
-            L::load_full(p.x, j),
-            L::load_full(p.y, j),
-            L::load_full(p.z, j),
-        ];
-        let mj = L::load_full(p.m, j);
-        let d0: [L; 3] = std::array::from_fn(|c| rj[c] - r0[c]);
-        let d1: [L; 3] = std::array::from_fn(|c| rj[c] - r1[c]);
-        let r2_0 = d0[0] * d0[0] + d0[1] * d0[1] + d0[2] * d0[2] + L::splat(eps2);
-        let r2_1 = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2] + L::splat(eps2);
+    for j in (j_start..j_end).step_by(LANES) {
+        let rj = [p.x, p.y, p.z].map(|v| Lanes::load(v, j, LANES));
+        let mj = Lanes::load(p.m, j, LANES);
+        let d0: [Lanes; 3] = std::array::from_fn(|c| rj[c] - r0[c]);
+        let d1: [Lanes; 3] = std::array::from_fn(|c| rj[c] - r1[c]);
+        let r2_0 = d0[0] * d0[0] + d0[1] * d0[1] + d0[2] * d0[2] + eps2;
+        let r2_1 = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2] + eps2;
         let (y0, y1) = (r2_0.rsqrt(), r2_1.rsqrt());
         let s0 = (y0 * y0 * y0).where_positive(r2_0);
         let s1 = (y1 * y1 * y1).where_positive(r2_1);
@@ -96,11 +92,11 @@ pub(super) fn pairs2<L: Lane>(
         for (c, r) in [&mut *rx, &mut *ry, &mut *rz].into_iter().enumerate() {
             a0[c] = a0[c] + sj0 * d0[c];
             a1[c] = a1[c] + sj1 * d1[c];
-            (si0 * d0[c]).subtract_full(r, k);
-            (si1 * d1[c]).subtract_full(r, k);
+            (si0 * d0[c]).subtract_from(r, k, LANES);
+            (si1 * d1[c]).subtract_from(r, k, LANES);
         }
     }
-    let sum = |a: [L; 3]| DVec3::new(a[0].lane_sum(), a[1].lane_sum(), a[2].lane_sum());
+    let sum = |a: [Lanes; 3]| DVec3::new(a[0].sum(), a[1].sum(), a[2].sum());
     (sum(a0), sum(a1))
 }
 
