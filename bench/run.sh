@@ -67,5 +67,6 @@ row "granular settling (10^4 spheres, 6000 steps)" bench/settle.toml "LIGGGHTS" 
 row "granular settling, LAMMPS" bench/settle.toml "LAMMPS -sf opt" lmp -sf opt -in lammps.settle_si.in -log none
 row "trimers (4608 clumps)" bench/clump.toml "LAMMPS rigid/small -sf opt" lmp -sf opt -in lammps.clump.in -log none
 row "direct gravity (N = 4096, 50 steps)" bench/gravity-4096.toml ""
+row "Barnes–Hut gravity (N = 10^5, theta = 0.5, 10 steps)" bench/gravity-tree-100k.toml ""
 row "hard spheres (32000, eta = 0.45, t = 20)" bench/hard-spheres.toml ""
 row "all-pairs dipoles (1000, 50 steps)" bench/dipoles-1000.toml ""
