@@ -5,7 +5,7 @@
 //! energy minimum near zero pressure the backbone (rattlers removed) is
 //! isostatic, z → 2D = 6.
 
-use mote_md::soft_pack::{extrapolate, SoftPackSettings, SoftPacker};
+use mote_md::soft_pack::{extrapolate, FinishSettings, SoftPackSettings, SoftPacker};
 
 /// Mean contact number of the backbone: spheres with fewer than 4
 /// overlapping neighbours among the non-rattlers removed recursively;
@@ -49,9 +49,17 @@ fn monodisperse_soft_spheres_jam_isostatic_near_0_64() {
         tolerance: 0.02,
         max_steps: 400_000,
         seed: 3,
+        finish: Some(FinishSettings {
+            lowest: 1e-8,
+            force_tolerance: 1e-10,
+        }),
+        wall_clock: None,
     })
     .unwrap();
-    let stages = p.run(|_, _| {}, &|| false);
+    while !p.barostat_over() {
+        p.advance();
+    }
+    let stages = p.stages().to_vec();
     assert_eq!(stages.len(), 3);
     for s in &stages {
         assert!(s.converged, "{s:?}");
@@ -60,8 +68,8 @@ fn monodisperse_soft_spheres_jam_isostatic_near_0_64() {
     // Compressed soft spheres: φ rises with pressure, above φ_J.
     assert!(stages[0].phi > stages[1].phi && stages[1].phi > stages[2].phi);
     let (z_before, _) = backbone(&p);
-    let (_, slope) = extrapolate(&stages).unwrap();
-    let finish = p.jam(1e-8, slope, 1e-10, &|| false);
+    p.run(&|| false);
+    let finish = p.finish().to_vec();
     assert!(finish.len() >= 4, "{finish:?}");
     assert!(finish.iter().all(|s| s.converged && s.pressure > 0.0));
     let lowest = finish.last().unwrap();
@@ -82,4 +90,61 @@ fn monodisperse_soft_spheres_jam_isostatic_near_0_64() {
         "a stable backbone is not hypostatic: z = {z}"
     );
     assert!(rattlers < 60, "{rattlers} rattlers");
+}
+
+/// A packing resumed from a checkpoint of any chunk — holding a target,
+/// at the barostat's end, inside a minimisation, inside a decompression
+/// step — ends in the bits of the uninterrupted packing: the spheres, the
+/// box and every stage.
+#[test]
+fn a_soft_packing_resumed_from_any_chunk_ends_bit_for_bit() {
+    let settings = SoftPackSettings {
+        diameters: (0..128).map(|k| 0.8 + 0.4 * (k % 5) as f64 / 4.0).collect(),
+        phi_start: 0.3,
+        pressures: SoftPackSettings::decades(1e-4),
+        tolerance: 0.02,
+        max_steps: 400_000,
+        seed: 11,
+        finish: Some(FinishSettings {
+            lowest: 1e-6,
+            force_tolerance: 1e-10,
+        }),
+        wall_clock: None,
+    };
+    let mut whole = SoftPacker::new(settings.clone()).unwrap();
+    let mut saved = Vec::new();
+    let mut barostat_end = None;
+    while whole.stopped().is_none() {
+        let mut cp = mote_io::checkpoint::Checkpoint::default();
+        whole.save(&mut cp);
+        if barostat_end.is_none() && whole.barostat_over() {
+            barostat_end = Some(saved.len());
+        }
+        saved.push(cp);
+        whole.advance();
+    }
+    assert!(whole.finish().len() >= 3, "{:?}", whole.finish());
+    let ended = |p: &SoftPacker| {
+        format!(
+            "{:?} {:?} {:?} {:?} {} {}",
+            p.position,
+            p.boundary,
+            p.stages(),
+            p.finish(),
+            p.steps,
+            p.time
+        )
+    };
+    let k = saved.len();
+    let end = barostat_end.unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    for at in [k / 10, end / 2, end, (end + k) / 2, k - 2] {
+        // through the file, as a resumed run reads it
+        let path = dir.path().join("checkpoint.mote");
+        mote_io::checkpoint::write(&path, &saved[at]).unwrap();
+        let cp = mote_io::checkpoint::read(&path).unwrap();
+        let mut p = SoftPacker::resume(settings.clone(), &cp).unwrap();
+        p.run(&|| false);
+        assert_eq!(ended(&p), ended(&whole), "resumed at chunk {at} of {k}");
+    }
 }

@@ -725,6 +725,38 @@ fn a_killed_mote_pack_resumes_in_its_format() {
     }
 }
 
+/// A soft packing (`--method soft`) killed in its jamming finish resumes
+/// bit for bit: the checkpoint holds the minimiser's and the
+/// decompression's state, and the resumed run ends in the whole run's
+/// packing and table.
+#[test]
+fn a_killed_soft_packing_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--seed",
+        "3",
+        "pack",
+        "--method",
+        "soft",
+        "--n",
+        "300",
+        "--min-pressure",
+        "1e-7",
+        "--checkpoint-every",
+        "20",
+    ];
+    let (whole, at_kill, resumed) = whole_killed_resumed(dir.path(), &args, 300);
+    assert!(at_kill.step >= 300 && at_kill.step < whole.step);
+    assert!(
+        at_kill.carried.iter().any(|(k, _)| k == "barostat_end"),
+        "killed before the finish"
+    );
+    assert_eq!(resumed.step, whole.step);
+    for file in ["packing.xyz", "packing.csv"] {
+        assert!(same_file(dir.path(), file), "{file} differs");
+    }
+}
+
 /// The toning nip killed mid-way resumes bit for bit: the checkpoint holds
 /// the Coulomb forces held between Ewald sums (`every = 5`), and the resume
 /// trims nip.csv as well as observables.csv and the trajectory.

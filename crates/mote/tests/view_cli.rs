@@ -179,3 +179,22 @@ fn a_growing_packing_is_watched_live() {
     let frames = mote_io::xyz::read_frames(&out.join("packing.xyz")).unwrap();
     assert_eq!(frames.last().unwrap().positions.len(), 3000, "{err}");
 }
+
+/// A soft packing (the SP method's barostat) runs live too; Ctrl-C
+/// writes the spheres so far.
+#[test]
+fn a_soft_packing_is_watched_live() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("soft.toml");
+    std::fs::write(&scene, "seed = 2\n[packing]\nmethod = \"soft\"\nn = 2000\n").unwrap();
+    let out = dir.path().join("out");
+    let (child, port) = start(&[scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let meta = get(port, "/api/meta");
+    assert!(meta.contains("\"live\":true"), "{meta}");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let (status, err) = interrupt(child);
+    assert_eq!(status.code(), Some(0), "{err}");
+    assert!(err.contains("the packing so far is written"), "{err}");
+    let frames = mote_io::xyz::read_frames(&out.join("packing.xyz")).unwrap();
+    assert_eq!(frames.last().unwrap().positions.len(), 2000, "{err}");
+}

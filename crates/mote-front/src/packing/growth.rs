@@ -5,7 +5,7 @@
 //! itself (`packing.EXT`, `packing.pov`) is written when it ends, the
 //! windows (`packing.csv`) as they close.
 
-use std::cell::{Cell, OnceCell, RefCell};
+use std::cell::{Cell, OnceCell};
 use std::path::{Path, PathBuf};
 
 use mote_edmd::analyse::{bond_order, contacts, deepest_overlap};
@@ -16,7 +16,7 @@ use mote_io::csv::CsvWriter;
 use mote_io::trajectory::Format;
 use mote_run::{Observer, Propagator, Report};
 
-use super::{packing_file, write_pov, Naming, PackingSpec};
+use super::PackRun;
 use crate::error::{refuse, FrontError};
 use crate::runner::{Done, EngineRun, RunFiles, SampleOf};
 use crate::{Ending, Engine, Monitor};
@@ -31,27 +31,9 @@ pub struct Grown {
     pub pressure: f64,
 }
 
-/// A packing request's part of the one run.
+/// A packing by growth in the one run.
 pub(crate) struct Growth<'a, const D: usize> {
-    pub spec: &'a PackingSpec,
-    /// How messages name the request's keys.
-    pub naming: Naming<'a>,
-    /// The folder the request's relative paths (`start`, `dist = "file:"`)
-    /// resolve against.
-    pub base: PathBuf,
-    pub scene_seed: Option<u64>,
-    /// The seed was drawn for this run (no `--seed`).
-    pub seed_chosen: bool,
-    pub scene_dir: Option<String>,
-    /// The packing file's format.
-    pub format: Format,
-    /// Whether it writes files (`mote pack` without `-o` writes none).
-    pub writes: bool,
-    /// The opening line's start where the request is not a scene under
-    /// `mote run` (`mote pack: LABEL`).
-    pub headline: Option<String>,
-    /// The result, once the packing has ended.
-    pub grown: &'a RefCell<Option<Grown>>,
+    job: PackRun<'a>,
     /// Collisions when the run began (a resumed packing counts on).
     collisions0: Cell<u64>,
     /// The run's folder and provenance, once known: a signal that stops
@@ -61,52 +43,24 @@ pub(crate) struct Growth<'a, const D: usize> {
 }
 
 impl<'a, const D: usize> Growth<'a, D> {
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        spec: &'a PackingSpec,
-        naming: Naming<'a>,
-        base: PathBuf,
-        (scene_seed, seed_chosen): (Option<u64>, bool),
-        scene_dir: Option<String>,
-        format: Format,
-        writes: bool,
-        headline: Option<String>,
-        grown: &'a RefCell<Option<Grown>>,
-    ) -> Self {
+    pub fn new(job: PackRun<'a>) -> Self {
         Growth {
-            spec,
-            naming,
-            base,
-            scene_seed,
-            seed_chosen,
-            scene_dir,
-            format,
-            writes,
-            headline,
-            grown,
+            job,
             collisions0: Cell::new(0),
             files: OnceCell::new(),
         }
     }
 
-    /// Writes the packing (every number exact in the format of its
-    /// extension) and its POV-Ray scene into `dir`, when the run writes
-    /// files; returns the packing's path.
+    /// Writes the packing and its POV-Ray scene into `dir` (when the run
+    /// writes files); returns the packing's path.
     fn write(
         &self,
         state: &Packer<D>,
         dir: &Path,
         provenance: &mote_io::Provenance,
     ) -> Result<Option<PathBuf>, FrontError> {
-        if !self.writes {
-            return Ok(None);
-        }
         let frame = state.frame().expect("a packing shows itself");
-        let path = packing_file(dir, self.format);
-        use mote_io::trajectory::TrajectoryWriter;
-        TrajectoryWriter::create(&path, self.format, provenance.clone(), true)?.write(0, &frame)?;
-        write_pov(&frame, &dir.join("packing.pov"))?;
-        Ok(Some(path))
+        self.job.write(&frame, dir, provenance)
     }
 }
 
@@ -162,32 +116,32 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
     const NAME: &'static str = "packing";
 
     fn scene_seed(&self) -> Option<u64> {
-        self.scene_seed
+        self.job.scene_seed
     }
 
     fn seed_chosen(&self) -> bool {
-        self.seed_chosen
+        self.job.seed_chosen
     }
 
     fn scene_dir(&self) -> Option<&String> {
-        self.scene_dir.as_ref()
+        self.job.scene_dir.as_ref()
     }
 
     fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<Packer<D>, FrontError> {
         let g = &*self;
-        let settings = g.spec.settings(seed, g.naming, &g.base)?;
+        let settings = g.job.spec.settings(seed, g.job.naming, &g.job.base)?;
         let packer = match resumed {
             Some(cp) => PackState::from_checkpoint(cp, D)
                 .and_then(|state| Packer::<D>::resume(settings, &state)),
             None => Packer::<D>::new(settings),
         }
-        .map_err(|e| g.naming.locate(e.into()))?;
+        .map_err(|e| g.job.naming.locate(e.into()))?;
         g.collisions0.set(packer.collisions());
         Ok(packer)
     }
 
     fn writes_files(&self) -> bool {
-        self.writes
+        self.job.writes
     }
 
     fn observers(
@@ -198,20 +152,18 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
         let _ = self
             .files
             .set((files.dir.clone(), files.provenance.clone()));
-        if !self.writes {
+        if !self.job.writes {
             return Ok(Vec::new());
         }
-        let path = files.dir.join("packing.csv");
-        let csv = if files.append {
-            CsvWriter::append(&path, 4)?
-        } else {
-            CsvWriter::create(
-                &path,
-                &files.provenance,
-                &["collisions", "time", "phi", "pressure"].map(String::from),
-                &["", "", "", ""].map(String::from),
-            )?
-        };
+        let (csv, path) = self.job.table(
+            files,
+            &[
+                ("collisions", ""),
+                ("time", ""),
+                ("phi", ""),
+                ("pressure", ""),
+            ],
+        )?;
         Ok(vec![Box::new(WindowTable {
             csv,
             path,
@@ -226,10 +178,10 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
 
     fn checkpoint_options(&self, _: &Packer<D>) -> Vec<(String, String)> {
         // Relative paths of the request resolve from here on resume.
-        let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
+        let base = std::path::absolute(&self.job.base).unwrap_or_else(|_| self.job.base.clone());
         vec![
             ("base".into(), base.display().to_string()),
-            ("packing-format".into(), self.format.extension().into()),
+            ("packing-format".into(), self.job.format.extension().into()),
         ]
     }
 
@@ -239,7 +191,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
     }
 
     fn opening(&self, state: &Packer<D>) -> String {
-        let spec = self.spec;
+        let spec = self.job.spec;
         format!(
             "packing {} {} by growth (rate {}, {})",
             state.system().len(),
@@ -250,7 +202,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
     }
 
     fn headline(&self, label: &str, state: &Packer<D>) -> String {
-        match &self.headline {
+        match &self.job.headline {
             Some(h) => h.clone(),
             None => format!("mote run {label}: {}", self.opening(state)),
         }
@@ -261,7 +213,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
         let Some(s) = state.windows().last() else {
             return;
         };
-        let max_pressure = self.spec.max_pressure;
+        let max_pressure = self.job.spec.max_pressure;
         let f = (s.pressure.max(1.0).log10() / max_pressure.log10()).clamp(0.0, 1.0);
         monitor.progress(
             (f * 1000.0) as u64,
@@ -281,7 +233,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
                 }
                 Ok(interrupted(signal))
             }
-            e => Err(self.naming.locate(e.into())),
+            e => Err(self.job.naming.locate(e.into())),
         }
     }
 
@@ -298,7 +250,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
         _: &Report<SampleOf<Self>>,
         done: &Done,
     ) -> Result<Vec<String>, FrontError> {
-        let spec = self.spec;
+        let spec = self.job.spec;
         let sys = state.system();
         let simbox = *sys.simbox();
         let (pos, radii) = (sys.positions(), sys.radii());
@@ -358,7 +310,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
                 );
             }
         }
-        *self.grown.borrow_mut() = Some(Grown {
+        *self.job.grown.borrow_mut() = Some(Grown {
             frame: state.frame().expect("a packing shows itself"),
             phi,
             pressure,

@@ -17,13 +17,14 @@ use mote_io::trajectory::Format;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{refuse, FrontError};
-use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
+use crate::{Ending, Input, Monitor, Outcome, RunOptions};
 
 mod growth;
 mod soft;
 
 pub use growth::Grown;
 use growth::Growth;
+use soft::Soft;
 
 /// What a packing is asked for, by either way in. The keys of a scene's
 /// `[packing]` table; `mote pack` spells them as options (`--dim` for
@@ -364,47 +365,6 @@ pub fn named_like_a_file(dir: &Path) -> Option<mote_io::trajectory::Format> {
     mote_io::trajectory::Format::of_path(dir).filter(|_| !dir.is_dir())
 }
 
-/// Where a packing of the soft method goes: the packing file (the CSV and
-/// POV-Ray scene go beside it, same stem) and a picture.
-#[derive(Debug, Clone, Default)]
-struct PackFiles {
-    xyz: Option<PathBuf>,
-    picture: Option<PathBuf>,
-}
-
-impl PackFiles {
-    /// The packing's path without its extension (the CSV and POV-Ray
-    /// scene go beside it), its folder made; `None` without `xyz`.
-    fn stem(&self) -> Result<Option<Stem>, FrontError> {
-        if let Some(dir) = self.xyz.as_ref().and_then(|p| p.parent()) {
-            if !dir.as_os_str().is_empty() {
-                std::fs::create_dir_all(dir).map_err(|e| mote_io::IoError::os(dir, e))?;
-            }
-        }
-        Ok(self.xyz.as_ref().map(|p| Stem(p.with_extension(""))))
-    }
-
-    /// Writes the packing (the format follows the extension: .xyz, .dump,
-    /// .gsd, .pvd, in numbers that read back bit for bit), its POV-Ray
-    /// scene and the picture, as asked.
-    fn write(
-        &self,
-        frame: &mote_io::xyz::Frame,
-        provenance: &mote_io::Provenance,
-    ) -> Result<(), FrontError> {
-        if let Some(path) = &self.xyz {
-            use mote_io::trajectory::{Format, TrajectoryWriter};
-            let format: Format = crate::written_format(path)?;
-            TrajectoryWriter::create(path, format, provenance.clone(), true)?.write(0, frame)?;
-            write_pov(frame, &Stem(path.with_extension("")).with("pov"))?;
-        }
-        if let Some(p) = &self.picture {
-            mote_render::frame::picture(frame, p, 800, 800)?;
-        }
-        Ok(())
-    }
-}
-
 /// The options of `mote pack` as the text of a `[packing]` scene (what its
 /// checkpoints record as their input).
 pub fn spec_scene_text(spec: &PackingSpec, seed: u64) -> Result<String, FrontError> {
@@ -442,7 +402,8 @@ pub struct PackRequest {
     /// The packing file's format.
     pub format: Format,
     pub picture: Option<PathBuf>,
-    /// Pressure windows between checkpoints (needs `output`).
+    /// Steps between checkpoints (pressure windows; chunks of 100 steps
+    /// for the soft method), needs `output`.
     pub checkpoint_every: Option<u64>,
     pub seed: u64,
     /// The seed was drawn for this packing (none was given).
@@ -450,8 +411,8 @@ pub struct PackRequest {
 }
 
 /// Packs what `spec` asks for, as `mote pack` (`label`, the command as
-/// given) and Python do: growth through the one run (checkpoints, folder,
-/// progress as `mote run` has them), the soft method by its own loop; then
+/// given) and Python do, through the one run (checkpoints, folder,
+/// progress as `mote run` has them); then
 /// what it found (φ, pressure, why it stopped, contacts, order, overlaps).
 /// A signal stops it at the end of the current window with the packing so
 /// far written; an overlap beyond round-off is an error.
@@ -461,42 +422,8 @@ pub fn pack(
     request: &PackRequest,
     monitor: &mut dyn Monitor,
 ) -> Result<Packed, FrontError> {
-    let method = spec.method(Naming::Options)?;
+    spec.method(Naming::Options)?;
     let seed = request.seed;
-    if let Method::Soft { min_pressure } = method {
-        if request.checkpoint_every.is_some() {
-            refuse!(
-                "the soft method does not write checkpoints yet: run it without --checkpoint-every"
-            );
-        }
-        let settings = spec.settings(seed, Naming::Options, Path::new("."))?;
-        let text = spec_scene_text(spec, seed)?;
-        let _folder = match &request.output {
-            Some(dir) => Some(crate::lock::RunFolder::fresh(dir, label, &text)?),
-            None => None,
-        };
-        monitor.start(&format!(
-            "mote pack: {label}, {}",
-            crate::seed_phrase(seed, request.seed_chosen)
-        ));
-        let files = PackFiles {
-            xyz: request
-                .output
-                .as_deref()
-                .map(|dir| packing_file(dir, request.format)),
-            picture: request.picture.clone(),
-        };
-        let packed = soft::pack_soft(
-            settings,
-            min_pressure,
-            &files,
-            &crate::provenance(label, seed),
-            monitor,
-        )
-        .map_err(|e| Naming::Options.locate(e));
-        monitor.finish();
-        return packed;
-    }
     let input = Input {
         name: "pack".into(),
         label: label.to_string(),
@@ -511,7 +438,7 @@ pub fn pack(
         ..RunOptions::default()
     };
     let grown = RefCell::new(None);
-    let growth = Growing {
+    let packing = PackRun {
         spec,
         naming: Naming::Options,
         base: PathBuf::from("."),
@@ -523,7 +450,7 @@ pub fn pack(
         headline: Some(format!("mote pack: {label}")),
         grown: &grown,
     };
-    let outcome = growth.run(&input, &options, None, monitor);
+    let outcome = packing.run(&input, &options, None, monitor);
     monitor.finish();
     packed(outcome?, grown)
 }
@@ -545,22 +472,34 @@ fn packed(outcome: Outcome, grown: RefCell<Option<Grown>>) -> Result<Packed, Fro
     })
 }
 
-/// The parts of a [`Growth`] its dimension does not change.
-struct Growing<'a> {
-    spec: &'a PackingSpec,
-    naming: Naming<'a>,
-    base: PathBuf,
-    scene_seed: Option<u64>,
-    seed_chosen: bool,
-    scene_dir: Option<String>,
-    format: Format,
-    writes: bool,
-    headline: Option<String>,
-    grown: &'a RefCell<Option<Grown>>,
+/// A packing request on its way through the one run, whichever its
+/// method: what both ways in (`mote pack`, a `[packing]` scene, a resumed
+/// checkpoint) say of the files and messages.
+pub(crate) struct PackRun<'a> {
+    pub spec: &'a PackingSpec,
+    /// How messages name the request's keys.
+    pub naming: Naming<'a>,
+    /// The folder the request's relative paths (`start`, `dist = "file:"`)
+    /// resolve against.
+    pub base: PathBuf,
+    pub scene_seed: Option<u64>,
+    /// The seed was drawn for this run (no `--seed`).
+    pub seed_chosen: bool,
+    pub scene_dir: Option<String>,
+    /// The packing file's format.
+    pub format: Format,
+    /// Whether it writes files (`mote pack` without `-o` writes none).
+    pub writes: bool,
+    /// The opening line's start where the request is not a scene under
+    /// `mote run` (`mote pack: LABEL`).
+    pub headline: Option<String>,
+    /// The result, once the packing has ended.
+    pub grown: &'a RefCell<Option<Grown>>,
 }
 
-impl Growing<'_> {
-    /// The growth through the one run, in its dimension.
+impl PackRun<'_> {
+    /// The packing through the one run, by its method (growth in its
+    /// dimension, or the soft method).
     fn run(
         self,
         input: &Input,
@@ -568,49 +507,60 @@ impl Growing<'_> {
         resumed: Option<&Checkpoint>,
         monitor: &mut dyn Monitor,
     ) -> Result<Outcome, FrontError> {
-        macro_rules! growth {
-            ($d:literal) => {
-                crate::runner::run_engine(
-                    Growth::<$d>::new(
-                        self.spec,
-                        self.naming,
-                        self.base,
-                        (self.scene_seed, self.seed_chosen),
-                        self.scene_dir,
-                        self.format,
-                        self.writes,
-                        self.headline,
-                        self.grown,
-                    ),
-                    input,
-                    options,
-                    resumed,
-                    monitor,
-                )
+        macro_rules! through {
+            ($engine:expr) => {
+                crate::runner::run_engine($engine, input, options, resumed, monitor)
             };
         }
-        match self.spec.dimension {
-            2 => growth!(2),
-            3 => growth!(3),
-            d => refuse!(
+        match (self.spec.method(self.naming)?, self.spec.dimension) {
+            (Method::Soft { min_pressure }, _) => through!(Soft::new(self, min_pressure)),
+            (Method::Hard, 2) => through!(Growth::<2>::new(self)),
+            (Method::Hard, 3) => through!(Growth::<3>::new(self)),
+            (Method::Hard, d) => refuse!(
                 "{}: must be 2 or 3",
                 self.naming.said("dimension", d, false)
             ),
         }
     }
-}
 
-/// A packing's path without its extension, to which the CSV and POV-Ray
-/// files add theirs (`pack.0.1.xyz` gives `pack.0.1.csv`, where
-/// `with_extension` would give `pack.0.csv`).
-struct Stem(PathBuf);
+    /// Writes the packing `frame` (every number exact in the format of
+    /// its extension) and its POV-Ray scene into `dir`, when the run
+    /// writes files; returns the packing's path.
+    fn write(
+        &self,
+        frame: &mote_io::xyz::Frame,
+        dir: &Path,
+        provenance: &mote_io::Provenance,
+    ) -> Result<Option<PathBuf>, FrontError> {
+        if !self.writes {
+            return Ok(None);
+        }
+        let path = packing_file(dir, self.format);
+        use mote_io::trajectory::TrajectoryWriter;
+        TrajectoryWriter::create(&path, self.format, provenance.clone(), true)?.write(0, frame)?;
+        write_pov(frame, &dir.join("packing.pov"))?;
+        Ok(Some(path))
+    }
 
-impl Stem {
-    fn with(&self, extension: &str) -> PathBuf {
-        let mut name = self.0.clone().into_os_string();
-        name.push(".");
-        name.push(extension);
-        PathBuf::from(name)
+    /// The packing's table, `packing.csv` with its columns (name, unit),
+    /// started or (a resumed run) continued.
+    fn table(
+        &self,
+        files: &crate::runner::RunFiles,
+        columns: &[(&str, &str)],
+    ) -> Result<(mote_io::csv::CsvWriter, PathBuf), FrontError> {
+        use mote_io::csv::CsvWriter;
+        let path = files.dir.join("packing.csv");
+        let csv = if files.append {
+            CsvWriter::append(&path, columns.len())?
+        } else {
+            let (names, units): (Vec<String>, Vec<String>) = columns
+                .iter()
+                .map(|(name, unit)| (name.to_string(), unit.to_string()))
+                .unzip();
+            CsvWriter::create(&path, &files.provenance, &names, &units)?
+        };
+        Ok((csv, path))
     }
 }
 
@@ -695,19 +645,8 @@ pub(crate) fn run(
     }
     let spec = &scene.packing;
     let format = options.trajectory_format(Format::Xyz)?;
-    if let Method::Soft { min_pressure } = spec.method(Naming::Scene(source))? {
-        return run_soft(
-            input,
-            options,
-            &scene,
-            source,
-            min_pressure,
-            format,
-            monitor,
-        );
-    }
     let grown = RefCell::new(None);
-    Growing {
+    PackRun {
         spec,
         naming: Naming::Scene(source),
         base: input.folder(),
@@ -720,59 +659,6 @@ pub(crate) fn run(
         grown: &grown,
     }
     .run(input, options, None, monitor)
-}
-
-/// A `[packing]` scene of the soft method under `mote run`, by its own
-/// loop (no checkpoints, no live view yet).
-fn run_soft(
-    input: &Input,
-    options: &RunOptions,
-    scene: &PackingScene,
-    source: mote_io::Source,
-    min_pressure: f64,
-    format: Format,
-    monitor: &mut dyn Monitor,
-) -> Result<Outcome, FrontError> {
-    if options.checkpoint_every.is_some() {
-        refuse!(
-            "the soft method does not write checkpoints yet: run it without --checkpoint-every"
-        );
-    }
-    if options.live.is_set() {
-        refuse!("{}: the soft method runs its own loop and cannot be watched live yet: run it, then `mote view` its packing", input.label);
-    }
-    let dir = input.output_dir(options.output.as_ref(), scene.output.dir.as_ref());
-    let (seed, chosen) = crate::seed::resolve(options.seed, scene.seed);
-    let spec = &scene.packing;
-    let settings = spec.settings(seed, Naming::Scene(source), &input.folder())?;
-    let _folder = crate::lock::RunFolder::fresh(&dir, &input.label, &input.text)?;
-    monitor.start(&format!(
-        "mote run {}: packing {} spheres by the soft method (down to P/K = {min_pressure:e}, {}), {}, {}",
-        input.label,
-        spec.n,
-        spec.dist,
-        crate::seed_phrase(seed, chosen),
-        crate::threads_phrase()
-    ));
-    let files = PackFiles {
-        xyz: Some(packing_file(&dir, format)),
-        picture: options.picture.clone(),
-    };
-    let packed = soft::pack_soft(
-        settings,
-        min_pressure,
-        &files,
-        &crate::provenance(&input.label, seed),
-        monitor,
-    )
-    .map_err(|e| Naming::Scene(source).locate(e))?;
-    Ok(Outcome {
-        engine: Engine::Packing,
-        seed,
-        dir,
-        summary: packed.summary,
-        ending: packed.ending,
-    })
 }
 
 /// The packer a `[packing]` scene of the growth method starts (Python's
@@ -832,7 +718,7 @@ pub(crate) fn resume(
         .and_then(Format::named)
         .unwrap_or(Format::Xyz);
     let grown = RefCell::new(None);
-    Growing {
+    PackRun {
         spec: &scene.packing,
         naming: Naming::Scene(source),
         base: cp

@@ -1,170 +1,299 @@
-//! `mote pack --method soft`: the SP packing of [`mote_md::soft_pack`] run
-//! with the common packing files and summary.
+//! The soft method ([`mote_md::soft_pack`]: Hertzian spheres under a
+//! barostat, the target pressure stepped down a decade at a time, then the
+//! jamming finish) in the one run: one step is a chunk of the dynamics or
+//! the minimiser, so a soft packing has the checkpoints, progress, live
+//! view and folder rules of every other run. φ at each held pressure and
+//! each minimised state goes to `packing.csv` as it is reached; the
+//! spheres at the lowest pressure (overlapping by ~p^{2/3} of a diameter)
+//! are the packing, written at the end with their contacts, rattlers and
+//! backbone in the summary.
 
-use mote_edmd::analyse::{contacts, stable_contacts};
-use mote_edmd::pack::{PackSettings, SizeSpec};
+use std::cell::OnceCell;
+use std::path::PathBuf;
 
-use super::{PackFiles, Packed};
+use mote_edmd::analyse::{contacts, stable_contacts, Contacts};
+use mote_edmd::pack::SizeSpec;
+use mote_io::checkpoint::Checkpoint;
+use mote_io::csv::CsvWriter;
+use mote_io::trajectory::Format;
+use mote_md::boundary::Boundary;
+use mote_md::soft_pack::{
+    extrapolate, FinishSettings, SoftPackSettings, SoftPacker, SoftSample, SoftStop, Stage,
+};
+use mote_md::MdError;
+use mote_run::{Observer, Propagator, Report};
+
+use super::{Grown, PackRun};
 use crate::error::FrontError;
-use crate::{Ending, Monitor};
+use crate::runner::{Done, EngineRun, RunFiles, SampleOf};
+use crate::{Ending, Engine, Monitor};
 
-/// The SP method ([`mote_md::soft_pack`]): soft spheres compressed by a
-/// barostat, the target pressure stepped down a decade at a time to
-/// `min_pressure`; φ at each pressure goes to the CSV and the summary with
-/// the extrapolation to P = 0; the spheres at the lowest pressure are the
-/// packing (overlapping by ~p^{2/3} of a diameter), with their contacts,
-/// rattlers and backbone.
-pub(super) fn pack_soft(
-    settings: PackSettings,
+/// The barostat holds 10⁻² … 10⁻⁴ (the SP method proper); the jamming
+/// finish minimises its way on down to the lowest pressure asked.
+const LOWEST_HELD: f64 = 1e-4;
+/// The finish's minimisations end at this residual force, relative to the
+/// mean contact force.
+const FORCE_TOLERANCE: f64 = 1e-10;
+
+/// A packing by the soft method in the one run.
+pub(crate) struct Soft<'a> {
+    job: PackRun<'a>,
     min_pressure: f64,
-    files: &PackFiles,
-    provenance: &mote_io::Provenance,
-    monitor: &mut dyn Monitor,
-) -> Result<Packed, FrontError> {
-    use mote_md::soft_pack::{extrapolate, SoftPackSettings, SoftPacker};
-    use rand::SeedableRng;
-    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(settings.seed);
-    let n = match &settings.sizes {
-        SizeSpec::Radii(r) => r.len(),
-        _ => settings.n,
-    };
-    let diameters = settings.sizes.diameters(n, &mut rng);
-    // The barostat holds 1e-2 … 1e-4 (the SP method proper); the jamming
-    // finish minimises its way on down to `min_pressure`.
-    let pressures = SoftPackSettings::decades(min_pressure.max(1e-4));
-    let mut packer = SoftPacker::new(SoftPackSettings {
-        diameters,
-        phi_start: settings.phi_start,
-        pressures: pressures.clone(),
-        tolerance: 0.02,
-        max_steps: 2_000_000,
-        seed: settings.seed,
-    })
-    .map_err(FrontError::request)?;
-    let stem = files.stem()?;
-    let mut csv = match &stem {
-        Some(s) => Some(mote_io::csv::CsvWriter::create(
-            &s.with("csv"),
-            provenance,
-            &["steps", "phi", "pressure", "minimised"].map(String::from),
-            &["", "", "K", ""].map(String::from),
-        )?),
-        None => None,
-    };
-    let cpu0 = crate::cpu::cpu_seconds();
-    let began = std::time::Instant::now();
-    let wall_clock = settings.wall_clock;
-    let stop = || {
-        mote_io::system::stop_requested().is_some()
-            || wall_clock.is_some_and(|limit| began.elapsed() > limit)
-    };
-    let mut csv_err = None;
-    let finish_decades = (1e-4 / min_pressure).log10().ceil().max(0.0) as u64;
-    let total = pressures.len() as u64 + finish_decades;
-    let mut done = 0;
-    let stages = packer.run(
-        |s, p| {
-            done += 1;
-            if let Some(w) = csv.as_mut() {
-                if let Err(e) = w.row(&[p.steps as f64, s.phi, s.pressure, 0.0]) {
-                    csv_err.get_or_insert(e);
-                }
-            }
-            monitor.progress(
-                done,
-                total,
-                &format!("barostat: phi {:.5}  P/K {:.2e}", s.phi, s.pressure),
-            );
-        },
-        &stop,
-    );
-    let held = stages.len() == pressures.len();
-    let barostat_phi_j = extrapolate(&stages[stages.len().saturating_sub(3)..]);
-    let analyse = |p: &SoftPacker| {
-        let side = p.side();
-        let simbox = mote_edmd::system::SimBox::<3> {
-            size: [side; 3],
-            boundary: [mote_edmd::system::Boundary::Periodic; 3],
-        };
-        let lo = p.boundary.lo;
-        let pos: Vec<[f64; 3]> = p
-            .position
-            .iter()
-            .map(|r| (p.boundary.wrap(*r) - lo).to_array())
-            .collect();
-        let counted = contacts(&simbox, &pos, &p.radius, 0.0);
-        (simbox, pos, counted)
-    };
-    let before = analyse(&packer).2;
-    let barostat_steps = packer.steps;
-    let finish = if held && min_pressure < 1e-4 && !stop() {
-        let slope = barostat_phi_j.map_or(3.0, |(_, c)| c);
-        monitor.progress(done, total, "jamming finish: minimising");
-        packer.jam(min_pressure, slope, 1e-10, &stop)
-    } else {
-        Vec::new()
-    };
-    // the steps column counts every step so far, FIRE's included
-    let mut steps = barostat_steps;
-    for s in &finish {
-        steps += s.steps;
-        if let Some(w) = csv.as_mut() {
-            if let Err(e) = w.row(&[steps as f64, s.phi, s.pressure, 1.0]) {
-                csv_err.get_or_insert(e);
-            }
+    /// The run's folder and provenance, once known: a signal still gets
+    /// the packing so far written there.
+    files: OnceCell<(PathBuf, mote_io::Provenance)>,
+}
+
+impl<'a> Soft<'a> {
+    pub fn new(job: PackRun<'a>, min_pressure: f64) -> Self {
+        Soft {
+            job,
+            min_pressure,
+            files: OnceCell::new(),
         }
     }
-    monitor.finish();
-    if let Some(e) = csv_err {
-        return Err(e.into());
+
+    /// The packer's settings for the request's sizes and `seed`.
+    fn settings(&self, seed: u64) -> Result<SoftPackSettings, FrontError> {
+        use rand::SeedableRng;
+        let job = &self.job;
+        let settings = job.spec.settings(seed, job.naming, &job.base)?;
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(settings.seed);
+        let n = match &settings.sizes {
+            SizeSpec::Radii(r) => r.len(),
+            _ => settings.n,
+        };
+        Ok(SoftPackSettings {
+            diameters: settings.sizes.diameters(n, &mut rng),
+            phi_start: settings.phi_start,
+            pressures: SoftPackSettings::decades(self.min_pressure.max(LOWEST_HELD)),
+            tolerance: 0.02,
+            max_steps: 2_000_000,
+            seed: settings.seed,
+            finish: (self.min_pressure < LOWEST_HELD).then_some(FinishSettings {
+                lowest: self.min_pressure,
+                force_tolerance: FORCE_TOLERANCE,
+            }),
+            wall_clock: settings.wall_clock,
+        })
     }
-    let cpu = crate::cpu::cpu_seconds() - cpu0;
-    let (simbox, pos, counted) = analyse(&packer);
-    let side = packer.side();
-    let radii = packer.radius.clone();
-    let frame = mote_io::xyz::Frame {
-        time: packer.time,
-        cell: [[side, 0.0, 0.0], [0.0, side, 0.0], [0.0, 0.0, side]],
-        origin: [0.0; 3],
-        pbc: [true; 3],
-        species: vec!["H".to_string(); radii.len()],
-        positions: pos.clone(),
-        radii: radii.clone(),
-        ..mote_io::xyz::Frame::default()
+}
+
+/// Contacts (overlaps) of the spheres at `position` in `boundary`.
+fn overlaps(position: &[glam::DVec3], radius: &[f64], boundary: &Boundary) -> Contacts {
+    let (simbox, pos) = in_box(position, boundary);
+    contacts(&simbox, &pos, radius, 0.0)
+}
+
+/// The periodic box of the event-driven analysis, and the positions from
+/// its lower corner.
+fn in_box(
+    position: &[glam::DVec3],
+    boundary: &Boundary,
+) -> (mote_edmd::system::SimBox<3>, Vec<[f64; 3]>) {
+    let simbox = mote_edmd::system::SimBox::<3> {
+        size: boundary.lengths().to_array(),
+        boundary: [mote_edmd::system::Boundary::Periodic; 3],
     };
-    files.write(&frame, provenance)?;
-    let mut summary = vec![format!(
-        "{} spheres by the soft (SP) method: {} steps in {cpu:.2} s CPU. Barostat (Hertz, radial dissipation, Stokes friction): pressure P/K, packing fraction, overlapping neighbours per sphere:",
-        radii.len(),
-        packer.steps
-    )];
-    for s in &stages {
-        summary.push(format!(
-            "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} steps{})",
-            s.pressure,
-            s.phi,
-            s.z,
-            s.steps,
-            if s.converged {
-                ""
-            } else {
-                ", NOT held: step budget spent"
+    let lo = boundary.lo;
+    let pos = position
+        .iter()
+        .map(|r| (boundary.wrap(*r) - lo).to_array())
+        .collect();
+    (simbox, pos)
+}
+
+/// One row per held pressure and per minimised state: steps so far, φ,
+/// P/K, whether minimised.
+struct StageTable {
+    csv: CsvWriter,
+    path: PathBuf,
+    /// Stages already written (barostat, finish).
+    written: (usize, usize),
+}
+
+impl Observer<SoftPacker> for StageTable {
+    fn every(&self) -> u64 {
+        1
+    }
+
+    fn observe(&mut self, state: &SoftPacker, _: &SoftSample) -> Result<(), MdError> {
+        let (stages, finish) = (state.stages(), state.finish());
+        let row = |s: &Stage, minimised: f64| [s.total as f64, s.phi, s.pressure, minimised];
+        for s in &stages[self.written.0.min(stages.len())..] {
+            self.csv.row(&row(s, 0.0))?;
+        }
+        for s in &finish[self.written.1.min(finish.len())..] {
+            self.csv.row(&row(s, 1.0))?;
+        }
+        self.written = (stages.len(), finish.len());
+        Ok(())
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.path.display().to_string()]
+    }
+}
+
+fn interrupted(signal: i32) -> Ending {
+    Ending::Interrupted {
+        signal,
+        message: format!("interrupted by signal {signal}; the packing so far is written"),
+    }
+}
+
+/// φ_J of the last three states of `stages`, if there are two.
+fn phi_j(stages: &[Stage]) -> Option<f64> {
+    extrapolate(&stages[stages.len().saturating_sub(3)..]).map(|(phi_j, _)| phi_j)
+}
+
+impl EngineRun for Soft<'_> {
+    type State = SoftPacker;
+    const ENGINE: Engine = Engine::Packing;
+    const NAME: &'static str = "packing";
+
+    fn scene_seed(&self) -> Option<u64> {
+        self.job.scene_seed
+    }
+
+    fn seed_chosen(&self) -> bool {
+        self.job.seed_chosen
+    }
+
+    fn scene_dir(&self) -> Option<&String> {
+        self.job.scene_dir.as_ref()
+    }
+
+    fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<SoftPacker, FrontError> {
+        let settings = self.settings(seed)?;
+        match resumed {
+            Some(cp) => SoftPacker::resume(settings, cp),
+            None => SoftPacker::new(settings),
+        }
+        .map_err(FrontError::request)
+    }
+
+    fn writes_files(&self) -> bool {
+        self.job.writes
+    }
+
+    fn observers(
+        &self,
+        state: &SoftPacker,
+        files: &RunFiles,
+    ) -> Result<Vec<Box<dyn Observer<SoftPacker>>>, FrontError> {
+        let _ = self
+            .files
+            .set((files.dir.clone(), files.provenance.clone()));
+        if !self.job.writes {
+            return Ok(Vec::new());
+        }
+        let (csv, path) = self.job.table(
+            files,
+            &[
+                ("steps", ""),
+                ("phi", ""),
+                ("pressure", "K"),
+                ("minimised", ""),
+            ],
+        )?;
+        Ok(vec![Box::new(StageTable {
+            csv,
+            path,
+            written: (state.stages().len(), state.finish().len()),
+        })])
+    }
+
+    fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
+        // The packing is written once, at its end.
+        Ok(None)
+    }
+
+    fn checkpoint_options(&self, _: &SoftPacker) -> Vec<(String, String)> {
+        // Relative paths of the request resolve from here on resume.
+        let base = std::path::absolute(&self.job.base).unwrap_or_else(|_| self.job.base.clone());
+        vec![
+            ("base".into(), base.display().to_string()),
+            ("packing-format".into(), self.job.format.extension().into()),
+        ]
+    }
+
+    fn last_step(&self, _: &SoftPacker) -> u64 {
+        // It ends when the finish is over (or at a limit of its own).
+        u64::MAX
+    }
+
+    fn opening(&self, state: &SoftPacker) -> String {
+        format!(
+            "packing {} spheres by the soft method (down to P/K = {:e}, {})",
+            state.radius.len(),
+            self.min_pressure,
+            self.job.spec.dist
+        )
+    }
+
+    fn headline(&self, label: &str, state: &SoftPacker) -> String {
+        match &self.job.headline {
+            Some(h) => h.clone(),
+            None => format!("mote run {label}: {}", self.opening(state)),
+        }
+    }
+
+    fn progress(&self, state: &SoftPacker, _: u64, monitor: &mut dyn Monitor) {
+        let held = state.settings().pressures.len() as u64;
+        let finish_decades = (LOWEST_HELD / self.min_pressure).log10().ceil().max(0.0) as u64;
+        let (stages, finish) = (state.stages(), state.finish());
+        let done = (stages.len() + finish.len()) as u64;
+        let text = match (finish.last(), stages.last()) {
+            (Some(s), _) => format!("jamming finish: phi {:.5}  P/K {:.2e}", s.phi, s.pressure),
+            (None, Some(s)) => format!("barostat: phi {:.5}  P/K {:.2e}", s.phi, s.pressure),
+            (None, None) => format!("barostat: phi {:.5}", state.phi()),
+        };
+        monitor.progress(
+            done.min(held + finish_decades),
+            held + finish_decades,
+            &text,
+        );
+    }
+
+    fn ending(&self, state: &mut SoftPacker, e: MdError) -> Result<Ending, FrontError> {
+        match e {
+            MdError::Interrupted { signal, .. } => {
+                if let (Some((dir, provenance)), Some(frame)) = (self.files.get(), state.frame()) {
+                    self.job.write(&frame, dir, provenance)?;
+                }
+                Ok(interrupted(signal))
             }
-        ));
+            e => Err(self.job.naming.locate(e.into())),
+        }
     }
-    if let Some((phi_j, _)) = barostat_phi_j {
-        summary.push(format!(
-            "Barostat extrapolated to zero pressure (phi = phi_J + c p^(2/3)): phi_J = {phi_j:.6}; backbone z = {:.4} with {} rattlers (< 4 contacts, recursively).",
-            before.backbone_z,
-            before.rattlers()
-        ));
+
+    fn ended(&self, state: &SoftPacker) -> Ending {
+        match (state.stopped(), mote_io::system::stop_requested()) {
+            (Some(SoftStop::Interrupted), Some(signal)) => interrupted(signal),
+            _ => Ending::Finished,
+        }
     }
-    let finish_phi_j = extrapolate(&finish[finish.len().saturating_sub(3)..]);
-    if !finish.is_empty() {
-        summary.push("Jamming finish (FIRE energy minimisation at fixed box, decompressed a decade of pressure at a time):".into());
-        for s in &finish {
+
+    fn summary(
+        &self,
+        state: &SoftPacker,
+        _: &Report<SampleOf<Self>>,
+        done: &Done,
+    ) -> Result<Vec<String>, FrontError> {
+        let frame = state.frame().expect("a packing shows itself");
+        let written = self
+            .job
+            .write(&frame, &done.files.dir, &done.files.provenance)?;
+        let (stages, finish) = (state.stages(), state.finish());
+        let n = state.radius.len();
+        let mut summary = vec![format!(
+            "{n} spheres by the soft (SP) method: {} steps in {:.2} s CPU. Barostat (Hertz, radial dissipation, Stokes friction): pressure P/K, packing fraction, overlapping neighbours per sphere:",
+            state.steps, done.cpu
+        )];
+        for s in stages {
             summary.push(format!(
-                "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} FIRE steps{})",
+                "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} steps{})",
                 s.pressure,
                 s.phi,
                 s.z,
@@ -172,43 +301,71 @@ pub(super) fn pack_soft(
                 if s.converged {
                     ""
                 } else {
-                    ", residual force above 1e-10"
+                    ", NOT held: step budget spent"
                 }
             ));
         }
-        if let Some((phi_j, _)) = finish_phi_j {
+        let barostat_phi_j = phi_j(stages);
+        if let (Some(phi_j), Some((position, boundary))) = (barostat_phi_j, state.barostat_end()) {
+            let before = overlaps(position, &state.radius, boundary);
             summary.push(format!(
-                "Finish extrapolated to zero pressure: phi_J = {phi_j:.6}."
+                "Barostat extrapolated to zero pressure (phi = phi_J + c p^(2/3)): phi_J = {phi_j:.6}; backbone z = {:.4} with {} rattlers (< 4 contacts, recursively).",
+                before.backbone_z,
+                before.rattlers()
             ));
         }
+        let finish_phi_j = phi_j(finish);
+        if !finish.is_empty() {
+            summary.push("Jamming finish (FIRE energy minimisation at fixed box, decompressed a decade of pressure at a time):".into());
+            for s in finish {
+                summary.push(format!(
+                    "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} FIRE steps{})",
+                    s.pressure,
+                    s.phi,
+                    s.z,
+                    s.steps,
+                    if s.converged {
+                        ""
+                    } else {
+                        ", residual force above 1e-10"
+                    }
+                ));
+            }
+            if let Some(phi_j) = finish_phi_j {
+                summary.push(format!(
+                    "Finish extrapolated to zero pressure: phi_J = {phi_j:.6}."
+                ));
+            }
+        }
+        let (simbox, pos) = in_box(&state.position, &state.boundary);
+        let counted = contacts(&simbox, &pos, &state.radius, 0.0);
+        let strict = stable_contacts(&simbox, &pos, &state.radius, 0.0);
+        summary.push(format!(
+            "Contacts (overlaps) at the end: {} rattlers ({:.2} %) by count (< 4 contacts, recursively), backbone z = {:.4}; with force balance (contacts not all in one hemisphere): {} rattlers, backbone z = {:.4} (isostatic 6).",
+            counted.rattlers(),
+            100.0 * counted.rattlers() as f64 / n as f64,
+            counted.backbone_z,
+            strict.rattlers(),
+            strict.backbone_z
+        ));
+        match state.stopped() {
+            Some(SoftStop::WallClock) => {
+                summary.push("Stopped at the wall-clock limit (time_limit).".into())
+            }
+            Some(SoftStop::Interrupted) => {
+                summary.push("Stopped by a signal: the packing so far.".into())
+            }
+            _ => {}
+        }
+        if let Some(path) = written {
+            summary.push(format!("Wrote {} (+ .csv, .pov).", path.display()));
+        }
+        let last = finish.last().or(stages.last());
+        *self.job.grown.borrow_mut() = Some(Grown {
+            frame,
+            phi: finish_phi_j.or(barostat_phi_j).unwrap_or(state.phi()),
+            pressure: last.map_or(f64::NAN, |s| s.pressure),
+        });
+        Ok(summary)
     }
-    let strict = stable_contacts(&simbox, &pos, &radii, 0.0);
-    summary.push(format!(
-        "Contacts (overlaps) at the end: {} rattlers ({:.2} %) by count (< 4 contacts, recursively), backbone z = {:.4}; with force balance (contacts not all in one hemisphere): {} rattlers, backbone z = {:.4} (isostatic 6).",
-        counted.rattlers(),
-        100.0 * counted.rattlers() as f64 / radii.len() as f64,
-        counted.backbone_z,
-        strict.rattlers(),
-        strict.backbone_z
-    ));
-    if let Some(o) = &files.xyz {
-        summary.push(format!("Wrote {} (+ .csv, .pov).", o.display()));
-    }
-    let phi_j = finish_phi_j.or(barostat_phi_j).map(|(phi_j, _)| phi_j);
-    let last = finish.last().or(stages.last()).copied();
-    let interrupted = !held || (min_pressure < 1e-4 && finish.len() < 2);
-    let ending = match (interrupted, mote_io::system::stop_requested()) {
-        (true, Some(signal)) => Ending::Interrupted {
-            signal,
-            message: format!("interrupted by signal {signal}; the packing so far is written"),
-        },
-        _ => Ending::Finished,
-    };
-    Ok(Packed {
-        summary,
-        ending,
-        frame,
-        phi: phi_j.unwrap_or(packer.phi()),
-        pressure: last.map_or(f64::NAN, |s| s.pressure),
-    })
 }

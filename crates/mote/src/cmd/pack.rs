@@ -91,7 +91,7 @@ pub struct PackArgs {
     tol: Option<f64>,
     /// Folder for the packing, as `mote run -o` names a run's:
     /// DIR/packing.xyz (numbers exact; another format with --format),
-    /// DIR/packing.csv (φ and pressure per window), DIR/packing.pov
+    /// DIR/packing.csv (φ and pressure per window or stage), DIR/packing.pov
     /// (POV-Ray scene) and DIR/checkpoint.mote. Without it, nothing is written.
     #[arg(long, short = 'o', value_name = "DIR")]
     output: Option<PathBuf>,
@@ -102,8 +102,9 @@ pub struct PackArgs {
     /// Render the packing to this PNG.
     #[arg(long, value_name = "FILE.png")]
     picture: Option<PathBuf>,
-    /// Write DIR/checkpoint.mote every N pressure windows and when a
-    /// signal stops the run (needs -o); continue with
+    /// Write DIR/checkpoint.mote every N pressure windows (soft method:
+    /// chunks of 100 steps) and when a signal stops the run (needs -o);
+    /// continue with
     /// `mote run --resume DIR/checkpoint.mote`.
     #[arg(long, value_name = "N")]
     checkpoint_every: Option<u64>,
@@ -229,7 +230,7 @@ fn pack_cmd(global: &GlobalOpts, a: &PackArgs) -> anyhow::Result<ExitCode> {
         }
     };
     match (a.checkpoint_every, &a.output) {
-        (Some(0), _) => anyhow::bail!("--checkpoint-every 0: give a number of windows ≥ 1"),
+        (Some(0), _) => anyhow::bail!("--checkpoint-every 0: give a number of steps ≥ 1"),
         (Some(_), None) => {
             anyhow::bail!("--checkpoint-every needs -o DIR: the packing is resumed into it")
         }

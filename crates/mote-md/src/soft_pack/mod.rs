@@ -34,6 +34,15 @@
 //! sphere pair vibrates at ω_t = √(3/2 δ_t^{1/2}); τ = 1/ω_t (near critical
 //! damping), ε̇_max = 0.1 δ_t ω_t (the box closes a tenth of a typical
 //! overlap per vibration), and the step is 0.1/ω of the stiffest contact.
+//!
+//! The packing is stepped: [`SoftPacker::advance`] takes [`CHUNK`] steps of
+//! the dynamics or of the jamming finish's minimiser (fewer where a stage
+//! ends), so a packing runs through the one run every engine shares
+//! (`mote_run::Driver`: checkpoints, progress, the live viewer). Every
+//! loop variable is state the packer saves ([`SoftPacker::save`]), and a
+//! packing resumed from any chunk ends in the bits of the uninterrupted one.
+
+use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -41,6 +50,18 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 
 use crate::boundary::Boundary;
 use crate::neighbor::SizedList;
+
+mod barostat;
+mod finish;
+mod propagator;
+mod saved;
+
+use barostat::Hold;
+use finish::Jam;
+pub use propagator::SoftSample;
+
+/// Steps of the dynamics or the minimiser per [`SoftPacker::advance`].
+pub const CHUNK: u64 = 100;
 
 /// What a soft-sphere packing is asked for.
 #[derive(Debug, Clone)]
@@ -54,9 +75,24 @@ pub struct SoftPackSettings {
     pub pressures: Vec<f64>,
     /// A target is held when |P/P_t − 1| is below this.
     pub tolerance: f64,
-    /// Steps allowed per target pressure.
+    /// Steps allowed per target pressure (and per minimisation).
     pub max_steps: u64,
     pub seed: u64,
+    /// The jamming finish after the barostat ([`SoftPacker`]'s FIRE
+    /// minimisation and decompression); `None` ends with the barostat.
+    pub finish: Option<FinishSettings>,
+    /// Wall-clock time after which the packing stops where it is.
+    pub wall_clock: Option<Duration>,
+}
+
+/// How far the jamming finish goes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FinishSettings {
+    /// The lowest pressure P/K, below the barostat's last target.
+    pub lowest: f64,
+    /// A minimisation ends when the root-mean-square net force is below
+    /// this fraction of the mean contact force.
+    pub force_tolerance: f64,
 }
 
 impl SoftPackSettings {
@@ -74,9 +110,10 @@ impl SoftPackSettings {
     }
 }
 
-/// One held target pressure.
+/// One held target pressure, or one minimised state of the finish.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Stage {
+    /// The pressure aimed at (NaN for the finish's first minimisation).
     pub target: f64,
     /// Reduced pressure P/K at the end of the stage.
     pub pressure: f64,
@@ -84,13 +121,42 @@ pub struct Stage {
     pub phi: f64,
     /// Mean number of overlapping neighbours per sphere (all spheres).
     pub z: f64,
-    /// Steps taken in this stage.
+    /// Steps taken in this stage (the minimisation's, in the finish).
     pub steps: u64,
+    /// Steps of the whole packing when the stage ended.
+    pub total: u64,
     /// Simulated time at the end of the stage.
     pub time: f64,
-    /// Whether the pressure held and the motion died out within the
-    /// step budget.
+    /// Whether the pressure held and the motion died out within the step
+    /// budget (in the finish: whether the residual force came below the
+    /// tolerance).
     pub converged: bool,
+}
+
+/// Why a packing stopped stepping.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SoftStop {
+    /// Every stage held and the finish, if asked, went as far as it could.
+    Done,
+    /// The wall-clock limit passed.
+    WallClock,
+    /// A signal asked the run to stop.
+    Interrupted,
+}
+
+impl SoftStop {
+    const ALL: [SoftStop; 3] = [SoftStop::Done, SoftStop::WallClock, SoftStop::Interrupted];
+}
+
+/// Where the packing is.
+#[derive(Debug, Clone)]
+enum Phase {
+    /// Holding the barostat's target `settings.pressures[stage]`.
+    Hold(Hold),
+    /// The jamming finish.
+    Jam(Box<Jam>),
+    /// Nothing left to do.
+    Over,
 }
 
 /// The soft-sphere packing in progress.
@@ -99,24 +165,41 @@ pub struct SoftPacker {
     pub velocity: Vec<DVec3>,
     pub radius: Vec<f64>,
     mass: Vec<f64>,
+    /// Forces of the last pass over the pairs.
     force: Vec<DVec3>,
+    /// What that pass summed to.
+    sums: PairSums,
     pub boundary: Boundary,
     list: SizedList,
     /// The largest diameter.
     d_max: f64,
-    /// Positions and box side at the last list build.
+    /// Positions and box at the last list build (empty: build at the next
+    /// refresh).
     reference: Vec<DVec3>,
-    reference_side: f64,
+    reference_box: Boundary,
     pub time: f64,
+    /// Steps of the dynamics and the minimiser so far.
     pub steps: u64,
+    /// Calls of [`SoftPacker::advance`] so far.
+    chunks: u64,
     settings: SoftPackSettings,
     /// The residual force the last minimisation could reach at best
     /// (rounding of the positions), relative to the mean contact force.
     pub last_floor: f64,
+    phase: Phase,
+    /// The barostat's stages held so far.
+    stages: Vec<Stage>,
+    /// The finish's minimised states so far (the first is its start).
+    finish: Vec<Stage>,
+    /// Positions and box when the barostat ended (for what the packing
+    /// was before the finish).
+    barostat_end: Option<(Vec<DVec3>, Boundary)>,
+    stopped: Option<SoftStop>,
+    deadline: Option<Instant>,
 }
 
 /// Forces and what they sum to, from one pass over the pairs.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct PairSums {
     /// Σ F_ij · r_ij over overlapping pairs.
     virial: f64,
@@ -130,8 +213,22 @@ struct PairSums {
 }
 
 impl SoftPacker {
-    /// A random start at `phi_start` in a periodic cube.
+    /// A random start at `phi_start` in a periodic cube, ready to hold the
+    /// first target.
     pub fn new(settings: SoftPackSettings) -> Result<Self, String> {
+        let mut packer = Self::unstarted(settings)?;
+        let side = packer.side();
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(packer.settings.seed);
+        for r in &mut packer.position {
+            *r = DVec3::new(rng.gen(), rng.gen(), rng.gen()) * side;
+        }
+        packer.phase = Phase::Hold(Hold::begin(&mut packer, 0));
+        Ok(packer)
+    }
+
+    /// The spheres of `settings` at the origin of their box (checked),
+    /// before any stage.
+    fn unstarted(settings: SoftPackSettings) -> Result<Self, String> {
         let n = settings.diameters.len();
         if n < 2 {
             return Err(format!("need at least 2 spheres, got {n}"));
@@ -163,6 +260,21 @@ impl SoftPacker {
                 settings.tolerance
             ));
         }
+        if let Some(f) = settings.finish {
+            let last = settings.pressures[settings.pressures.len() - 1];
+            if !(f.lowest > 0.0 && f.lowest < last) {
+                return Err(format!(
+                    "the finish's lowest pressure {} must lie in (0, {last}), below the barostat's last target",
+                    f.lowest
+                ));
+            }
+            if !(f.force_tolerance > 0.0 && f.force_tolerance < 1.0) {
+                return Err(format!(
+                    "the finish's force tolerance {} must lie in (0, 1)",
+                    f.force_tolerance
+                ));
+            }
+        }
         let mean = settings.diameters.iter().sum::<f64>() / n as f64;
         let radius: Vec<f64> = settings.diameters.iter().map(|d| 0.5 * d / mean).collect();
         let volume: f64 = radius.iter().map(|a| sphere_volume(*a)).sum();
@@ -175,26 +287,30 @@ impl SoftPacker {
             ));
         }
         let boundary = Boundary::periodic(DVec3::ZERO, DVec3::splat(side));
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(settings.seed);
-        let position: Vec<DVec3> = (0..n)
-            .map(|_| DVec3::new(rng.gen(), rng.gen(), rng.gen()) * side)
-            .collect();
         let mass = radius.iter().map(|a| 2.0 * a).collect();
         Ok(Self {
+            position: vec![DVec3::ZERO; n],
             velocity: vec![DVec3::ZERO; n],
             force: vec![DVec3::ZERO; n],
+            sums: PairSums::default(),
             reference: Vec::new(),
-            reference_side: side,
+            reference_box: boundary,
             list: SizedList::new(skin),
             d_max,
-            position,
             radius,
             mass,
             boundary,
             time: 0.0,
             steps: 0,
+            chunks: 0,
+            deadline: settings.wall_clock.map(|d| Instant::now() + d),
             settings,
             last_floor: 0.0,
+            phase: Phase::Over,
+            stages: Vec::new(),
+            finish: Vec::new(),
+            barostat_end: None,
+            stopped: None,
         })
     }
 
@@ -208,12 +324,82 @@ impl SoftPacker {
         self.radius.iter().map(|a| sphere_volume(*a)).sum::<f64>() / self.boundary.volume()
     }
 
+    /// The settings the packer was made with.
+    pub fn settings(&self) -> &SoftPackSettings {
+        &self.settings
+    }
+
+    /// The barostat's stages held so far.
+    pub fn stages(&self) -> &[Stage] {
+        &self.stages
+    }
+
+    /// The jamming finish's minimised states so far (the first is the
+    /// barostat's end, minimised).
+    pub fn finish(&self) -> &[Stage] {
+        &self.finish
+    }
+
+    /// Whether the barostat's stages are over (the finish, if any, begun).
+    pub fn barostat_over(&self) -> bool {
+        !matches!(self.phase, Phase::Hold(_))
+    }
+
+    /// Positions and box when the barostat ended, once it has.
+    pub fn barostat_end(&self) -> Option<(&[DVec3], &Boundary)> {
+        self.barostat_end.as_ref().map(|(r, b)| (r.as_slice(), b))
+    }
+
+    /// Why the packing stopped, once it has.
+    pub fn stopped(&self) -> Option<SoftStop> {
+        self.stopped
+    }
+
+    /// Ends the packing where it is.
+    pub fn stop(&mut self, why: SoftStop) {
+        self.stopped.get_or_insert(why);
+    }
+
+    /// Takes up to [`CHUNK`] steps of the barostat or the finish (fewer
+    /// where a stage or minimisation ends there); nothing once stopped.
+    pub fn advance(&mut self) {
+        if self.stopped.is_some() {
+            return;
+        }
+        if self.deadline.is_some_and(|d| Instant::now() > d) {
+            self.stop(SoftStop::WallClock);
+            return;
+        }
+        self.chunks += 1;
+        self.phase = match std::mem::replace(&mut self.phase, Phase::Over) {
+            Phase::Hold(hold) => barostat::advance(self, hold),
+            Phase::Jam(jam) => finish::advance(self, *jam),
+            Phase::Over => Phase::Over,
+        };
+        if matches!(self.phase, Phase::Over) {
+            self.stop(SoftStop::Done);
+        }
+    }
+
+    /// Steps until the packing stops (or `stop` says so between chunks);
+    /// the barostat's stages and the finish's states are then
+    /// [`SoftPacker::stages`] and [`SoftPacker::finish`].
+    pub fn run(&mut self, stop: &dyn Fn() -> bool) {
+        while self.stopped.is_none() {
+            if stop() {
+                self.stop(SoftStop::Interrupted);
+                break;
+            }
+            self.advance();
+        }
+    }
+
     /// Rebuilds the neighbour list when a pair may have come within reach
     /// unseen: twice the largest non-affine displacement plus the affine
     /// shrink of the reach since the last build exceeds the skin.
     fn refresh_list(&mut self) {
         let side = self.side();
-        let scale = side / self.reference_side;
+        let scale = side / self.reference_box.lengths().x;
         let stale = self.reference.len() != self.position.len() || {
             let lo = self.boundary.lo;
             let mut worst = 0.0f64;
@@ -231,7 +417,7 @@ impl SoftPacker {
             self.list
                 .build(&self.position, &self.radius, &self.boundary);
             self.reference.clone_from(&self.position);
-            self.reference_side = side;
+            self.reference_box = self.boundary;
         }
     }
 
@@ -286,285 +472,26 @@ impl SoftPacker {
             }
             self.force[i] += fi;
         }
+        self.sums = sums;
         sums
     }
 
-    /// Holds each target pressure in turn; `on_stage` sees each stage as
-    /// it ends. `stop` is asked between chunks of steps; when it says so
-    /// the run ends with the stages so far.
-    pub fn run(
-        &mut self,
-        mut on_stage: impl FnMut(&Stage, &Self),
-        stop: &dyn Fn() -> bool,
-    ) -> Vec<Stage> {
-        let mut stages = Vec::new();
-        let targets = self.settings.pressures.clone();
-        for target in targets {
-            match self.hold(target, stop) {
-                Some(stage) => {
-                    on_stage(&stage, self);
-                    stages.push(stage);
-                }
-                None => break,
-            }
-        }
-        stages
-    }
-
-    /// Runs at target pressure `target` until it holds (or the step budget
-    /// is spent); `None` when `stop` ended it.
-    fn hold(&mut self, target: f64, stop: &dyn Fn() -> bool) -> Option<Stage> {
-        let n = self.position.len() as f64;
-        let overlap = target.powf(2.0 / 3.0);
-        let omega = (1.5 * overlap.sqrt()).sqrt();
-        let friction = omega; // ζ/m = 1/τ
-        let rate_max = 0.1 * overlap * omega;
-        let tol = self.settings.tolerance;
-        let mut steps = 0u64;
-        let mut held = 0u32;
-        self.refresh_list();
-        let mut sums = self.pair_forces();
-        let mut dt = 0.1 / sums.stiffest.max(omega * omega).sqrt();
-        let converged = loop {
-            // Velocity Verlet (the dissipative forces use the velocities
-            // of the previous half step), then the box follows the
-            // pressure.
-            for i in 0..self.position.len() {
-                let a = self.force[i] / self.mass[i] - friction * self.velocity[i];
-                self.velocity[i] += 0.5 * dt * a;
-                self.position[i] += dt * self.velocity[i];
-            }
-            self.refresh_list();
-            sums = self.pair_forces();
-            let mut kinetic2 = 0.0;
-            for i in 0..self.position.len() {
-                let a = self.force[i] / self.mass[i] - friction * self.velocity[i];
-                self.velocity[i] += 0.5 * dt * a;
-                kinetic2 += self.mass[i] * self.velocity[i].length_squared();
-            }
-            let volume = self.boundary.volume();
-            let pressure = (kinetic2 + sums.virial) / (3.0 * volume);
-            let strain_rate = rate_max * ((pressure - target) / target).clamp(-1.0, 1.0);
-            let scale = (strain_rate * dt).exp();
-            let lo = self.boundary.lo;
-            for r in &mut self.position {
-                *r = lo + (*r - lo) * scale;
-            }
-            self.boundary.hi = lo + (self.boundary.hi - lo) * scale;
-            self.time += dt;
-            self.steps += 1;
-            steps += 1;
-            if steps.is_multiple_of(100) {
-                dt = 0.1 / sums.stiffest.max(omega * omega).sqrt();
-                let still = 0.5 * kinetic2 < 1e-4 * sums.elastic;
-                if (pressure / target - 1.0).abs() < tol && still {
-                    held += 1;
-                    if held >= 3 {
-                        break true;
-                    }
-                } else {
-                    held = 0;
-                }
-                if steps >= self.settings.max_steps {
-                    break false;
-                }
-                if steps.is_multiple_of(1000) && stop() {
-                    return None;
-                }
-            }
-        };
-        let volume = self.boundary.volume();
-        let kinetic2: f64 = self
-            .velocity
+    /// Σ mᵢvᵢ², twice the kinetic energy.
+    fn kinetic2(&self) -> f64 {
+        self.velocity
             .iter()
             .zip(&self.mass)
             .map(|(v, m)| m * v.length_squared())
-            .sum();
-        Some(Stage {
-            target,
-            pressure: (kinetic2 + sums.virial) / (3.0 * volume),
-            phi: self.phi(),
-            z: 2.0 * sums.contacts as f64 / n,
-            steps,
-            time: self.time,
-            converged,
-        })
-    }
-}
-
-impl SoftPacker {
-    /// The jamming finish: the elastic energy minimised at fixed box by
-    /// FIRE (Bitzek et al., Phys. Rev. Lett. 97, 170201 (2006): damped
-    /// dynamics that mixes the velocity towards the force, v ← (1 − α) v +
-    /// α |v| F̂, speeding up while the power F·v stays positive and
-    /// stopping dead when it turns negative), until the root-mean-square
-    /// net force is below `ftol` times the mean contact force (or the floor
-    /// the rounding of the positions sets, ~50 ε L/δ̄; or when the best
-    /// residual has not halved in 20 000 steps). The barostat
-    /// leaves a residual imbalance of a few per cent; at a true minimum
-    /// the spheres that carry no load lose their contacts, so rattlers and
-    /// the backbone's contact number are those of a mechanically stable
-    /// packing. Returns the steps taken and the relative residual reached.
-    pub fn minimise(&mut self, ftol: f64, max_steps: u64) -> (u64, f64) {
-        // Bitzek et al.'s parameters.
-        const N_MIN: u64 = 5;
-        const F_INC: f64 = 1.1;
-        const F_DEC: f64 = 0.5;
-        const ALPHA0: f64 = 0.1;
-        const F_ALPHA: f64 = 0.99;
-        self.velocity.iter_mut().for_each(|v| *v = DVec3::ZERO);
-        self.refresh_list();
-        let mut sums = self.pair_forces_with(false);
-        let dt0 = 0.1 / sums.stiffest.max(1e-300).sqrt();
-        let (mut dt, mut alpha, mut since_negative) = (dt0, ALPHA0, 0u64);
-        let residual = |p: &Self, sums: &PairSums| -> f64 {
-            let rms = (p.force.iter().map(|f| f.length_squared()).sum::<f64>()
-                / p.force.len() as f64)
-                .sqrt();
-            // Mean contact force from the virial: Σ F·r ≈ F̄ d̄ per contact.
-            let mean_contact = sums.virial / sums.contacts.max(1) as f64;
-            rms / mean_contact.max(1e-300)
-        };
-        // Positions carry ~ε L of rounding, so overlaps δ carry a relative
-        // error ε L/δ and forces 3/2 of it: no minimiser gets below that.
-        let side = self.side();
-        let floor = |sums: &PairSums| {
-            let mean_overlap = sums.overlap / sums.contacts.max(1) as f64;
-            50.0 * f64::EPSILON * side / mean_overlap.max(1e-300)
-        };
-        let mut steps = 0;
-        let mut rel = residual(self, &sums);
-        // Stagnation: the best residual must halve every 20 000 steps.
-        let (mut best, mut best_at) = (rel, 0u64);
-        while rel > ftol.max(floor(&sums)) && steps < max_steps && steps - best_at < 20_000 {
-            let power: f64 = self
-                .force
-                .iter()
-                .zip(&self.velocity)
-                .map(|(f, v)| f.dot(*v))
-                .sum();
-            if power > 0.0 {
-                let (fnorm, vnorm) = (
-                    self.force
-                        .iter()
-                        .map(|f| f.length_squared())
-                        .sum::<f64>()
-                        .sqrt(),
-                    self.velocity
-                        .iter()
-                        .map(|v| v.length_squared())
-                        .sum::<f64>()
-                        .sqrt(),
-                );
-                for (v, f) in self.velocity.iter_mut().zip(&self.force) {
-                    *v = (1.0 - alpha) * *v + alpha * vnorm * *f / fnorm.max(1e-300);
-                }
-                since_negative += 1;
-                if since_negative > N_MIN {
-                    dt = (dt * F_INC).min(10.0 * dt0);
-                    alpha *= F_ALPHA;
-                }
-            } else {
-                self.velocity.iter_mut().for_each(|v| *v = DVec3::ZERO);
-                since_negative = 0;
-                dt *= F_DEC;
-                alpha = ALPHA0;
-            }
-            for i in 0..self.position.len() {
-                self.velocity[i] += 0.5 * dt * self.force[i] / self.mass[i];
-                self.position[i] += dt * self.velocity[i];
-            }
-            self.refresh_list();
-            sums = self.pair_forces_with(false);
-            for i in 0..self.position.len() {
-                self.velocity[i] += 0.5 * dt * self.force[i] / self.mass[i];
-            }
-            steps += 1;
-            self.steps += 1;
-            rel = residual(self, &sums);
-            if rel < 0.5 * best {
-                (best, best_at) = (rel, steps);
-            }
-        }
-        self.last_floor = floor(&sums);
-        self.velocity.iter_mut().for_each(|v| *v = DVec3::ZERO);
-        (steps, rel)
+            .sum()
     }
 
-    /// The jamming finish towards vanishing pressure: energy minimisation
-    /// at fixed box ([`SoftPacker::minimise`]) alternated with affine
-    /// decompression, a decade of pressure at a time down to `lowest`
-    /// (O'Hern et al. 2003's protocol). Near jamming φ is linear in
-    /// x = p^{2/3}, so each next φ comes from the line through the last two
-    /// minimised states (the first step takes the slope of the barostat's
-    /// stages, `slope`); a step that unjams the packing (pressure below a
-    /// thousandth of its aim) is undone and halved. Returns the minimised
-    /// states (pressure, φ, minimiser steps), the first being the start.
-    pub fn jam(
-        &mut self,
-        lowest: f64,
-        slope: f64,
-        ftol: f64,
-        stop: &dyn Fn() -> bool,
-    ) -> Vec<Stage> {
-        let mut out: Vec<Stage> = Vec::new();
-        let record = |p: &mut Self, steps: u64, target: f64, converged: bool| {
-            let (pressure, z) = p.at_rest();
-            Stage {
-                target,
-                pressure,
-                phi: p.phi(),
-                z,
-                steps,
-                time: p.time,
-                converged,
-            }
-        };
-        let (steps, rel) = self.minimise(ftol, self.settings.max_steps);
-        let first = record(self, steps, f64::NAN, rel <= ftol.max(self.last_floor));
-        if first.pressure <= 0.0 {
-            return vec![first];
+    /// Scales positions and box about the box's lower corner by `scale`.
+    fn dilate(&mut self, scale: f64) {
+        let lo = self.boundary.lo;
+        for r in &mut self.position {
+            *r = lo + (*r - lo) * scale;
         }
-        out.push(first);
-        let mut fails = 0;
-        while out.last().unwrap().pressure > 1.5 * lowest && fails < 20 && !stop() {
-            let last = *out.last().unwrap();
-            let aim = (last.pressure / 10.0).max(lowest);
-            let x = |p: f64| p.powf(2.0 / 3.0);
-            let c = match out.len() {
-                1 => slope,
-                k => {
-                    let prev = out[k - 2];
-                    (last.phi - prev.phi) / (x(last.pressure) - x(prev.pressure))
-                }
-            };
-            let c = if c.is_finite() && c > 0.0 { c } else { slope };
-            let mut dphi = c * (x(last.pressure) - x(aim)) / 2f64.powi(fails);
-            let saved = (self.position.clone(), self.boundary, self.reference_side);
-            loop {
-                let scale = (last.phi / (last.phi - dphi)).cbrt();
-                let lo = self.boundary.lo;
-                for r in &mut self.position {
-                    *r = lo + (*r - lo) * scale;
-                }
-                self.boundary.hi = lo + (self.boundary.hi - lo) * scale;
-                let (steps, rel) = self.minimise(ftol, self.settings.max_steps);
-                let now = record(self, steps, aim, rel <= ftol.max(self.last_floor));
-                if now.pressure > 1e-3 * aim {
-                    out.push(now);
-                    break;
-                }
-                // Unjammed: back to the saved state, half the step.
-                (self.position, self.boundary, self.reference_side) = saved.clone();
-                self.reference.clear();
-                dphi *= 0.5;
-                fails += 1;
-                if fails >= 20 || stop() {
-                    break;
-                }
-            }
-        }
-        out
+        self.boundary.hi = lo + (self.boundary.hi - lo) * scale;
     }
 
     /// The reduced pressure P/K of the spheres at rest (virial only).
@@ -626,6 +553,8 @@ mod tests {
             tolerance: 0.01,
             max_steps: 10,
             seed: 1,
+            finish: None,
+            wall_clock: None,
         })
         .unwrap();
         let side = p.side();
@@ -658,6 +587,7 @@ mod tests {
                 phi: 0.64 + 0.3 * p.powf(2.0 / 3.0),
                 z: 6.0,
                 steps: 0,
+                total: 0,
                 time: 0.0,
                 converged: true,
             })
