@@ -12,7 +12,9 @@ fi
 "$venv/bin/python" -m pip install --quiet "maturin>=1.5,<2" pytest numpy matplotlib
 # ASE for the interop test (skipped with a message where it cannot install).
 "$venv/bin/python" -m pip install --quiet ase >/dev/null 2>&1 || echo "note: could not install ase; its Python test will skip"
-(cd "$here" && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --quiet)
+# Optimised as the Rust tests are (Cargo.toml's `pytest` profile): a debug
+# build compiles as long and runs pytest several times slower.
+(cd "$here" && VIRTUAL_ENV="$venv" "$venv/bin/maturin" develop --quiet --profile pytest)
 cd "$here"
 "$venv/bin/python" -m pytest -q tests
 # The example scripts at small sizes: each must run and write its plot.

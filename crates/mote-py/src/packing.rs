@@ -1,6 +1,7 @@
 //! `mote.Packing`: a `[packing]` scene (hard disks or spheres grown by
-//! Lubachevsky–Stillinger) that Python steps a pressure window at a time
-//! and reads, through the front (`mote_front::stepper::Packing`): the
+//! Lubachevsky–Stillinger, or soft spheres pressed by the SP method) that
+//! Python steps a pressure window (or a chunk of the soft method) at a
+//! time and reads, through the front (`mote_front::stepper::Packing`): the
 //! packer and driver of `mote run`, so a packing grown from Python is
 //! `mote run`'s (and `mote.pack`'s) bit for bit.
 
@@ -43,7 +44,8 @@ impl Stepped for PackEngine {
         match (steps, until) {
             (_, Some(_)) => Err(PyValueError::new_err(
                 "a packing grows until it jams (or reaches the scene's phi, max_collisions or \
-                 time_limit), a pressure window at a time: give steps= (windows) or nothing",
+                 time_limit), a pressure window (or a soft packing's chunk) at a time: give \
+                 steps= or nothing",
             )),
             (Some(n), None) => Ok(n),
             (None, None) => Ok(u64::MAX),
@@ -64,7 +66,7 @@ impl Stepped for PackEngine {
 
     fn describe(&self) -> String {
         format!(
-            "{}: packing {} {}, window {}",
+            "{}: packing {} {}, step {}",
             self.label,
             self.len(),
             if self.run.dimension() == 2 {
@@ -89,17 +91,19 @@ impl Packing {
 }
 
 simulation_class! {
-    /// A packing grown from a `[packing]` scene (see docs/pack.md): hard
-    /// disks or spheres whose radii grow between exact collisions until
-    /// the packing jams (or reaches the scene's `phi`, `max_collisions` or
-    /// `time_limit`). A step is one pressure window; `run()` grows it to
-    /// its end, as `mote run` does.
+    /// A packing from a `[packing]` scene (see docs/pack.md): hard disks
+    /// or spheres whose radii grow between exact collisions until the
+    /// packing jams (or reaches the scene's `phi`, `max_collisions` or
+    /// `time_limit`), a step being one pressure window; or (`method =
+    /// "soft"`) soft spheres pressed by a barostat and minimised down to
+    /// `min_pressure`, a step being a chunk of 100 steps of the barostat
+    /// or the minimiser. `run()` takes it to its end, as `mote run` does.
     ///
     /// >>> p = mote.Packing.from_toml("[packing]\nn = 500\nmax_pressure = 1e8\n", seed=1)
     /// >>> p.run()
     /// >>> p.phi, p.stopped
     pub struct Packing(PackEngine);
-    unit = "pressure windows", every = 1;
+    unit = "packing steps", every = 1;
 
     /// A packing scene file or `example:NAME`; `seed` replaces the scene's.
     #[staticmethod]
@@ -142,7 +146,8 @@ simulation_class! {
     }
 
     /// Why the packing stopped ("pressure": jammed, "target-phi",
-    /// "collisions", "wall-clock"), or None while it grows.
+    /// "collisions", "wall-clock"; the soft method "done"), or None while
+    /// it goes on.
     #[getter]
     fn stopped(&self) -> PyResult<Option<&'static str>> {
         Ok(self.engine()?.run.stopped())
@@ -154,16 +159,17 @@ simulation_class! {
         Ok(self.engine()?.run.phi())
     }
 
-    /// The reduced pressure Z = PV/(NkT) of the last window (NaN before
-    /// the first).
+    /// The reduced pressure Z = PV/(NkT) of the last window, or (soft
+    /// method) P/K of the last held or minimised state; NaN before the
+    /// first.
     #[getter]
     fn pressure(&self) -> PyResult<f64> {
         Ok(self.engine()?.run.pressure())
     }
 
-    /// Pair collisions so far.
+    /// Pair collisions so far (None for the soft method).
     #[getter]
-    fn collisions(&self) -> PyResult<u64> {
+    fn collisions(&self) -> PyResult<Option<u64>> {
         Ok(self.engine()?.run.collisions())
     }
 
@@ -193,12 +199,14 @@ simulation_class! {
         Ok(PyArray1::from_vec(py, self.engine()?.run.frame().radii))
     }
 
-    /// The pressure windows closed so far, as `mote run`'s packing.csv
-    /// holds them: collisions, time, phi, pressure (numpy arrays).
+    /// The rows of `mote run`'s packing.csv so far (numpy arrays): the
+    /// pressure windows closed (collisions, time, phi, pressure), or the
+    /// soft method's held and minimised states (steps, phi, pressure,
+    /// minimised).
     #[getter]
     fn windows<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let rows = self.engine()?.run.windows();
-        crate::tools::columns(py, mote_front::stepper::Packing::WINDOW_COLUMNS, &rows)
+        let run = &self.engine()?.run;
+        crate::tools::columns(py, run.columns(), &run.windows())
     }
 
     /// Ray-traces the current state as `mote run --picture` does: a

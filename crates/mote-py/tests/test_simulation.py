@@ -430,7 +430,7 @@ def test_every_simulation_class_steps_and_runs_the_same_way():
         (mote.Simulation, "steps"),
         (mote.RigidSimulation, "steps"),
         (mote.HardSpheres, "output intervals"),
-        (mote.Packing, "pressure windows"),
+        (mote.Packing, "packing steps"),
     ]:
         assert cls.step.__text_signature__ == "($self, n=1)"
         run = cls.run.__text_signature__
@@ -487,8 +487,43 @@ def test_a_packing_refuses_what_it_cannot_do():
         mote.Packing.from_toml(HARD_SPHERES)
     with pytest.raises(ValueError, match="dimension = 4: must be 2 or 3"):
         mote.Packing.from_toml("[packing]\nn = 100\ndimension = 4\n")
-    with pytest.raises(ValueError, match="soft"):
-        mote.Packing.from_toml("[packing]\nn = 100\nmethod = \"soft\"\n")
+    with pytest.raises(ValueError, match="the soft method packs spheres"):
+        mote.Packing.from_toml("[packing]\nn = 100\nmethod = \"soft\"\ndimension = 2\n")
+
+
+SOFT = """seed = 3
+[packing]
+method = "soft"
+n = 200
+min_pressure = 1e-6
+"""
+
+
+def test_a_soft_packing_steps_from_python_with_the_bits_of_mote_run(tmp_path):
+    p = mote.Packing.from_toml(SOFT)
+    assert (len(p), p.dimension, p.seed, p.steps, p.stopped, p.collisions) == (200, 3, 3, 0, None, None)
+    assert np.isnan(p.pressure)
+    # A chunk of 100 steps of the barostat or minimiser a step, to the end
+    # of the jamming finish.
+    p.step(5)
+    assert p.steps == 5 and p.stopped is None
+    p.run()
+    assert p.stopped == "done"
+    w = p.windows
+    assert list(w) == ["steps", "phi", "pressure", "minimised"]
+    assert w["minimised"][-1] == 1.0 and w["pressure"][-1] == p.pressure < 1.5e-6
+    # mote run of the same scene, and mote.pack with the same settings as
+    # options: the same packing and table, bit for bit.
+    scene = tmp_path / "soft.toml"
+    scene.write_text(SOFT)
+    out = mote.run(scene, output=tmp_path / "run")
+    assert out["ending"] == "finished"
+    table = csv_columns(tmp_path / "run" / "packing.csv")
+    for name in w:
+        assert np.array_equal(table[name], w[name]), name
+    r = mote.pack(200, method="soft", min_pressure=1e-6, seed=3)
+    assert np.array_equal(r["positions"], p.positions)
+    assert np.array_equal(r["radii"], p.radii)
 
 
 def test_the_type_stubs_parse_and_name_every_class():

@@ -20,7 +20,7 @@ use crate::error::{refuse, FrontError};
 use crate::{Ending, Input, Monitor, Outcome, RunOptions};
 
 mod growth;
-mod soft;
+pub(crate) mod soft;
 
 pub use growth::Grown;
 use growth::Growth;
@@ -661,8 +661,7 @@ pub(crate) fn run(
     .run(input, options, None, monitor)
 }
 
-/// The packer a `[packing]` scene of the growth method starts (Python's
-/// `Packing`): the settings and seed `mote run` would use (`seed`
+/// The packer a `[packing]` scene starts (Python's `Packing`): the settings and seed `mote run` would use (`seed`
 /// replaces the scene's), in the scene's dimension; with the seed used.
 pub(crate) fn scene_packer(
     input: &Input,
@@ -673,14 +672,15 @@ pub(crate) fn scene_packer(
     let scene = PackingScene::parse(source)?;
     let spec = &scene.packing;
     let naming = Naming::Scene(source);
-    if let Method::Soft { .. } = spec.method(naming)? {
-        refuse!(
-            "{}:{}: [packing] method = \"soft\" runs its own loop and cannot be stepped yet: use mote.pack(method=\"soft\")",
-            source.file,
-            source.key_line("method")
-        );
-    }
     let (seed, _) = crate::seed::resolve(seed, scene.seed);
+    if let Method::Soft { min_pressure } = spec.method(naming)? {
+        let settings = soft::settings(spec, naming, &input.folder(), seed, min_pressure)?;
+        let packer = mote_md::soft_pack::SoftPacker::new(settings).map_err(FrontError::request)?;
+        return Ok((
+            crate::stepper::Packing::Soft(crate::stepper::Stepper::new(packer, 1)),
+            seed,
+        ));
+    }
     let settings = spec.settings(seed, naming, &input.folder())?;
     let locate = |e: mote_edmd::EdmdError| naming.locate(e.into());
     let packer = match spec.dimension {

@@ -9,7 +9,7 @@
 //! backbone in the summary.
 
 use std::cell::OnceCell;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use mote_edmd::analyse::{contacts, stable_contacts, Contacts};
 use mote_edmd::pack::SizeSpec;
@@ -23,7 +23,7 @@ use mote_md::soft_pack::{
 use mote_md::MdError;
 use mote_run::{Observer, Propagator, Report};
 
-use super::{Grown, PackRun};
+use super::{Grown, Naming, PackRun, PackingSpec};
 use crate::error::FrontError;
 use crate::runner::{Done, EngineRun, RunFiles, SampleOf};
 use crate::{Ending, Engine, Monitor};
@@ -52,31 +52,56 @@ impl<'a> Soft<'a> {
             files: OnceCell::new(),
         }
     }
+}
 
-    /// The packer's settings for the request's sizes and `seed`.
-    fn settings(&self, seed: u64) -> Result<SoftPackSettings, FrontError> {
-        use rand::SeedableRng;
-        let job = &self.job;
-        let settings = job.spec.settings(seed, job.naming, &job.base)?;
-        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(settings.seed);
-        let n = match &settings.sizes {
-            SizeSpec::Radii(r) => r.len(),
-            _ => settings.n,
-        };
-        Ok(SoftPackSettings {
-            diameters: settings.sizes.diameters(n, &mut rng),
-            phi_start: settings.phi_start,
-            pressures: SoftPackSettings::decades(self.min_pressure.max(LOWEST_HELD)),
-            tolerance: 0.02,
-            max_steps: 2_000_000,
-            seed: settings.seed,
-            finish: (self.min_pressure < LOWEST_HELD).then_some(FinishSettings {
-                lowest: self.min_pressure,
-                force_tolerance: FORCE_TOLERANCE,
-            }),
-            wall_clock: settings.wall_clock,
-        })
-    }
+/// The soft packer's settings for what `spec` asks (down to
+/// `min_pressure`) with `seed`; messages name keys as `naming` does,
+/// radii files resolve against `base`.
+pub(crate) fn settings(
+    spec: &PackingSpec,
+    naming: Naming,
+    base: &Path,
+    seed: u64,
+    min_pressure: f64,
+) -> Result<SoftPackSettings, FrontError> {
+    use rand::SeedableRng;
+    let settings = spec.settings(seed, naming, base)?;
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(settings.seed);
+    let n = match &settings.sizes {
+        SizeSpec::Radii(r) => r.len(),
+        _ => settings.n,
+    };
+    Ok(SoftPackSettings {
+        diameters: settings.sizes.diameters(n, &mut rng),
+        phi_start: settings.phi_start,
+        pressures: SoftPackSettings::decades(min_pressure.max(LOWEST_HELD)),
+        tolerance: 0.02,
+        max_steps: 2_000_000,
+        seed: settings.seed,
+        finish: (min_pressure < LOWEST_HELD).then_some(FinishSettings {
+            lowest: min_pressure,
+            force_tolerance: FORCE_TOLERANCE,
+        }),
+        wall_clock: settings.wall_clock,
+    })
+}
+
+/// The columns of a soft packing's table (packing.csv).
+pub(crate) const COLUMNS: [(&str, &str); 4] = [
+    ("steps", ""),
+    ("phi", ""),
+    ("pressure", "K"),
+    ("minimised", ""),
+];
+
+/// The rows of a soft packing's table so far, in [`COLUMNS`]: the steps
+/// so far, φ and P/K of each held pressure (minimised 0), then of each
+/// minimised state of the finish (1).
+pub(crate) fn rows(state: &SoftPacker) -> Vec<[f64; 4]> {
+    let row = |s: &Stage, minimised: f64| [s.total as f64, s.phi, s.pressure, minimised];
+    let held = state.stages().iter().map(|s| row(s, 0.0));
+    held.chain(state.finish().iter().map(|s| row(s, 1.0)))
+        .collect()
 }
 
 /// Contacts (overlaps) of the spheres at `position` in `boundary`.
@@ -103,13 +128,12 @@ fn in_box(
     (simbox, pos)
 }
 
-/// One row per held pressure and per minimised state: steps so far, φ,
-/// P/K, whether minimised.
+/// The table of [`rows`], a row as each state is reached.
 struct StageTable {
     csv: CsvWriter,
     path: PathBuf,
-    /// Stages already written (barostat, finish).
-    written: (usize, usize),
+    /// Rows already written.
+    written: usize,
 }
 
 impl Observer<SoftPacker> for StageTable {
@@ -118,15 +142,11 @@ impl Observer<SoftPacker> for StageTable {
     }
 
     fn observe(&mut self, state: &SoftPacker, _: &SoftSample) -> Result<(), MdError> {
-        let (stages, finish) = (state.stages(), state.finish());
-        let row = |s: &Stage, minimised: f64| [s.total as f64, s.phi, s.pressure, minimised];
-        for s in &stages[self.written.0.min(stages.len())..] {
-            self.csv.row(&row(s, 0.0))?;
+        let rows = rows(state);
+        for row in &rows[self.written.min(rows.len())..] {
+            self.csv.row(row)?;
         }
-        for s in &finish[self.written.1.min(finish.len())..] {
-            self.csv.row(&row(s, 1.0))?;
-        }
-        self.written = (stages.len(), finish.len());
+        self.written = rows.len();
         Ok(())
     }
 
@@ -165,7 +185,8 @@ impl EngineRun for Soft<'_> {
     }
 
     fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<SoftPacker, FrontError> {
-        let settings = self.settings(seed)?;
+        let job = &self.job;
+        let settings = settings(job.spec, job.naming, &job.base, seed, self.min_pressure)?;
         match resumed {
             Some(cp) => SoftPacker::resume(settings, cp),
             None => SoftPacker::new(settings),
@@ -188,19 +209,11 @@ impl EngineRun for Soft<'_> {
         if !self.job.writes {
             return Ok(Vec::new());
         }
-        let (csv, path) = self.job.table(
-            files,
-            &[
-                ("steps", ""),
-                ("phi", ""),
-                ("pressure", "K"),
-                ("minimised", ""),
-            ],
-        )?;
+        let (csv, path) = self.job.table(files, &COLUMNS)?;
         Ok(vec![Box::new(StageTable {
             csv,
             path,
-            written: (state.stages().len(), state.finish().len()),
+            written: rows(state).len(),
         })])
     }
 

@@ -146,6 +146,14 @@ pub enum SoftStop {
 
 impl SoftStop {
     const ALL: [SoftStop; 3] = [SoftStop::Done, SoftStop::WallClock, SoftStop::Interrupted];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            SoftStop::Done => "done",
+            SoftStop::WallClock => "wall-clock",
+            SoftStop::Interrupted => "interrupted",
+        }
+    }
 }
 
 /// Where the packing is.

@@ -149,10 +149,12 @@ class HardSpheres:
 
 
 class Packing:
-    """A packing grown from a ``[packing]`` scene (hard disks or spheres,
-    Lubachevsky–Stillinger): a step is one pressure window; ``run()`` grows
-    it until it stops by itself (jammed, the scene's ``phi``,
-    ``max_collisions`` or ``time_limit``), in ``mote run``'s bits."""
+    """A packing from a ``[packing]`` scene: hard disks or spheres grown by
+    Lubachevsky–Stillinger (a step is one pressure window), or soft spheres
+    pressed by the SP method (``method = "soft"``: a step is a chunk of 100
+    steps of the barostat or minimiser); ``run()`` takes it until it stops
+    by itself (jammed, the scene's ``phi``, ``max_collisions`` or
+    ``time_limit``, the soft method's finish), in ``mote run``'s bits."""
 
     @staticmethod
     def from_file(path: Path, seed: Optional[int] = None) -> "Packing": ...
@@ -161,7 +163,7 @@ class Packing:
     @staticmethod
     def from_dict(scene: dict[str, Any], seed: Optional[int] = None) -> "Packing": ...
     def step(self, n: int = 1) -> None:
-        """Advances n pressure windows (fewer where the packing stops)."""
+        """Advances n packing steps (fewer where the packing stops)."""
     def run(
         self,
         steps: Optional[int] = None,
@@ -170,7 +172,7 @@ class Packing:
         every: int = 1,
         progress: bool = False,
     ) -> None:
-        """steps windows, or until the packing stops; until is refused."""
+        """steps packing steps, or until the packing stops; until is refused."""
     @property
     def time(self) -> float: ...
     @property
@@ -181,14 +183,14 @@ class Packing:
     def seed(self) -> int: ...
     @property
     def stopped(self) -> Optional[str]:
-        """pressure (jammed), target-phi, collisions, wall-clock, or None while it grows."""
+        """pressure (jammed), target-phi, collisions, wall-clock (soft: done), or None while it goes on."""
     @property
     def phi(self) -> float: ...
     @property
     def pressure(self) -> float:
-        """Reduced pressure Z = PV/(NkT) of the last window."""
+        """Reduced pressure Z = PV/(NkT) of the last window (soft: P/K of the last held or minimised state)."""
     @property
-    def collisions(self) -> int: ...
+    def collisions(self) -> Optional[int]: ...
     @property
     def box(self) -> npt.NDArray[np.float64]: ...
     def __len__(self) -> int: ...
@@ -199,7 +201,7 @@ class Packing:
     def radii(self) -> npt.NDArray[np.float64]: ...
     @property
     def windows(self) -> dict[str, npt.NDArray[np.float64]]:
-        """collisions, time, phi, pressure of every window (mote run's packing.csv)."""
+        """mote run's packing.csv so far: collisions, time, phi, pressure of every window (soft: steps, phi, pressure, minimised)."""
     def render(self, output: Optional[Path] = None, width: int = 800, height: int = 600) -> Optional[npt.NDArray[np.uint8]]: ...
 
 
