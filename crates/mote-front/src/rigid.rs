@@ -63,6 +63,8 @@ fn run_with(
         format,
         nip: None,
         walls: Vec::new(),
+        pressure: false,
+        without_virial: Vec::new(),
         dt: 0.0,
         last_step: 0,
     };
@@ -79,6 +81,11 @@ struct RigidRun {
     nip: Option<(mote_nip::NipProbe, u64)>,
     /// The names of the walls, for the table's force columns.
     walls: Vec<String>,
+    /// Whether the table has the pressure (a periodic box, every
+    /// interaction with a virial).
+    pressure: bool,
+    /// In a periodic box, the interactions without a virial.
+    without_virial: Vec<String>,
     dt: f64,
     last_step: u64,
 }
@@ -140,6 +147,10 @@ impl EngineRun for RigidRun {
         if let Some(cp) = resumed {
             dynamics.resume(cp, label)?;
         }
+        if dynamics.pressure_volume().is_some() {
+            self.without_virial = dynamics.without_virial();
+            self.pressure = self.without_virial.is_empty();
+        }
         Ok(dynamics)
     }
 
@@ -154,6 +165,7 @@ impl EngineRun for RigidRun {
                 &files.provenance,
                 &self.walls,
                 self.scene.output.observables_every.max(1),
+                self.pressure,
                 files.append,
             )?)];
         if let Some((probe, every)) = &self.nip {
@@ -221,6 +233,20 @@ impl EngineRun for RigidRun {
         )];
         for (name, f) in &last.wall_forces {
             summary.push(format!("  force on wall {name}: {f}"));
+        }
+        if self.pressure {
+            summary.push(format!(
+                "Pressure {:.6e} at the end (molecular virial: the bodies' centres, as LAMMPS's fix rigid).",
+                last.pressure
+            ));
+        } else if !self.without_virial.is_empty() {
+            let n = self.without_virial.len();
+            summary.push(format!(
+                "No pressure column: {} do{} not compute {} virial.",
+                self.without_virial.join(", "),
+                if n == 1 { "es" } else { "" },
+                if n == 1 { "its" } else { "their" }
+            ));
         }
         summary.push(format!("Output: {}", report.files.join(", ")));
         Ok(summary)

@@ -213,3 +213,67 @@ fn settled_clumps_rest_on_the_walls() {
     );
     assert!(avg.x.abs() < 1e-3 * weight && avg.y.abs() < 1e-3 * weight);
 }
+
+/// Irregular clumps pressed into one another in a periodic cube, at rest:
+/// the molecular virial of the contacts gives the pressure of the
+/// body-centre ensemble, P = W/3V = −dU/dV for the Hertz energy U when
+/// the body centres and the box are scaled together (orientations kept;
+/// central differences, h = 1e-6). At rest nothing but the elastic law
+/// acts (no damping, no tangential history), so the two agree to the
+/// differences' error.
+#[test]
+fn the_contact_virial_is_the_volume_derivative_of_the_energy() {
+    let side = 6.4;
+    let gen = IrregularClump::default();
+    let templates: Vec<_> = (0..3)
+        .map(|k| BodyTemplate::new(&gen.generate(30 + k), Integration::default()).unwrap())
+        .collect();
+    let pressed = |scale: f64| {
+        let mut b = RigidBodies::new();
+        let kinds: Vec<u32> = templates
+            .iter()
+            .map(|t| b.add_template(t.clone()))
+            .collect();
+        let mut n = 0;
+        for ix in 0..4 {
+            for iy in 0..4 {
+                for iz in 0..4 {
+                    let x = DVec3::new(ix as f64, iy as f64, iz as f64) * (side / 4.0)
+                        + DVec3::new(0.1, 0.2, 0.3);
+                    let r =
+                        from_axis_angle(DVec3::new(1.0, n as f64, 2.0 - iz as f64), 0.7 * n as f64);
+                    b.push(kinds[n % 3], E::new(r, x * scale), DE::default());
+                    n += 1;
+                }
+            }
+        }
+        let box_ = mote_md::boundary::Boundary::periodic(DVec3::ZERO, DVec3::splat(side * scale));
+        let contacts =
+            RigidContacts::new(law(0.5, 0.5), law(0.5, 0.5), vec![], 0.3).with_boundary(box_);
+        (b, Frbi::new().with(contacts), box_.volume())
+    };
+    let (b, mut f, volume) = pressed(1.0);
+    let w = f.virial(&b).unwrap();
+    // Many contacts press: a force pass of a copy counts them.
+    let (mut moved, mut g, _) = pressed(1.0);
+    g.step(&mut moved, 1e-12);
+    let touching = g.find::<RigidContacts>().unwrap().contact_counts().0;
+    assert!(touching > 20, "only {touching} contacts");
+    let h = 1e-6;
+    let energy = |s: f64| {
+        let (b, mut f, v) = pressed(s);
+        (f.energies(&b).potential, v)
+    };
+    let ((u_plus, v_plus), (u_minus, v_minus)) = (energy(1.0 + h), energy(1.0 - h));
+    let from_energy = -(u_plus - u_minus) / (v_plus - v_minus);
+    let from_virial = w / (3.0 * volume);
+    println!("{touching} contacts: P = {from_virial:e} by the virial, {from_energy:e} by -dU/dV");
+    assert!(
+        from_virial > 0.0,
+        "pressed clumps push outwards: P = {from_virial}"
+    );
+    assert!(
+        (from_virial - from_energy).abs() < 1e-6 * from_virial,
+        "virial {from_virial:e} against -dU/dV {from_energy:e}"
+    );
+}

@@ -672,6 +672,64 @@ fn rigid_scene_runs_through_mote_run() {
         .all(|p| (p - px[0]).abs() <= 1e-12 * px[0].abs().max(1.0)));
 }
 
+/// Rigid bodies in a box periodic on every axis have a pressure column:
+/// at the start, before any contact, the ideal gas of the bodies' centres,
+/// P = Σ M V²/3V = 2 E_trans/3V; once they collide, the contacts' virial
+/// adds to it. A box with walls (not periodic everywhere) has no such
+/// column, and the scene's pressure tensor is refused saying what there is.
+#[test]
+fn rigid_bodies_in_a_periodic_box_have_a_pressure() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = "seed = 5\n[rigid]\n[[rigid.template]]\nname = \"trimer\"\ngenerator = \"trimer\"\nradius = 0.5\ndistance = 0.5\nmass = 1.5\n\
+        [[rigid.lattice]]\ntemplate = \"trimer\"\nn = 64\nlo = [0.0, 0.0, 0.0]\nhi = [8.0, 8.0, 8.0]\nspacing = 2.05\n\
+        random_orientation = true\nspeed = 2.0\n\
+        [box]\nlo = [0.0, 0.0, 0.0]\nhi = [8.2, 8.2, 8.2]\nperiodic = [true, true, true]\n\
+        [rigid.contacts]\nyoung = 136500.0\npoisson = 0.3\nrestitution = 0.9\nfriction = 0.3\n\
+        [run]\ndt = 5e-4\nsteps = 4000\n[output]\nobservables_every = 200\n";
+    std::fs::write(dir.path().join("gas.toml"), scene).unwrap();
+    let o = mote(&["run", "gas.toml", "-q", "-o", "gas"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = mote_io::csv::read_table(&dir.path().join("gas/observables.csv")).unwrap();
+    let p = t.column("pressure").unwrap();
+    let kt = t.column("translational_energy").unwrap();
+    let volume = 8.2f64.powi(3);
+    let ideal = 2.0 * kt[0] / (3.0 * volume);
+    assert!(
+        (p[0] - ideal).abs() <= 1e-12 * ideal,
+        "{} against {ideal}",
+        p[0]
+    );
+    assert!(p.iter().all(|p| p.is_finite() && *p > 0.0), "{p:?}");
+    // the contacts press: some row differs from its ideal gas
+    assert!(
+        (0..p.len()).any(|i| (p[i] - 2.0 * kt[i] / (3.0 * volume)).abs() > 1e-6 * p[i]),
+        "no contact ever pressed: {p:?}"
+    );
+    let settling = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/rigid/clumps-settling.toml"
+    );
+    let o = mote(
+        &["run", settling, "--steps", "2", "-q", "-o", "walls"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = mote_io::csv::read_table(&dir.path().join("walls/observables.csv")).unwrap();
+    assert!(t.column("pressure").is_none());
+    let tensor = scene.replace(
+        "observables_every = 200",
+        "observables_every = 200\npressure_tensor = true",
+    );
+    std::fs::write(dir.path().join("tensor.toml"), tensor).unwrap();
+    let o = mote(&["run", "tensor.toml", "-q", "-o", "tensor"], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("the scalar pressure only"),
+        "{}",
+        stderr(&o)
+    );
+}
+
 /// A granular run's observables give the kinetic energy whole and split
 /// into its translational part (what LAMMPS's `ke` reports) and its
 /// rotational part, with the units in the header, as rigid runs do.

@@ -31,8 +31,9 @@ use mote_geom::DE;
 
 use super::interaction::{BodyInteraction, BodyView};
 use crate::boundary::Boundary;
+use crate::boundary::MinimumImage;
 use crate::force::granular::history::{history_of, PAIR_ROW};
-use crate::force::granular::{ContactLaw, History, PairHistories, Wall, WallShape};
+use crate::force::granular::{ContactForce, ContactLaw, History, PairHistories, Wall, WallShape};
 use crate::neighbor::VerletList;
 
 /// Contact parameters shared by all sphere pairs and walls. Stiffness comes
@@ -157,6 +158,70 @@ impl ContactState {
     }
 }
 
+/// The sphere pairs of one evaluation: the bodies, the law and the
+/// search positions (wrapped on periodic axes, with the minimum image).
+struct SpherePairs<'a> {
+    view: &'a BodyView<'a>,
+    law: &'a ContactLaw,
+    pos: &'a [DVec3],
+    image: Option<&'a MinimumImage>,
+}
+
+impl SpherePairs<'_> {
+    /// The separation of the centres of spheres `s` and `o` (the minimum
+    /// image on periodic axes).
+    #[inline(always)]
+    fn separation(&self, s: usize, o: usize) -> DVec3 {
+        match self.image {
+            Some(image) => image.apply(self.pos[s] - self.pos[o]),
+            None => self.pos[s] - self.pos[o],
+        }
+    }
+
+    /// The contact between spheres `s` and `o` of different bodies (the
+    /// force on `s`, its torques), with `history` advanced by `dt`; `None`
+    /// when they do not touch (the history untouched).
+    #[inline(always)]
+    fn contact(&self, s: usize, o: usize, dt: f64, history: &mut History) -> Option<ContactForce> {
+        let (world, bodies) = (self.view.world, self.view.bodies);
+        let (centres, radius, body) = (
+            &world.sphere_centre,
+            &world.sphere_radius,
+            &world.sphere_body,
+        );
+        let d = self.separation(s, o);
+        let reach = radius[s] + radius[o];
+        let r2 = d.length_squared();
+        if r2 >= reach * reach {
+            return None;
+        }
+        let r = r2.sqrt();
+        let nrm = d / r;
+        let delta = reach - r;
+        let (arm_s, arm_o) = (radius[s] - 0.5 * delta, radius[o] - 0.5 * delta);
+        let (a, b) = (body[s] as usize, body[o] as usize);
+        let (xa, va, wa) = (bodies.position[a], bodies.velocity[a], bodies.omega[a]);
+        // The contact point relative to each body's centre (true centres,
+        // not wrapped: arms from the unwrapped spheres).
+        let ps = centres[s] - nrm * arm_s - xa;
+        let po = centres[o] + nrm * arm_o - bodies.position[b];
+        let v_rel = va + wa.cross(ps) - bodies.velocity[b] - bodies.omega[b].cross(po);
+        let (ma, mb) = (bodies.template(a).mass(), bodies.template(b).mass());
+        Some(self.law.force(
+            delta,
+            nrm,
+            v_rel,
+            wa - bodies.omega[b],
+            arm_s,
+            arm_o,
+            radius[s] * radius[o] / reach,
+            ma * mb / (ma + mb),
+            dt,
+            history,
+        ))
+    }
+}
+
 impl BodyInteraction for RigidContacts {
     fn name(&self) -> &str {
         "contacts"
@@ -180,55 +245,25 @@ impl BodyInteraction for RigidContacts {
         let mut contacts = 0usize;
 
         // Sphere–sphere.
+        let pairs = SpherePairs {
+            view,
+            law,
+            pos,
+            image: periodic.then_some(&image),
+        };
         for s in 0..n {
-            let range = st.pairs.range(s);
-            if range.is_empty() {
-                continue;
-            }
-            let (cs, rs) = (pos[s], radius[s]);
-            let a = body[s] as usize;
-            let (xa, va, wa) = (bodies.position[a], bodies.velocity[a], bodies.omega[a]);
-            let ma = bodies.template(a).mass();
+            let (a, range) = (body[s] as usize, st.pairs.range(s));
             for k in range {
                 let o = st.pairs.partner(k) as usize;
-                let d = if periodic {
-                    image.apply(cs - pos[o])
-                } else {
-                    cs - pos[o]
-                };
-                let reach = rs + radius[o];
-                let r2 = d.length_squared();
-                if r2 >= reach * reach {
+                let Some(c) = pairs.contact(s, o, dt, &mut st.pairs.history[k]) else {
                     if st.pairs.touching[k] {
                         st.pairs.touching[k] = false;
                         st.pairs.history[k] = History::default();
                     }
                     continue;
-                }
+                };
                 st.pairs.touching[k] = true;
-                let r = r2.sqrt();
-                let nrm = d / r;
-                let delta = reach - r;
-                let (arm_s, arm_o) = (rs - 0.5 * delta, radius[o] - 0.5 * delta);
                 let b = body[o] as usize;
-                // The contact point relative to each body's centre (true
-                // centres, not wrapped: arms from the unwrapped spheres).
-                let ps = centres[s] - nrm * arm_s - xa;
-                let po = centres[o] + nrm * arm_o - bodies.position[b];
-                let v_rel = va + wa.cross(ps) - bodies.velocity[b] - bodies.omega[b].cross(po);
-                let mb = bodies.template(b).mass();
-                let c = law.force(
-                    delta,
-                    nrm,
-                    v_rel,
-                    wa - bodies.omega[b],
-                    arm_s,
-                    arm_o,
-                    rs * radius[o] / reach,
-                    ma * mb / (ma + mb),
-                    dt,
-                    &mut st.pairs.history[k],
-                );
                 let wa_ = view.wrench_at(a, centres[s], c.force);
                 wrench[a].omega += wa_.omega + c.torque_i;
                 wrench[a].v += wa_.v;
@@ -355,6 +390,46 @@ impl BodyInteraction for RigidContacts {
             .map(|r| (r[0] as usize, history_of(&r[1..])))
             .collect();
         Ok(())
+    }
+
+    /// The molecular virial of the sphere–sphere contacts at the view's
+    /// placement: Σ (R_a − R_b)·F over touching pairs of spheres, R_a − R_b
+    /// the separation of their bodies' centres in the pair's minimum image
+    /// (the spheres' separation less the spheres' offsets from their
+    /// centres), F the law's whole force on sphere a — elastic, damping and
+    /// tangential from the carried history, which is not advanced (dt = 0).
+    /// Walls add nothing (LAMMPS's fix convention).
+    fn virial(&mut self, view: &BodyView<'_>, _t: f64) -> Option<f64> {
+        let world = view.world;
+        let (centres, radius, body) = (
+            &world.sphere_centre,
+            &world.sphere_radius,
+            &world.sphere_body,
+        );
+        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+        let st = &mut self.state;
+        st.refresh(centres, body, r_max, &self.boundary);
+        let image = self.boundary.image();
+        let periodic = self.boundary.is_periodic();
+        let pairs = SpherePairs {
+            view,
+            law: &self.law,
+            pos: if periodic { &st.wrapped } else { centres },
+            image: periodic.then_some(&image),
+        };
+        let offset = |s: usize| centres[s] - view.bodies.position[body[s] as usize];
+        let mut w = 0.0;
+        for s in 0..centres.len() {
+            for k in st.pairs.range(s) {
+                let o = st.pairs.partner(k) as usize;
+                let mut history = st.pairs.history[k];
+                if let Some(c) = pairs.contact(s, o, 0.0, &mut history) {
+                    let between = pairs.separation(s, o) - offset(s) + offset(o);
+                    w += between.dot(c.force);
+                }
+            }
+        }
+        Some(w)
     }
 
     /// The Hertz elastic energy Σ (8/15) E* √R* δ^{5/2} of all sphere pairs

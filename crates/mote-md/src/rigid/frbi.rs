@@ -390,6 +390,31 @@ impl Frbi {
         Ok(())
     }
 
+    /// The molecular virial of every interaction at the bodies' current
+    /// time ([`BodyInteraction::virial`]), or the names of those that
+    /// cannot give one.
+    pub fn virial(&mut self, b: &RigidBodies) -> Result<f64, Vec<String>> {
+        self.world.update(b);
+        let view = BodyView {
+            bodies: b,
+            world: &self.world,
+            dt: 0.0,
+        };
+        let mut total = 0.0;
+        let mut without = Vec::new();
+        for it in self.interactions.iter_mut() {
+            match it.virial(&view, b.time) {
+                Some(w) => total += w,
+                None => without.push(it.name().to_string()),
+            }
+        }
+        if without.is_empty() {
+            Ok(total)
+        } else {
+            Err(without)
+        }
+    }
+
     /// Kinetic and potential energy at the bodies' current time.
     pub fn energies(&mut self, b: &RigidBodies) -> BodyEnergies {
         self.world.update(b);

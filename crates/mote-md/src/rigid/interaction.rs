@@ -33,6 +33,18 @@ pub trait BodyInteraction: AsAny + Send + Sync {
     fn potential_energy(&mut self, _view: &BodyView<'_>, _t: f64) -> f64 {
         0.0
     }
+
+    /// The molecular virial W = Σ_{I<J} (R_I − R_J)·F_IJ of the forces at
+    /// the view's placement and time `t`: R the body centres (the minimum
+    /// image of the pair), F_IJ the force body J exerts on body I — the
+    /// body-centre virial of LAMMPS's `fix rigid`, so that a periodic box
+    /// has the pressure P = (Σ_I M_I V_I² + W)/3V. A force from outside
+    /// (gravity, fields, drag; walls, by LAMMPS's fix convention) adds 0;
+    /// `None` where the interaction cannot give it (the pressure column is
+    /// then left out, and the summary says why).
+    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+        None
+    }
     /// The live viewer's hooks (steering the fields it owns), where this
     /// interaction has any.
     fn viewer_mut(&mut self) -> Option<&mut dyn crate::viewer::ViewerHooks> {

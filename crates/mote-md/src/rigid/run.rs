@@ -35,6 +35,32 @@ impl RigidDynamics {
         self.frbi.find()
     }
 
+    /// The volume of the box a pressure is measured in: the contacts' box,
+    /// when it is periodic on every axis.
+    pub fn pressure_volume(&self) -> Option<f64> {
+        let b = &self.contacts()?.boundary;
+        (b.periodic.iter().all(|p| *p) && b.volume().is_finite()).then(|| b.volume())
+    }
+
+    /// The interactions that cannot give a virial (none: the pressure is
+    /// measured wherever the box is periodic).
+    pub fn without_virial(&mut self) -> Vec<String> {
+        self.frbi.virial(&self.bodies).err().unwrap_or_default()
+    }
+
+    /// The pressure P = (Σ_I M_I V_I² + W)/3V of the bodies in a periodic
+    /// box, W the molecular (body-centre) virial; NaN where it is not
+    /// measured (no periodic box, or an interaction without a virial).
+    fn pressure(&mut self, translational_energy: f64) -> f64 {
+        let Some(volume) = self.pressure_volume() else {
+            return f64::NAN;
+        };
+        match self.frbi.virial(&self.bodies) {
+            Ok(w) => (2.0 * translational_energy + w) / (3.0 * volume),
+            Err(_) => f64::NAN,
+        }
+    }
+
     /// The bodies and integrator a scene built, before their first step.
     pub fn new(built: super::scene::BuiltRigid) -> Self {
         RigidDynamics {
@@ -58,6 +84,9 @@ pub struct RigidSample {
     pub angular_momentum: DVec3,
     /// The force on each wall, F = −Σ (contact forces of the spheres on it).
     pub wall_forces: Vec<(String, DVec3)>,
+    /// The pressure in a periodic box ([`RigidDynamics::pressure_volume`]);
+    /// NaN where it is not measured.
+    pub pressure: f64,
 }
 
 impl RigidSample {
@@ -105,7 +134,9 @@ impl Propagator for RigidDynamics {
     fn measure(&mut self) -> RigidSample {
         let e = self.frbi.energies(&self.bodies);
         let o = self.bodies.observables();
+        let pressure = self.pressure(o.translational_energy);
         RigidSample {
+            pressure,
             time: self.bodies.time,
             translational_energy: o.translational_energy,
             rotational_energy: o.rotational_energy,
@@ -218,10 +249,12 @@ impl RigidDynamics {
 /// observables.csv of a rigid run: time, kinetic (translational +
 /// rotational), translational, rotational, potential and total energy,
 /// momentum, angular momentum (the first twelve of the point-particle
-/// engine's columns, by the same names), the force on each wall.
+/// engine's columns, by the same names), the pressure where it is measured
+/// (a periodic box), the force on each wall.
 pub struct RigidCsv {
     writer: CsvWriter,
     every: u64,
+    pressure: bool,
 }
 
 impl RigidCsv {
@@ -230,6 +263,7 @@ impl RigidCsv {
         provenance: &Provenance,
         walls: &[String],
         every: u64,
+        pressure: bool,
         append: bool,
     ) -> Result<Self, MdError> {
         // The point-particle engine's words for the same quantities.
@@ -237,6 +271,9 @@ impl RigidCsv {
             .iter()
             .map(|s| s.to_string())
             .collect();
+        if pressure {
+            columns.push("pressure".into());
+        }
         for w in walls {
             for a in ["x", "y", "z"] {
                 columns.push(format!("{w}.f{a}"));
@@ -247,7 +284,11 @@ impl RigidCsv {
         } else {
             CsvWriter::create(path, provenance, &columns, &[])?
         };
-        Ok(RigidCsv { writer, every })
+        Ok(RigidCsv {
+            writer,
+            every,
+            pressure,
+        })
     }
 }
 
@@ -267,6 +308,9 @@ impl Observer<RigidDynamics> for RigidCsv {
         ];
         row.extend(s.linear_momentum.to_array());
         row.extend(s.angular_momentum.to_array());
+        if self.pressure {
+            row.push(s.pressure);
+        }
         for (_, f) in &s.wall_forces {
             row.extend(f.to_array());
         }

@@ -505,7 +505,7 @@ impl RigidScene {
         if let Some(p) = &self.output.pressure_tensor {
             return Err(err(
                 p.span(),
-                "[output] pressure_tensor: the rigid engine does not measure pressure yet".into(),
+                "[output] pressure_tensor: the rigid engine measures the scalar pressure only (observables.csv's pressure column, in a periodic box)".into(),
             ));
         }
         let mut frbi = Frbi::new();

@@ -100,6 +100,11 @@ impl BodyInteraction for ExternalFields {
         "external fields"
     }
 
+    /// A force from outside: no virial (LAMMPS's fix convention).
+    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+        Some(0.0)
+    }
+
     fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
         let (e, b) = (self.electric.at(t), self.magnetic.at(t));
         let bodies = view.bodies;
@@ -164,6 +169,11 @@ impl BodyInteraction for Gravity {
         "gravity"
     }
 
+    /// A force from outside: no virial (LAMMPS's fix convention).
+    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+        Some(0.0)
+    }
+
     fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
         for (i, w) in wrench.iter_mut().enumerate() {
             w.v += view.bodies.template(i).mass() * self.g;
@@ -221,6 +231,11 @@ impl BodyInteraction for AirDrag {
 
     fn name(&self) -> &str {
         "air drag"
+    }
+
+    /// A force from outside: no virial (LAMMPS's fix convention).
+    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+        Some(0.0)
     }
 
     fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
