@@ -655,11 +655,13 @@ impl Scene {
             self.equilibrate = self.run.equilibrate.unwrap_or(0.0);
             self.time = match self.run.until {
                 Some(until) => {
-                    if !(until >= self.equilibrate && until.is_finite()) {
+                    // After the equilibration, as `--until` must be: the
+                    // same value is taken or refused by either way in.
+                    if !(until > self.equilibrate && until.is_finite()) {
                         return Err(err(
                             "until",
                             format!(
-                                "[run] until = {until} must be a time at or after equilibrate = {}",
+                                "[run] until = {until} must be a time after equilibrate = {}",
                                 self.equilibrate
                             ),
                         ));
@@ -1203,7 +1205,7 @@ mod tests {
         let e = Scene::parse(&text, "early.toml").unwrap_err().to_string();
         assert_eq!(
             e,
-            "early.toml:6: [run] until = 1 must be a time at or after equilibrate = 2"
+            "early.toml:6: [run] until = 1 must be a time after equilibrate = 2"
         );
     }
 }
