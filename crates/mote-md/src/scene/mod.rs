@@ -137,11 +137,34 @@ pub struct Build<'a> {
     pub forces: ForceField,
 }
 
-/// A table of the scene that adds interactions to the run.
-pub trait Section {
-    /// Checks the table and pushes its interactions onto `b.forces`; `span`
-    /// locates the table in errors, `scene` gives the other tables.
-    fn add_to(&self, span: Range<usize>, scene: &Scene, b: &mut Build) -> Result<(), ParseError>;
+/// The kind of scene a table belongs to: the scene as parsed and what its
+/// tables build together. Point particles ([`Points`]: [`Scene`] and
+/// [`Build`]) and rigid clumps (`rigid::scene::Clumps`) have their tables
+/// as [`Section`]s of their kind.
+pub trait Kind {
+    type Scene;
+    type Build<'a>;
+}
+
+/// Point-particle scenes.
+pub struct Points;
+
+impl Kind for Points {
+    type Scene = Scene;
+    type Build<'a> = Build<'a>;
+}
+
+/// A table of a scene that adds to what the scene builds (interactions,
+/// particles or bodies), in the order the scene's build calls it.
+pub trait Section<K: Kind = Points> {
+    /// Checks the table and adds what it makes to `b`; `span` locates the
+    /// table in errors, `scene` gives the other tables.
+    fn add_to(
+        &self,
+        span: Range<usize>,
+        scene: &K::Scene,
+        b: &mut K::Build<'_>,
+    ) -> Result<(), ParseError>;
 }
 
 /// Adds an optional table's interactions.

@@ -1,0 +1,519 @@
+//! The `[rigid]` scene format: templates of overlapping spheres, bodies
+//! placed one by one or by generators, fields, contacts and walls, built
+//! into bodies and an FRBI (run by [`super::run`]).
+//!
+//! ```toml
+//! seed = 7
+//! [rigid]
+//! free_flight = "straight"     # or "screw" (the seed's literal free step)
+//! spin_update = "keep_momentum" # or "seed"
+//!
+//! [[rigid.template]]
+//! name = "bead"
+//! generator = "irregular"      # or "sphere", "dumbbell", "trimer"; or spheres = [[x, y, z, r], ...]
+//! radius = 1.0
+//! lobes = 8
+//! density = 1.0                # or mass = ... (density is then set to give it)
+//! dipole = [0.0, 0.0, 1.0]
+//! charge = 0.0
+//!
+//! [[rigid.body]]
+//! template = "bead"
+//! position = [0.0, 0.0, 1.0]
+//! rotation = [0.0, 0.0, 0.0]   # rotation vector n·tan(φ/2); or axis + angle
+//! velocity = [0.0, 0.0, 0.0]
+//! omega = [0.0, 0.0, 0.0]
+//!
+//! [[rigid.lattice]]            # n bodies on a simple cubic lattice in [lo, hi]
+//! template = "bead"
+//! n = 100
+//! lo = [0.0, 0.0, 0.0]
+//! hi = [10.0, 10.0, 10.0]
+//! spacing = 2.5
+//! arrangement = "cubic"        # or "fcc" (spacing: nearest-neighbour distance)
+//! random_orientation = true
+//!
+//! [[rigid.random]]             # n bodies at random, bounding spheres not overlapping
+//! template = "bead"
+//! n = 50
+//! lo = [0.0, 0.0, 0.0]
+//! hi = [10.0, 10.0, 10.0]
+//!
+//! [rigid.fields]
+//! gravity = [0.0, 0.0, -9.81]
+//! electric = [0.0, 0.0, 0.0]
+//! magnetic = { amplitude = 1.0, axis = [0, 0, 1], start = [1, 0, 0], frequency = 0.5 }
+//! coulomb = 8.99e9             # k of Coulomb forces between charges (off if absent)
+//! dipole_dipole = 1e-7         # k = μ0/4π of dipole–dipole forces (off if absent)
+//! drag = { viscosity = 1.8e-5, air_density = 1.2, drag_coefficient = 0.47 }
+//!
+//! [rigid.contacts]
+//! young = 1e7
+//! poisson = 0.3
+//! restitution = 0.5
+//! friction = 0.5
+//! rolling_friction = 0.0
+//! skin = 0.2                   # Verlet skin (default 0.2 × the largest sphere diameter)
+//!
+//! [box]                        # as every engine spells it; contacts search across
+//! lo = [0.0, 0.0, 0.0]         # its periodic faces, planes and roller take its faces
+//! hi = [1e-3, 1e-3, 2.5e-4]
+//! periodic = [true, true, false]  # default: all axes
+//!
+//! [rigid.planes]               # conducting planes z = lo.z and z = hi.z of [box]
+//! coulomb = 8.99e9             # k: Coulomb forces between charges with all their images
+//! potential = [0.0, -300.0]    # volts on the lower and the upper plane
+//! accuracy = 1e-12             # RMS force error of the Ewald sum (newtons)
+//! r_cut = 1e-4                 # real-space cut-off (default from the charges' spacing)
+//! every = 1                    # sum the charges' forces every n steps, hold them between
+//!
+//! [rigid.latent_image]         # surface charge on a belt over the lower plane
+//! height = 2e-5                # electrical thickness d/ε_r of the photoconductor
+//! speed = 0.3                  # belt speed along x
+//! background = 0.0             # charge density outside the patches
+//! patches = [[1e-4, 3e-4, -5e-4]]  # [start, end, density]: x-intervals at t = 0
+//!
+//! [rigid.roller]               # magnetic roller inside the upper plane (the shell)
+//! field = 0.08                 # B₀ (T) at the shell's surface
+//! poles = 8
+//! radius = 0.01                # shell radius: the axis is this far above the upper plane
+//! frequency = 5.0              # roller turns per second (negative: the other way)
+//! x = 2e-4                     # x of the axis (default: the box's centre)
+//! dipole_dipole = 1e-7         # μ0/4π: forces between the induced moments (off if absent)
+//! iterations = 2               # passes of mutual induction
+//! magnetic = [{ template = "carrier", permeability = 6.0, saturation = 3.3e5 }]
+//!
+//! [rigid.nip]                  # toning-nip observables in nip.csv (the crate mote-nip)
+//! toner = "toner"
+//! carrier = "carrier"
+//! every = 500                  # default: [output] observables_every
+//!
+//! [[rigid.wall]]               # as the granular [[wall]]
+//! kind = "box"
+//! lo = [0.0, 0.0, 0.0]
+//! hi = [10.0, 10.0, 10.0]
+//!
+//! [run]
+//! dt = 1e-4
+//! steps = 10000                # or until = 1.0
+//!
+//! [output]
+//! dir = "out/my-scene"          # default out/<scene name>
+//! observables_every = 100
+//! trajectory_every = 1000
+//! ```
+//!
+//! Each table is a [`Section`] of the [`Clumps`] kind, as point-particle
+//! scenes' tables are of theirs: templates (templates.rs), placements —
+//! bodies one by one, `[[from_file]]`, lattices, random placement —
+//! (placement.rs), fields (fields.rs), contacts and walls (contacts.rs),
+//! conducting planes, the latent image and the magnetic roller
+//! (planes.rs); [`RigidScene::build`] adds them in that order.
+
+use std::ops::Range;
+
+use glam::DVec3;
+use mote_io::{ParseError, Source};
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::bodies::RigidBodies;
+use super::contacts::RigidContacts;
+use super::frbi::{Frbi, FreeFlight, SpinUpdate};
+use crate::boundary::Boundary;
+use crate::force::granular::Material;
+use crate::force::slab::ConductingPlanes;
+use crate::scene::{Kind, Section};
+
+mod contacts;
+mod fields;
+mod placement;
+mod planes;
+mod templates;
+
+pub use contacts::ContactSettings;
+pub use fields::{DragSpec, FieldSettings, FieldSpec};
+pub use placement::{BodySpec, FileSpec, Lattice, PlacementSpec, Random};
+pub use planes::{LatentSettings, MagneticSpec, PlaneSettings, RollerSettings};
+pub use templates::TemplateSpec;
+
+/// A whole rigid scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidScene {
+    #[serde(default)]
+    pub seed: Option<u64>,
+    /// Free text, ignored.
+    #[serde(default)]
+    pub title: Option<String>,
+    pub rigid: Spanned<RigidSettings>,
+    pub run: Spanned<RunSettings>,
+    /// `[[from_file]]`: bodies from a frame of their spheres (the key every
+    /// engine starts from a file with; `templates` and `tolerance` are
+    /// this engine's own).
+    #[serde(default)]
+    pub from_file: Vec<Spanned<FileSpec>>,
+    /// `[box]`, spelled as every engine spells it: `lo`, `hi` and the
+    /// periodic axes (default all). The contacts search across its
+    /// periodic faces; the planes, the roller and the nip take its faces.
+    #[serde(rename = "box", default)]
+    pub bounds: Option<Spanned<crate::scene::BoxSettings>>,
+    /// The `[output]` of every time-stepped engine (`inspect`, which names
+    /// point particles, is refused).
+    #[serde(default)]
+    pub output: crate::scene::OutputSettings,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidSettings {
+    #[serde(default)]
+    pub free_flight: Option<Spanned<String>>,
+    #[serde(default)]
+    pub spin_update: Option<Spanned<String>>,
+    #[serde(default)]
+    pub template: Vec<Spanned<TemplateSpec>>,
+    #[serde(default)]
+    pub body: Vec<Spanned<BodySpec>>,
+    #[serde(default)]
+    pub lattice: Vec<Spanned<Lattice>>,
+    #[serde(default)]
+    pub random: Vec<Spanned<Random>>,
+    /// `[[rigid.from_file]]`, the first spelling of `[[from_file]]`, read
+    /// only to be refused with the one every engine uses.
+    #[serde(default)]
+    from_file: Vec<Spanned<toml::Value>>,
+    #[serde(default)]
+    pub fields: Option<Spanned<FieldSettings>>,
+    #[serde(default)]
+    pub contacts: Option<Spanned<ContactSettings>>,
+    #[serde(default)]
+    /// `[[rigid.wall]]`: the keys of the granular `[[wall]]`.
+    pub wall: Vec<Spanned<crate::scene::WallSpec>>,
+    /// `[rigid.planes]`: conducting planes bounding the box along z.
+    #[serde(default)]
+    pub planes: Option<Spanned<PlaneSettings>>,
+    /// `[rigid.latent_image]`: charge on the belt over the lower plane.
+    #[serde(default)]
+    pub latent_image: Option<Spanned<LatentSettings>>,
+    /// `[rigid.roller]`: the magnetic roller above the upper plane.
+    #[serde(default)]
+    pub roller: Option<Spanned<RollerSettings>>,
+    /// `[rigid.nip]`: the toning nip's observables, an application's
+    /// table: the crate mote-nip reads it from the scene text; the engine
+    /// only lets it through.
+    #[serde(default)]
+    pub nip: Option<serde::de::IgnoredAny>,
+}
+
+/// `[run]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSettings {
+    pub dt: f64,
+    #[serde(default)]
+    pub steps: Option<u64>,
+    #[serde(default)]
+    pub until: Option<f64>,
+}
+
+/// The built scene: bodies, the integrator and what to run.
+pub struct BuiltRigid {
+    pub bodies: RigidBodies,
+    pub frbi: Frbi,
+    pub dt: f64,
+    pub steps: u64,
+    pub seed: u64,
+}
+
+impl BuiltRigid {
+    /// The contact model, if the scene has `[rigid.contacts]`.
+    pub fn contacts(&self) -> Option<&RigidContacts> {
+        self.frbi.find()
+    }
+}
+
+/// Whether a scene text is a rigid-body scene (has a `[rigid]` table).
+pub fn is_rigid_scene(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .map(|t| t.contains_key("rigid"))
+        .unwrap_or(false)
+}
+
+/// Rigid-clump scenes: their tables are [`Section`]s of this kind.
+pub struct Clumps;
+
+impl Kind for Clumps {
+    type Scene = RigidScene;
+    type Build<'a> = RigidBuild<'a>;
+}
+
+/// What the tables of a rigid scene build together, in table order: the
+/// templates (by name), the bodies, the integrator with its interactions
+/// in the order their wrenches are summed, and the placements' random
+/// generator (drawn from in table order, so a seed gives one scene).
+pub struct RigidBuild<'a> {
+    /// Locates errors: `file:line: message`.
+    pub src: Source<'a>,
+    pub seed: u64,
+    /// The contacts' material, where the scene has contacts (the
+    /// templates take it).
+    pub material: Option<Material>,
+    /// The templates' names and body kinds, in the order they are listed.
+    pub names: Vec<(String, u32)>,
+    pub bodies: RigidBodies,
+    pub frbi: Frbi,
+    pub rng: Xoshiro256PlusPlus,
+    /// `[box]` checked, with its span.
+    pub scene_box: Option<(Boundary, Range<usize>)>,
+    /// The conducting planes and the height of the lower one, once
+    /// `[rigid.planes]` is built (the latent image lies on them).
+    pub planes: Option<(ConductingPlanes, f64)>,
+}
+
+impl RigidBuild<'_> {
+    /// `file:line: message` at `span`.
+    fn error(&self, span: Range<usize>, message: String) -> ParseError {
+        self.src.error(span, message)
+    }
+
+    /// The body kind of the template named `name`, or an error at `span`.
+    fn kind_of(&self, name: &str, span: Range<usize>) -> Result<u32, ParseError> {
+        self.names
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, k)| *k)
+            .ok_or_else(|| self.error(span, format!("unknown template '{name}'")))
+    }
+}
+
+/// Adds the tables of a list (`[[rigid.template]]`, ...), in order.
+fn add_each<T: Section<Clumps>>(
+    tables: &[Spanned<T>],
+    scene: &RigidScene,
+    b: &mut RigidBuild,
+) -> Result<(), ParseError> {
+    tables
+        .iter()
+        .try_for_each(|t| t.get_ref().add_to(t.span(), scene, b))
+}
+
+/// Adds an optional table.
+fn add_one<T: Section<Clumps>>(
+    table: &Option<Spanned<T>>,
+    scene: &RigidScene,
+    b: &mut RigidBuild,
+) -> Result<(), ParseError> {
+    match table {
+        Some(t) => t.get_ref().add_to(t.span(), scene, b),
+        None => Ok(()),
+    }
+}
+
+impl RigidScene {
+    /// Parses a scene; errors are `file:line: message`.
+    pub fn parse(text: &str, file: &str) -> Result<Self, ParseError> {
+        Source::new(file, text).finite_numbers()?;
+        toml::from_str::<RigidScene>(text)
+            .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
+    }
+
+    /// Builds bodies and integrator; `seed` overrides the scene's.
+    pub fn build(
+        &self,
+        text: &str,
+        file: &str,
+        seed: Option<u64>,
+    ) -> Result<BuiltRigid, ParseError> {
+        let src = Source::new(file, text);
+        let err = |span: Range<usize>, msg: String| src.error(span, msg);
+        let seed = seed.or(self.seed).unwrap_or(1);
+        let rigid = self.rigid.get_ref();
+        if let Some(p) = self.output.inspect.first() {
+            return Err(err(
+                p.span(),
+                "[output] inspect names point particles; a rigid scene has bodies (their observables are in observables.csv)".into(),
+            ));
+        }
+        if let Some(p) = &self.output.pressure_tensor {
+            return Err(err(
+                p.span(),
+                "[output] pressure_tensor: the rigid engine measures the scalar pressure only (observables.csv's pressure column, in a periodic box)".into(),
+            ));
+        }
+        let mut frbi = Frbi::new();
+        if let Some(f) = &rigid.free_flight {
+            frbi.flight = match f.get_ref().as_str() {
+                "straight" => FreeFlight::Straight,
+                "screw" => FreeFlight::Screw,
+                o => {
+                    return Err(err(
+                        f.span(),
+                        format!("unknown free_flight '{o}': expected straight or screw"),
+                    ))
+                }
+            };
+        }
+        if let Some(s) = &rigid.spin_update {
+            frbi.spin = match s.get_ref().as_str() {
+                "keep_momentum" => SpinUpdate::KeepMomentum,
+                "seed" => SpinUpdate::Seed,
+                o => {
+                    return Err(err(
+                        s.span(),
+                        format!("unknown spin_update '{o}': expected keep_momentum or seed"),
+                    ))
+                }
+            };
+        }
+        let contact = rigid.contacts.as_ref();
+        if let Some(c) = contact {
+            let c = c.get_ref();
+            for (key, value) in [
+                ("box_lo", &c.box_lo),
+                ("box_hi", &c.box_hi),
+                ("periodic", &c.periodic),
+            ] {
+                if let Some(v) = value {
+                    return Err(err(
+                        v.span(),
+                        format!("[rigid.contacts] {key}: the box is a table of its own, spelled as every engine spells it: [box] lo = [...], hi = [...], periodic = [...]"),
+                    ));
+                }
+            }
+        }
+        let mut b = RigidBuild {
+            src,
+            seed,
+            material: contact.map(|c| Material {
+                young: c.get_ref().young,
+                poisson: c.get_ref().poisson,
+            }),
+            names: Vec::new(),
+            bodies: RigidBodies::new(),
+            frbi,
+            rng: Xoshiro256PlusPlus::seed_from_u64(seed),
+            scene_box: self.scene_box(src)?,
+            planes: None,
+        };
+
+        add_each(&rigid.template, self, &mut b)?;
+        add_each(&rigid.body, self, &mut b)?;
+        if let Some(f) = rigid.from_file.first() {
+            return Err(err(
+                f.span(),
+                "[[rigid.from_file]]: a scene starts from a file as every engine spells it: [[from_file]] file = \"...\" (with frame, templates, tolerance)".into(),
+            ));
+        }
+        add_each(&self.from_file, self, &mut b)?;
+        add_each(&rigid.lattice, self, &mut b)?;
+        add_each(&rigid.random, self, &mut b)?;
+        if b.bodies.is_empty() {
+            return Err(src.error(
+                self.rigid.span(),
+                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]] or [[from_file]]",
+            ));
+        }
+        add_one(&rigid.fields, self, &mut b)?;
+        match contact {
+            Some(_) => add_one(&rigid.contacts, self, &mut b)?,
+            None => {
+                for (k, w) in rigid.wall.iter().enumerate() {
+                    w.get_ref().walls(k).map_err(|m| err(w.span(), m))?;
+                }
+                if let Some(w) = rigid.wall.first() {
+                    return Err(err(
+                        w.span(),
+                        "walls need [rigid.contacts] (young, restitution, ...)".into(),
+                    ));
+                }
+            }
+        }
+        add_one(&rigid.planes, self, &mut b)?;
+        add_one(&rigid.latent_image, self, &mut b)?;
+        add_one(&rigid.roller, self, &mut b)?;
+
+        // Run length.
+        let (rspan, run) = (self.run.span(), self.run.get_ref());
+        if !positive(run.dt) {
+            return Err(err(rspan, "[run] dt must be > 0".into()));
+        }
+        let steps = match (run.steps, run.until) {
+            (Some(s), None) => s,
+            (None, Some(t)) if t <= 0.0 => {
+                return Err(err(
+                    rspan,
+                    format!("[run] until = {t}: must be a time after the start (t = 0)"),
+                ))
+            }
+            (None, Some(t)) => match mote_run::steps_until(0.0, t, run.dt) {
+                Some(n) => n,
+                None => {
+                    return Err(err(
+                        rspan,
+                        format!(
+                            "[run] until = {} with dt = {}: not a number of steps a run can take",
+                            mote_io::system::human_number(t),
+                            mote_io::system::human_number(run.dt)
+                        ),
+                    ))
+                }
+            },
+            _ => {
+                return Err(err(
+                    rspan,
+                    "[run] needs exactly one of `steps` and `until`".into(),
+                ))
+            }
+        };
+        Ok(BuiltRigid {
+            bodies: b.bodies,
+            frbi: b.frbi,
+            dt: run.dt,
+            steps,
+            seed,
+        })
+    }
+}
+
+impl RigidScene {
+    /// The body kind (template index) of the template named `name`:
+    /// templates are numbered in the order `[[rigid.template]]` lists them.
+    pub fn template_kind(&self, name: &str) -> Option<u32> {
+        let templates = &self.rigid.get_ref().template;
+        templates
+            .iter()
+            .position(|t| t.get_ref().name == name)
+            .map(|k| k as u32)
+    }
+
+    /// The scene's `[box]` (lower and upper corner, periodic axes), if it
+    /// has one.
+    pub fn box_faces(&self) -> Option<(DVec3, DVec3, [bool; 3])> {
+        let b = self.bounds.as_ref()?.get_ref();
+        Some((DVec3::from(b.lo), DVec3::from(b.hi), b.periodic))
+    }
+
+    /// `[box]` checked (lo < hi on every axis), with its span.
+    fn scene_box(
+        &self,
+        src: Source,
+    ) -> Result<Option<(Boundary, std::ops::Range<usize>)>, ParseError> {
+        match &self.bounds {
+            None => Ok(None),
+            Some(b) => Ok(Some((
+                crate::scene::run::boundary(&self.bounds, None, src)?,
+                b.span(),
+            ))),
+        }
+    }
+}
+
+/// x > 0 (false for NaN).
+fn positive(x: f64) -> bool {
+    x > 0.0
+}
+
+pub use super::run::sphere_frame;

@@ -1,0 +1,262 @@
+//! The toning nip's electrostatics and magnetics as general tables:
+//! `[rigid.planes]` (the box's faces z = lo.z and z = hi.z as conductors
+//! at given potentials, the charges' forces summed with all their images),
+//! `[rigid.latent_image]` (surface charge on a belt over the lower plane)
+//! and `[rigid.roller]` (a multipole magnetic roller inside the upper
+//! plane, inducing the carriers' moments).
+
+use std::ops::Range;
+
+use glam::DVec3;
+use mote_io::ParseError;
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::{positive, Clumps, FieldSettings, RigidBuild, RigidScene};
+use crate::force::latent::{LatentImage, Patch};
+use crate::force::slab::ConductingPlanes;
+use crate::rigid::bodies::RigidBodies;
+use crate::rigid::magnet::{InducedDipoles, MagneticRoller};
+use crate::rigid::sources::{LatentField, PlaneCoulomb};
+use crate::scene::Section;
+
+/// `[rigid.roller]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RollerSettings {
+    pub field: f64,
+    pub poles: u32,
+    pub radius: f64,
+    #[serde(default)]
+    pub frequency: f64,
+    #[serde(default)]
+    pub x: Option<f64>,
+    #[serde(default)]
+    pub dipole_dipole: f64,
+    #[serde(default)]
+    pub iterations: u32,
+    pub magnetic: Vec<MagneticSpec>,
+}
+
+/// A magnetic template of `[rigid.roller]`: relative permeability μ_r and
+/// saturation magnetisation M_s (A/m; absent: none).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MagneticSpec {
+    pub template: String,
+    pub permeability: f64,
+    #[serde(default)]
+    pub saturation: Option<f64>,
+}
+
+/// `[rigid.latent_image]`: patches across the track, moving along x.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatentSettings {
+    pub height: f64,
+    #[serde(default)]
+    pub speed: f64,
+    #[serde(default)]
+    pub background: f64,
+    #[serde(default)]
+    pub patches: Vec<[f64; 3]>,
+}
+
+/// `[rigid.planes]`: the box's faces z = box_lo.z and z = box_hi.z are
+/// conductors at the given potentials (the box periodic along x and y).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneSettings {
+    /// k = 1/(4πε₀).
+    pub coulomb: f64,
+    /// Potentials of the lower and the upper plane.
+    #[serde(default)]
+    pub potential: [f64; 2],
+    /// Requested RMS force error.
+    pub accuracy: f64,
+    #[serde(default)]
+    pub r_cut: Option<f64>,
+    /// Sum the charges' forces at every n-th step, hold them in between.
+    #[serde(default)]
+    pub every: Option<u64>,
+}
+
+impl Section<Clumps> for PlaneSettings {
+    fn add_to(
+        &self,
+        span: Range<usize>,
+        scene: &RigidScene,
+        b: &mut RigidBuild<'_>,
+    ) -> Result<(), ParseError> {
+        let built = plane_coulomb(
+            self,
+            scene.box_faces(),
+            &scene.rigid.get_ref().fields,
+            &b.bodies,
+        )
+        .map_err(|m| b.error(span, m))?;
+        b.planes = Some((built.planes.clone(), built.z0));
+        b.frbi.push(Box::new(built));
+        Ok(())
+    }
+}
+
+impl Section<Clumps> for LatentSettings {
+    /// The image's field, on the belt over the lower plane (which
+    /// `[rigid.planes]` must have made).
+    fn add_to(
+        &self,
+        span: Range<usize>,
+        _: &RigidScene,
+        b: &mut RigidBuild<'_>,
+    ) -> Result<(), ParseError> {
+        let Some((planes, z0)) = &b.planes else {
+            return Err(b.error(
+                span,
+                "[rigid.latent_image] needs [rigid.planes] (the belt is the lower plane)".into(),
+            ));
+        };
+        let ls = self;
+        let image = LatentImage {
+            k: planes.k,
+            gap: planes.gap,
+            height: ls.height,
+            period: planes.lateral[0],
+            speed: ls.speed,
+            background: ls.background,
+            patches: ls
+                .patches
+                .iter()
+                .map(|p| Patch {
+                    start: p[0],
+                    end: p[1],
+                    density: p[2],
+                })
+                .collect(),
+        };
+        let z0 = *z0;
+        image.check().map_err(|m| b.error(span, m))?;
+        b.frbi.push(Box::new(LatentField { image, z0 }));
+        Ok(())
+    }
+}
+
+impl Section<Clumps> for RollerSettings {
+    fn add_to(
+        &self,
+        span: Range<usize>,
+        scene: &RigidScene,
+        b: &mut RigidBuild<'_>,
+    ) -> Result<(), ParseError> {
+        let model = induced_dipoles(self, scene.box_faces(), &b.names, &b.bodies)
+            .map_err(|m| b.error(span, m))?;
+        b.frbi.push(Box::new(model));
+        Ok(())
+    }
+}
+
+/// `[rigid.roller]` above the scene's `[box]`.
+fn induced_dipoles(
+    rs: &RollerSettings,
+    scene_box: Option<(DVec3, DVec3, [bool; 3])>,
+    names: &[(String, u32)],
+    bodies: &RigidBodies,
+) -> Result<InducedDipoles, String> {
+    let Some((lo, hi, [true, true, _])) = scene_box else {
+        return Err(
+            "[rigid.roller] needs a [box] periodic along x and y (the shell is its face z = hi.z)"
+                .into(),
+        );
+    };
+    if !positive(rs.field) || !positive(rs.radius) || rs.poles < 2 || !rs.poles.is_multiple_of(2) {
+        return Err(
+            "[rigid.roller] needs field > 0, radius > 0 and an even number of poles".into(),
+        );
+    }
+    let n = bodies.templates.len();
+    let (mut polarisability, mut saturation) = (vec![0.0; n], vec![f64::INFINITY; n]);
+    for m in &rs.magnetic {
+        let Some((_, k)) = names.iter().find(|(name, _)| *name == m.template) else {
+            return Err(format!(
+                "[rigid.roller] names unknown template '{}'",
+                m.template
+            ));
+        };
+        if m.permeability.is_nan()
+            || m.permeability < 1.0
+            || m.saturation.is_some_and(|s| !positive(s))
+        {
+            return Err(
+                "[rigid.roller] magnetic templates need permeability >= 1 and saturation > 0"
+                    .into(),
+            );
+        }
+        let volume = bodies.templates[*k as usize].props.volume;
+        polarisability[*k as usize] = InducedDipoles::polarisability(volume, m.permeability);
+        if let Some(ms) = m.saturation {
+            saturation[*k as usize] = ms * volume;
+        }
+    }
+    let roller = MagneticRoller {
+        field: rs.field,
+        poles: rs.poles,
+        radius: rs.radius,
+        angular_velocity: 2.0 * std::f64::consts::PI * rs.frequency,
+        axis: [rs.x.unwrap_or(0.5 * (lo.x + hi.x)), hi.z + rs.radius],
+    };
+    Ok(InducedDipoles {
+        roller,
+        polarisability,
+        saturation,
+        dipole_dipole: rs.dipole_dipole,
+        iterations: rs.iterations,
+        period: [hi.x - lo.x, hi.y - lo.y],
+    })
+}
+
+/// `[rigid.planes]` on the faces of the scene's `[box]`.
+fn plane_coulomb(
+    ps: &PlaneSettings,
+    scene_box: Option<(DVec3, DVec3, [bool; 3])>,
+    fields: &Option<Spanned<FieldSettings>>,
+    bodies: &RigidBodies,
+) -> Result<PlaneCoulomb, String> {
+    if fields
+        .as_ref()
+        .is_some_and(|f| f.get_ref().coulomb.is_some())
+    {
+        return Err("[rigid.planes] sums the Coulomb forces with their images: remove coulomb from [rigid.fields]".into());
+    }
+    let Some((lo, hi, [true, true, false])) = scene_box else {
+        return Err("[rigid.planes] needs a [box] with periodic = [true, true, false] (the planes are its faces z = lo.z and z = hi.z)".into());
+    };
+    if !positive(ps.coulomb) || !positive(ps.accuracy) {
+        return Err("[rigid.planes] needs coulomb > 0 and accuracy > 0".into());
+    }
+    let charge: Vec<f64> = (0..bodies.len())
+        .map(|i| bodies.template(i).charge)
+        .filter(|&q| q != 0.0)
+        .collect();
+    let size = hi - lo;
+    let largest = size.x.min(size.y).min(2.0 * size.z) / 2.0;
+    // About 3.5 spacings of the doubled cell's 2N charges: some 180
+    // neighbours in reach, on linked cells.
+    let spacing = (2.0 * size.element_product() / (2 * charge.len().max(1)) as f64).cbrt();
+    let r_cut = ps.r_cut.unwrap_or((3.5 * spacing).min(largest));
+    if !positive(r_cut) || r_cut > largest * (1.0 + 1e-12) {
+        return Err(format!("[rigid.planes] r_cut must be > 0 and at most {largest} (half the smallest side of the box doubled along z)"));
+    }
+    let planes = ConductingPlanes::new(
+        ps.coulomb,
+        size.z,
+        [size.x, size.y],
+        ps.potential,
+        &charge,
+        r_cut,
+        ps.accuracy,
+    );
+    if ps.every == Some(0) {
+        return Err("[rigid.planes] every must be at least 1".into());
+    }
+    Ok(PlaneCoulomb::new(planes, lo.z, ps.every.unwrap_or(1)))
+}
