@@ -13,7 +13,6 @@ use mote_edmd::pack::{PackState, Packer, Stop};
 use mote_edmd::EdmdError;
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
-use mote_io::trajectory::Format;
 use mote_run::{Observer, Propagator, Report};
 
 use super::PackRun;
@@ -103,29 +102,12 @@ fn stopped_because(stop: Stop, max_pressure: f64) -> String {
     }
 }
 
-fn interrupted(signal: i32) -> Ending {
-    Ending::Interrupted {
-        signal,
-        message: format!("interrupted by signal {signal}; the packing so far is written"),
-    }
-}
-
 impl<const D: usize> EngineRun for Growth<'_, D> {
     type State = Packer<D>;
     const ENGINE: Engine = Engine::Packing;
     const NAME: &'static str = "packing";
 
-    fn scene_seed(&self) -> Option<u64> {
-        self.job.scene_seed
-    }
-
-    fn seed_chosen(&self) -> bool {
-        self.job.seed_chosen
-    }
-
-    fn scene_dir(&self) -> Option<&String> {
-        self.job.scene_dir.as_ref()
-    }
+    pack_run_methods!();
 
     fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<Packer<D>, FrontError> {
         let g = &*self;
@@ -138,10 +120,6 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
         .map_err(|e| g.job.naming.locate(e.into()))?;
         g.collisions0.set(packer.collisions());
         Ok(packer)
-    }
-
-    fn writes_files(&self) -> bool {
-        self.job.writes
     }
 
     fn observers(
@@ -171,25 +149,6 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
         })])
     }
 
-    fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
-        // The packing is written once, at its end.
-        Ok(None)
-    }
-
-    fn checkpoint_options(&self, _: &Packer<D>) -> Vec<(String, String)> {
-        // Relative paths of the request resolve from here on resume.
-        let base = std::path::absolute(&self.job.base).unwrap_or_else(|_| self.job.base.clone());
-        vec![
-            ("base".into(), base.display().to_string()),
-            ("packing-format".into(), self.job.format.extension().into()),
-        ]
-    }
-
-    fn last_step(&self, _: &Packer<D>) -> u64 {
-        // It ends when it has jammed (or at a limit of its own).
-        u64::MAX
-    }
-
     fn opening(&self, state: &Packer<D>) -> String {
         let spec = self.job.spec;
         format!(
@@ -199,13 +158,6 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
             spec.rate,
             spec.dist
         )
-    }
-
-    fn headline(&self, label: &str, state: &Packer<D>) -> String {
-        match &self.job.headline {
-            Some(h) => h.clone(),
-            None => format!("mote run {label}: {}", self.opening(state)),
-        }
     }
 
     fn progress(&self, state: &Packer<D>, _: u64, monitor: &mut dyn Monitor) {
@@ -231,7 +183,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
                 if let Some((dir, provenance)) = self.files.get() {
                     self.write(state, dir, provenance)?;
                 }
-                Ok(interrupted(signal))
+                Ok(super::interrupted(signal))
             }
             e => Err(self.job.naming.locate(e.into())),
         }
@@ -239,7 +191,7 @@ impl<const D: usize> EngineRun for Growth<'_, D> {
 
     fn ended(&self, state: &Packer<D>) -> Ending {
         match (state.stopped(), mote_io::system::stop_requested()) {
-            (Some(Stop::Interrupted), Some(signal)) => interrupted(signal),
+            (Some(Stop::Interrupted), Some(signal)) => super::interrupted(signal),
             _ => Ending::Finished,
         }
     }

@@ -19,6 +19,52 @@ use serde::{Deserialize, Serialize};
 use crate::error::{refuse, FrontError};
 use crate::{Ending, Input, Monitor, Outcome, RunOptions};
 
+/// The methods of [`crate::runner::EngineRun`] both packing methods take
+/// from their request ([`PackRun`], `self.job`): its seed and folder, its
+/// files (the packing is written once, at its end: no trajectory), its
+/// checkpoints' options, its opening line; a packing ends when it stops
+/// by itself, not at a step.
+macro_rules! pack_run_methods {
+    () => {
+        fn scene_seed(&self) -> Option<u64> {
+            self.job.scene_seed
+        }
+
+        fn seed_chosen(&self) -> bool {
+            self.job.seed_chosen
+        }
+
+        fn scene_dir(&self) -> Option<&String> {
+            self.job.scene_dir.as_ref()
+        }
+
+        fn writes_files(&self) -> bool {
+            self.job.writes
+        }
+
+        fn trajectory(
+            &self,
+        ) -> Result<Option<(String, mote_io::trajectory::Format, u64)>, FrontError> {
+            Ok(None)
+        }
+
+        fn checkpoint_options(&self, _: &Self::State) -> Vec<(String, String)> {
+            self.job.checkpoint_options()
+        }
+
+        fn last_step(&self, _: &Self::State) -> u64 {
+            u64::MAX
+        }
+
+        fn headline(&self, label: &str, state: &Self::State) -> String {
+            match &self.job.headline {
+                Some(h) => h.clone(),
+                None => format!("mote run {label}: {}", self.opening(state)),
+            }
+        }
+    };
+}
+
 mod growth;
 pub(crate) mod soft;
 
@@ -455,6 +501,14 @@ pub fn pack(
     packed(outcome?, grown)
 }
 
+/// How a packing a signal stopped ended: its packing so far is written.
+fn interrupted(signal: i32) -> Ending {
+    Ending::Interrupted {
+        signal,
+        message: format!("interrupted by signal {signal}; the packing so far is written"),
+    }
+}
+
 /// A packing's outcome with the packing it left.
 fn packed(outcome: Outcome, grown: RefCell<Option<Grown>>) -> Result<Packed, FrontError> {
     let Some(grown) = grown.into_inner() else {
@@ -521,6 +575,17 @@ impl PackRun<'_> {
                 self.naming.said("dimension", d, false)
             ),
         }
+    }
+
+    /// What a packing's checkpoints record beyond the run's: the folder
+    /// the request's relative paths resolve from on resume, and the
+    /// packing file's format.
+    fn checkpoint_options(&self) -> Vec<(String, String)> {
+        let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
+        vec![
+            ("base".into(), base.display().to_string()),
+            ("packing-format".into(), self.format.extension().into()),
+        ]
     }
 
     /// Writes the packing `frame` (every number exact in the format of

@@ -15,7 +15,6 @@ use mote_edmd::analyse::{contacts, stable_contacts, Contacts};
 use mote_edmd::pack::SizeSpec;
 use mote_io::checkpoint::Checkpoint;
 use mote_io::csv::CsvWriter;
-use mote_io::trajectory::Format;
 use mote_md::boundary::Boundary;
 use mote_md::soft_pack::{
     extrapolate, FinishSettings, SoftPackSettings, SoftPacker, SoftSample, SoftStop, Stage,
@@ -155,11 +154,17 @@ impl Observer<SoftPacker> for StageTable {
     }
 }
 
-fn interrupted(signal: i32) -> Ending {
-    Ending::Interrupted {
-        signal,
-        message: format!("interrupted by signal {signal}; the packing so far is written"),
-    }
+/// The summary's line of a held or minimised state: P/K, φ, z and its
+/// steps (named `steps`), and `unconverged` where it did not converge.
+fn stage_line(s: &Stage, steps: &str, unconverged: &str) -> String {
+    format!(
+        "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} {steps}{})",
+        s.pressure,
+        s.phi,
+        s.z,
+        s.steps,
+        if s.converged { "" } else { unconverged }
+    )
 }
 
 /// φ_J of the last three states of `stages`, if there are two.
@@ -172,17 +177,7 @@ impl EngineRun for Soft<'_> {
     const ENGINE: Engine = Engine::Packing;
     const NAME: &'static str = "packing";
 
-    fn scene_seed(&self) -> Option<u64> {
-        self.job.scene_seed
-    }
-
-    fn seed_chosen(&self) -> bool {
-        self.job.seed_chosen
-    }
-
-    fn scene_dir(&self) -> Option<&String> {
-        self.job.scene_dir.as_ref()
-    }
+    pack_run_methods!();
 
     fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<SoftPacker, FrontError> {
         let job = &self.job;
@@ -192,10 +187,6 @@ impl EngineRun for Soft<'_> {
             None => SoftPacker::new(settings),
         }
         .map_err(FrontError::request)
-    }
-
-    fn writes_files(&self) -> bool {
-        self.job.writes
     }
 
     fn observers(
@@ -217,25 +208,6 @@ impl EngineRun for Soft<'_> {
         })])
     }
 
-    fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
-        // The packing is written once, at its end.
-        Ok(None)
-    }
-
-    fn checkpoint_options(&self, _: &SoftPacker) -> Vec<(String, String)> {
-        // Relative paths of the request resolve from here on resume.
-        let base = std::path::absolute(&self.job.base).unwrap_or_else(|_| self.job.base.clone());
-        vec![
-            ("base".into(), base.display().to_string()),
-            ("packing-format".into(), self.job.format.extension().into()),
-        ]
-    }
-
-    fn last_step(&self, _: &SoftPacker) -> u64 {
-        // It ends when the finish is over (or at a limit of its own).
-        u64::MAX
-    }
-
     fn opening(&self, state: &SoftPacker) -> String {
         format!(
             "packing {} spheres by the soft method (down to P/K = {:e}, {})",
@@ -243,13 +215,6 @@ impl EngineRun for Soft<'_> {
             self.min_pressure,
             self.job.spec.dist
         )
-    }
-
-    fn headline(&self, label: &str, state: &SoftPacker) -> String {
-        match &self.job.headline {
-            Some(h) => h.clone(),
-            None => format!("mote run {label}: {}", self.opening(state)),
-        }
     }
 
     fn progress(&self, state: &SoftPacker, _: u64, monitor: &mut dyn Monitor) {
@@ -275,7 +240,7 @@ impl EngineRun for Soft<'_> {
                 if let (Some((dir, provenance)), Some(frame)) = (self.files.get(), state.frame()) {
                     self.job.write(&frame, dir, provenance)?;
                 }
-                Ok(interrupted(signal))
+                Ok(super::interrupted(signal))
             }
             e => Err(self.job.naming.locate(e.into())),
         }
@@ -283,7 +248,7 @@ impl EngineRun for Soft<'_> {
 
     fn ended(&self, state: &SoftPacker) -> Ending {
         match (state.stopped(), mote_io::system::stop_requested()) {
-            (Some(SoftStop::Interrupted), Some(signal)) => interrupted(signal),
+            (Some(SoftStop::Interrupted), Some(signal)) => super::interrupted(signal),
             _ => Ending::Finished,
         }
     }
@@ -305,18 +270,7 @@ impl EngineRun for Soft<'_> {
             state.steps, done.cpu
         )];
         for s in stages {
-            summary.push(format!(
-                "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} steps{})",
-                s.pressure,
-                s.phi,
-                s.z,
-                s.steps,
-                if s.converged {
-                    ""
-                } else {
-                    ", NOT held: step budget spent"
-                }
-            ));
+            summary.push(stage_line(s, "steps", ", NOT held: step budget spent"));
         }
         let barostat_phi_j = phi_j(stages);
         if let (Some(phi_j), Some((position, boundary))) = (barostat_phi_j, state.barostat_end()) {
@@ -331,18 +285,7 @@ impl EngineRun for Soft<'_> {
         if !finish.is_empty() {
             summary.push("Jamming finish (FIRE energy minimisation at fixed box, decompressed a decade of pressure at a time):".into());
             for s in finish {
-                summary.push(format!(
-                    "  P/K = {:.3e}  phi = {:.6}  z = {:.4}  ({} FIRE steps{})",
-                    s.pressure,
-                    s.phi,
-                    s.z,
-                    s.steps,
-                    if s.converged {
-                        ""
-                    } else {
-                        ", residual force above 1e-10"
-                    }
-                ));
+                summary.push(stage_line(s, "FIRE steps", ", residual force above 1e-10"));
             }
             if let Some(phi_j) = finish_phi_j {
                 summary.push(format!(

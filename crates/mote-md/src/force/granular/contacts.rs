@@ -368,6 +368,9 @@ mod tests {
         }
         let two = GranularContacts::block_firsts(&start, 2);
         assert!((two[1] as f64 / n as f64 - (1.0 - 0.5f64.sqrt())).abs() < 0.01);
-        assert_eq!(GranularContacts::block_firsts(&[0; 11], 3), vec![0, 0, 0, 10]);
+        assert_eq!(
+            GranularContacts::block_firsts(&[0; 11], 3),
+            vec![0, 0, 0, 10]
+        );
     }
 }
