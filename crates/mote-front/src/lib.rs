@@ -272,6 +272,22 @@ pub fn check_simd_request() -> Result<(), FrontError> {
 
 /// "1 thread, AVX-512" / "2 threads, AVX2 + FMA (portable kernels)": the
 /// threads and the SIMD level the kernels run at (`MOTE_SIMD` forces one).
+/// What a run's summary says when a periodic box has no pressure column:
+/// the interactions `without` a virial, named.
+fn no_pressure_column<S: AsRef<str>>(without: &[S]) -> String {
+    let one = without.len() == 1;
+    format!(
+        "No pressure column: {} do{} not compute {} virial.",
+        without
+            .iter()
+            .map(|w| w.as_ref())
+            .collect::<Vec<_>>()
+            .join(", "),
+        if one { "es" } else { "" },
+        if one { "its" } else { "their" }
+    )
+}
+
 fn threads_phrase() -> String {
     let n = rayon::current_num_threads();
     format!(

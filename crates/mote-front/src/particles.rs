@@ -362,12 +362,7 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
     };
     let without = sim.forces.without_virial();
     let pressure = if sim.system.boundary.periodic.iter().all(|p| *p) && !without.is_empty() {
-        format!(
-            " No pressure column: {} do{} not compute {} virial.",
-            without.join(", "),
-            if without.len() == 1 { "es" } else { "" },
-            if without.len() == 1 { "its" } else { "their" }
-        )
+        format!(" {}", crate::no_pressure_column(&without))
     } else {
         String::new()
     };

@@ -240,13 +240,7 @@ impl EngineRun for RigidRun {
                 last.pressure
             ));
         } else if !self.without_virial.is_empty() {
-            let n = self.without_virial.len();
-            summary.push(format!(
-                "No pressure column: {} do{} not compute {} virial.",
-                self.without_virial.join(", "),
-                if n == 1 { "es" } else { "" },
-                if n == 1 { "its" } else { "their" }
-            ));
+            summary.push(crate::no_pressure_column(&self.without_virial));
         }
         summary.push(format!("Output: {}", report.files.join(", ")));
         Ok(summary)

@@ -167,11 +167,12 @@ pub trait Section<K: Kind = Points> {
     ) -> Result<(), ParseError>;
 }
 
-/// Adds an optional table's interactions.
-fn add<T: Section>(
+/// Adds an optional table of a scene of kind `K` (point particles, rigid
+/// clumps).
+pub(crate) fn add<K: Kind, T: Section<K>>(
     table: &Option<Spanned<T>>,
-    scene: &Scene,
-    b: &mut Build,
+    scene: &K::Scene,
+    b: &mut K::Build<'_>,
 ) -> Result<(), ParseError> {
     match table {
         Some(t) => t.get_ref().add_to(t.span(), scene, b),

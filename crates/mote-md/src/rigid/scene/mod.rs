@@ -125,7 +125,7 @@ use super::frbi::{Frbi, FreeFlight, SpinUpdate};
 use crate::boundary::Boundary;
 use crate::force::granular::Material;
 use crate::force::slab::ConductingPlanes;
-use crate::scene::{Kind, Section};
+use crate::scene::{add, Kind, Section};
 
 mod contacts;
 mod fields;
@@ -300,18 +300,6 @@ fn add_each<T: Section<Clumps>>(
         .try_for_each(|t| t.get_ref().add_to(t.span(), scene, b))
 }
 
-/// Adds an optional table.
-fn add_one<T: Section<Clumps>>(
-    table: &Option<Spanned<T>>,
-    scene: &RigidScene,
-    b: &mut RigidBuild,
-) -> Result<(), ParseError> {
-    match table {
-        Some(t) => t.get_ref().add_to(t.span(), scene, b),
-        None => Ok(()),
-    }
-}
-
 impl RigidScene {
     /// Parses a scene; errors are `file:line: message`.
     pub fn parse(text: &str, file: &str) -> Result<Self, ParseError> {
@@ -416,9 +404,9 @@ impl RigidScene {
                 "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]] or [[from_file]]",
             ));
         }
-        add_one(&rigid.fields, self, &mut b)?;
+        add(&rigid.fields, self, &mut b)?;
         match contact {
-            Some(_) => add_one(&rigid.contacts, self, &mut b)?,
+            Some(_) => add(&rigid.contacts, self, &mut b)?,
             None => {
                 for (k, w) in rigid.wall.iter().enumerate() {
                     w.get_ref().walls(k).map_err(|m| err(w.span(), m))?;
@@ -431,9 +419,9 @@ impl RigidScene {
                 }
             }
         }
-        add_one(&rigid.planes, self, &mut b)?;
-        add_one(&rigid.latent_image, self, &mut b)?;
-        add_one(&rigid.roller, self, &mut b)?;
+        add(&rigid.planes, self, &mut b)?;
+        add(&rigid.latent_image, self, &mut b)?;
+        add(&rigid.roller, self, &mut b)?;
 
         // Run length.
         let (rspan, run) = (self.run.span(), self.run.get_ref());
