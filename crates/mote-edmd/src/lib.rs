@@ -53,3 +53,9 @@ pub enum EdmdError {
     #[error("the run was interrupted by signal {signal} at t = {time}")]
     Interrupted { signal: i32, time: f64 },
 }
+
+impl From<mote_io::ParseError> for EdmdError {
+    fn from(e: mote_io::ParseError) -> Self {
+        EdmdError::Io(e.into())
+    }
+}

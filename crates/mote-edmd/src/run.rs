@@ -270,7 +270,7 @@ impl<const D: usize> EventDriven<D> {
             time: scene.time,
             equilibrate: scene.equilibrate,
             resuming,
-            check_overlaps: scene.check_overlaps,
+            check_overlaps: scene.spheres.check_overlaps,
             ledger,
         }
     }

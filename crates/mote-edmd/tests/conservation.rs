@@ -20,7 +20,7 @@ fn rel_momentum_change<const D: usize>(p0: [f64; D], sys: &System<D>) -> f64 {
 #[test]
 fn spheres_conserve_energy_and_momentum_over_a_million_collisions() {
     let scene = Scene::parse(
-        "dimension = 3\nn = 1000\npacking_fraction = 0.40\nlarge_fraction = 0.5\nsize_ratio = 1.4\ntemperature = 1.0\n",
+        "[event_driven]\ndimension = 3\nn = 1000\npacking_fraction = 0.40\nlarge_fraction = 0.5\nsize_ratio = 1.4\ntemperature = 1.0\n",
         "test",
     )
     .unwrap();
@@ -53,7 +53,7 @@ fn spheres_conserve_energy_and_momentum_over_a_million_collisions() {
 #[test]
 fn disks_with_walls_conserve_energy_and_periodic_momentum() {
     let scene = Scene::parse(
-        "dimension = 2\nn = 2000\npacking_fraction = 0.6\nplacement = \"cubic\"\nlarge_fraction = 0.3\nsize_ratio = 1.2\n[box]\nperiodic = [true, false]\n",
+        "[event_driven]\ndimension = 2\nn = 2000\npacking_fraction = 0.6\nplacement = \"cubic\"\nlarge_fraction = 0.3\nsize_ratio = 1.2\n[box]\nperiodic = [true, false]\n",
         "test",
     )
     .unwrap();
@@ -89,7 +89,11 @@ fn disks_with_walls_conserve_energy_and_periodic_momentum() {
 /// The same seed gives the same trajectory, bit for bit.
 #[test]
 fn runs_are_reproducible() {
-    let scene = Scene::parse("dimension = 3\nn = 500\npacking_fraction = 0.3\n", "test").unwrap();
+    let scene = Scene::parse(
+        "[event_driven]\ndimension = 3\nn = 500\npacking_fraction = 0.3\n",
+        "test",
+    )
+    .unwrap();
     let run = || {
         let mut s: System<3> = scene.build(3, Path::new(".")).unwrap();
         s.run_until(5.0);

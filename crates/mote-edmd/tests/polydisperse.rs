@@ -11,7 +11,7 @@ use std::path::Path;
 #[test]
 fn a_one_to_eight_mixture_keeps_its_energy_and_never_overlaps() {
     let scene = Scene::parse(
-        "dimension = 3\nn = 2020\npacking_fraction = 0.30\nlarge_fraction = 0.0099\nsize_ratio = 8\nplacement = \"random\"\ntemperature = 1.0\n",
+        "[event_driven]\ndimension = 3\nn = 2020\npacking_fraction = 0.30\nlarge_fraction = 0.0099\nsize_ratio = 8\nplacement = \"random\"\ntemperature = 1.0\n",
         "test",
     )
     .unwrap();

@@ -2,14 +2,14 @@
 //! as `file:line: message`.
 
 use mote_edmd::scene::{example, EXAMPLES};
-use mote_edmd::{EdmdError, Scene, System};
+use mote_edmd::{Scene, System};
 use std::path::Path;
 
 #[test]
 fn every_example_builds_without_overlap() {
     for (name, text) in EXAMPLES {
         let scene = Scene::parse(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
-        match scene.dimension {
+        match scene.spheres.dimension {
             2 => {
                 let s: System<2> = scene.build(1, Path::new(".")).unwrap();
                 assert!(s.find_overlap(1e-12).is_none());
@@ -36,43 +36,43 @@ fn cube_example_has_the_seed_radius_and_packing_fraction() {
 }
 
 fn scene_error(text: &str) -> (usize, String) {
-    match Scene::parse(text, "bad.toml") {
-        Err(EdmdError::Scene {
-            file,
-            line,
-            message,
-        }) => {
-            assert_eq!(file, "bad.toml");
-            (line, message)
-        }
-        other => panic!("expected a scene error, got {other:?}"),
-    }
+    let e = Scene::parse(text, "bad.toml").expect_err(text).to_string();
+    let rest = e.strip_prefix("bad.toml:").expect(&e);
+    let (line, message) = rest.split_once(": ").expect(&e);
+    (line.parse().expect(&e), message.to_string())
 }
 
 #[test]
 fn errors_name_the_line() {
-    let (line, msg) = scene_error("dimension = 3\nn = 10\npacking_fraction = 0.9\n");
-    assert_eq!(line, 3);
+    let (line, msg) =
+        scene_error("[event_driven]\ndimension = 3\nn = 10\npacking_fraction = 0.9\n");
+    assert_eq!(line, 4);
     assert!(msg.contains("packing_fraction"), "{msg}");
     let (line, msg) = scene_error(
-        "dimension = 3\nn = 10\npacking_fraction = 0.1\n[box]\nperiodic = [true, \"sticky\", true]\n",
+        "[event_driven]\ndimension = 3\nn = 10\npacking_fraction = 0.1\n[box]\nperiodic = [true, \"sticky\", true]\n",
     );
-    assert_eq!(line, 5);
-    assert!(msg.contains("[box] periodic"), "{msg}");
-    let (line, msg) = scene_error("dimension = 4\nn = 10\npacking_fraction = 0.1\n");
-    assert_eq!(line, 1);
+    assert_eq!(line, 6);
+    assert!(
+        msg.contains("invalid type: string \"sticky\", expected a boolean"),
+        "{msg}"
+    );
+    let (line, msg) =
+        scene_error("[event_driven]\ndimension = 4\nn = 10\npacking_fraction = 0.1\n");
+    assert_eq!(line, 2);
     assert!(msg.contains("2 (disks) or 3"), "{msg}");
-    let (line, msg) = scene_error("n = 10\npacking_fraction = 0.1\ntemprature = 1.0\n");
-    assert_eq!(line, 3);
+    let (line, msg) =
+        scene_error("[event_driven]\nn = 10\npacking_fraction = 0.1\ntemprature = 1.0\n");
+    assert_eq!(line, 4);
     assert!(msg.contains("temprature"), "{msg}");
-    let (line, msg) = scene_error("n = 10\n[box]\nhi = [1.0, 2.0]\n");
-    assert_eq!(line, 3);
-    assert!(msg.contains("3 positive lengths"), "{msg}");
-    let (line, msg) = scene_error("n = 10\n[box]\nlo = [1.0, 0.0, 0.0]\nhi = [3.0, 3.0, 3.0]\n");
-    assert_eq!(line, 3);
+    let (line, msg) = scene_error("[event_driven]\nn = 10\n[box]\nhi = [1.0, 2.0]\n");
+    assert_eq!(line, 4);
+    assert!(msg.contains("[box] hi must list 3 entries"), "{msg}");
+    let (line, msg) =
+        scene_error("[event_driven]\nn = 10\n[box]\nlo = [1.0, 0.0, 0.0]\nhi = [3.0, 3.0, 3.0]\n");
+    assert_eq!(line, 4);
     assert!(msg.contains("from the origin"), "{msg}");
-    // The first spellings are refused with the one every engine uses,
-    // in [event_driven] and at the top level alike.
+    // The first spellings inside [event_driven] are refused with the one
+    // every engine uses (at the top level, the front refuses them).
     for (text, line, spelling) in [
         (
             "[event_driven]\nn = 10\nbox = [3.0, 3.0, 3.0]\n",
@@ -80,8 +80,8 @@ fn errors_name_the_line() {
             "[box] hi = [lengths]",
         ),
         (
-            "n = 10\npacking_fraction = 0.1\nboundary = \"wall\"\n",
-            3,
+            "[event_driven]\nn = 10\npacking_fraction = 0.1\nboundary = \"wall\"\n",
+            4,
             "[box] hi = [lengths]",
         ),
         (
@@ -112,14 +112,18 @@ fn errors_name_the_line() {
         .unwrap()
         .build::<3>(5, std::path::Path::new("."));
     assert!(system.is_ok() && t0.elapsed().as_secs_f64() < 2.0);
-    let e = Scene::parse("n = 10\npacking_fraction = 0.1\ntime = -1.0\n", "bad.toml").unwrap_err();
-    assert!(e.to_string().starts_with("bad.toml:3: "), "{e}");
+    let e = Scene::parse(
+        "[event_driven]\nn = 10\npacking_fraction = 0.1\n[run]\nuntil = -1.0\n",
+        "bad.toml",
+    )
+    .unwrap_err();
+    assert!(e.to_string().starts_with("bad.toml:5: "), "{e}");
 }
 
 #[test]
 fn too_dense_random_placement_is_an_error_not_a_panic() {
     let scene = Scene::parse(
-        "n = 500\npacking_fraction = 0.55\nplacement = \"random\"\n",
+        "[event_driven]\nn = 500\npacking_fraction = 0.55\nplacement = \"random\"\n",
         "dense.toml",
     )
     .unwrap();

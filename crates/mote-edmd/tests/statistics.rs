@@ -31,7 +31,9 @@ fn z_blocks<const D: usize>(
 }
 
 fn eos_check(dim: usize, n: usize, eta: f64, equil: f64, blocks: usize, tau: f64) {
-    let text = format!("dimension = {dim}\nn = {n}\npacking_fraction = {eta}\ntemperature = 1.0\n");
+    let text = format!(
+        "[event_driven]\ndimension = {dim}\nn = {n}\npacking_fraction = {eta}\ntemperature = 1.0\n"
+    );
     let scene = Scene::parse(&text, "test").unwrap();
     let (z, se, reference, name) = if dim == 3 {
         let mut sys: System<3> = scene.build(42, Path::new(".")).unwrap();
@@ -92,7 +94,7 @@ fn disks_follow_henderson_large() {
 fn collision_rate_matches_enskog_at_low_density() {
     let eta = 0.05;
     let scene = Scene::parse(
-        &format!("dimension = 3\nn = 4000\npacking_fraction = {eta}\ntemperature = 1.0\n"),
+        &format!("[event_driven]\ndimension = 3\nn = 4000\npacking_fraction = {eta}\ntemperature = 1.0\n"),
         "test",
     )
     .unwrap();

@@ -38,7 +38,10 @@ impl FrontError {
             self,
             FrontError::Parse(_)
                 | FrontError::Request(_)
-                | FrontError::Edmd(mote_edmd::EdmdError::Scene { .. })
+                | FrontError::Edmd(
+                    mote_edmd::EdmdError::Scene { .. }
+                        | mote_edmd::EdmdError::Io(IoError::Parse(_))
+                )
                 | FrontError::Md(mote_md::MdError::Parse(_) | mote_md::MdError::Length(_))
         )
     }

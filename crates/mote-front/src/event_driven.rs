@@ -74,6 +74,14 @@ pub fn run_with(
     words: &EdmdWords,
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
+    let engine = input.engine()?;
+    if engine != Engine::EventDriven {
+        refuse!(
+            "{}: a scene of {}, not of hard spheres (no [event_driven] table): run it with `mote run`",
+            input.label,
+            engine.title()
+        );
+    }
     run_events(input, options, words, None, monitor)
 }
 
@@ -123,7 +131,7 @@ fn run_events(
         scene.histogram = None;
     }
     let scene_dir = input.folder();
-    match scene.dimension {
+    match scene.spheres.dimension {
         2 => run_engine(
             EventRun::<2>::new(scene, scene_dir, words, options, input),
             input,
@@ -335,7 +343,6 @@ fn summary(r: &mote_edmd::Run, scene: &Scene, cpu: f64) -> Vec<String> {
         r.ks.0, r.ks.1
     );
     let mut lines = vec![s];
-    lines.extend(scene.notes.iter().cloned());
     if r.n <= 10 {
         let v: Vec<String> = r.speeds.iter().map(|x| format!("{x:.12}")).collect();
         lines.push(format!("final speeds: {}", v.join(" ")));

@@ -160,12 +160,13 @@ impl Input {
         self.output_dir(option, scene.as_ref())
     }
 
-    /// The engine that runs this input.
-    pub fn engine(&self) -> Engine {
+    /// The engine that runs this input, after the scene envelope's check
+    /// ([`Engine::read`]).
+    pub fn engine(&self) -> Result<Engine, FrontError> {
         if self.plist {
-            Engine::Particles
+            Ok(Engine::Particles)
         } else {
-            Engine::of_scene(&self.text)
+            Engine::read(&self.label, &self.text)
         }
     }
 }

@@ -243,10 +243,7 @@ pub fn run_input(
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
     options.check_values()?;
-    if !input.plist {
-        Engine::check_one(&input.label, &input.text)?;
-    }
-    let result = match input.engine() {
+    let result = match input.engine()? {
         Engine::Particles => particles::run(Some(input.clone()), options, monitor),
         Engine::Rigid => rigid::run(input, options, monitor),
         Engine::EventDriven => event_driven::run(input, options, monitor),

@@ -6,7 +6,7 @@ use std::path::Path;
 use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::trajectory::Format;
 use mote_md::output::ObservablesCsv;
-use mote_md::scene::{PlistSystem, Scene, Setting};
+use mote_md::scene::{Origin, PlistSystem, Scene, Setting};
 use mote_md::{MdError, RunLength, RunReport, Simulation};
 use mote_run::Observer;
 
@@ -96,14 +96,12 @@ pub(crate) fn run(
         }
         let mut scene = Scene::parse(&input.text, &input.label)?;
         if let Some(s) = &args.solver {
-            scene.run.integrator = Setting::from_option("--solver", s.clone());
+            scene.run.integrator = Some(Setting::from_option("--solver", s.clone()));
         }
         scene
     };
     let mut scene = scene;
-    if let Some(dt) = args.dt {
-        scene.run.dt = Some(Setting::from_option("--dt", dt));
-    }
+    scene.run.with_options(args.dt, args.steps, args.until);
     if scene.run.dt.is_none() {
         refuse!(
             "{}: no time step: give one with --dt (a particle file sets it with a 'dt' line)",
@@ -159,20 +157,19 @@ impl EngineRun for PointsRun {
     fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<Simulation, FrontError> {
         let (args, label) = (&self.args, &self.input.label);
         let built = self.scene.build(&self.input.text, label, seed)?;
+        let Some(length) = built.length else {
+            refuse!("{label}: no run length: give --until T or --steps N")
+        };
         // Where the length was given, for its messages: an option, or the
         // line of the scene's [run] key.
-        let (length, given) = match (args.steps, args.until, built.length) {
-            (Some(n), _, _) => (RunLength::Steps(n), label.to_string()),
-            (None, Some(t), _) => (RunLength::Until(t), label.to_string()),
-            (None, None, Some(l)) => {
-                let key = match l {
-                    RunLength::Steps(_) => "steps",
-                    RunLength::Until(_) => "until",
-                };
+        let run = &self.scene.run;
+        let origin = run.steps.as_ref().map(|s| &s.origin);
+        let given = match origin.or(run.until.as_ref().map(|t| &t.origin)) {
+            Some(Origin::Scene(span)) => {
                 let source = mote_io::Source::new(label, &self.input.text);
-                (l, format!("{label}:{}", source.key_line(key)))
+                format!("{label}:{}", source.line_of(span.start))
             }
-            (None, None, None) => refuse!("{label}: no run length: give --until T or --steps N"),
+            _ => label.to_string(),
         };
         let mut sim = built.simulation;
         if let (RunLength::Until(t), None) = (length, resumed) {

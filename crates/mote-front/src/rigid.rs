@@ -50,7 +50,10 @@ fn run_with(
             (options.system.is_some(), "--system", crate::WHY_NO_SYSTEM),
         ],
     )?;
-    let scene = RigidScene::parse(&input.text, &input.label)?;
+    let mut scene = RigidScene::parse(&input.text, &input.label)?;
+    scene
+        .run
+        .with_options(options.dt, options.steps, options.until);
     let format = options.trajectory_format(
         scene
             .output
@@ -111,29 +114,8 @@ impl EngineRun for RigidRun {
     ) -> Result<RigidDynamics, FrontError> {
         let (text, label) = (&self.input.text, &self.input.label);
         let options = &self.options;
-        let mut built = self.scene.build(text, label, Some(seed))?;
+        let built = self.scene.build(text, label, Some(seed))?;
         self.nip = mote_nip::probe(&self.scene, text, label)?;
-        let until_steps = |t: f64, dt: f64| {
-            mote_run::steps_until(0.0, t, dt).ok_or_else(|| {
-                let n = mote_io::system::human_number;
-                MdError::Length(format!(
-                    "until {} with dt = {}: not a number of steps a run can take",
-                    n(t),
-                    n(dt)
-                ))
-            })
-        };
-        if let Some(dt) = options.dt {
-            if let Some(t) = self.scene.run.get_ref().until {
-                built.steps = until_steps(t, dt)?;
-            }
-            built.dt = dt;
-        }
-        if let Some(n) = options.steps {
-            built.steps = n;
-        } else if let Some(t) = options.until {
-            built.steps = until_steps(t, built.dt)?;
-        }
         if resumed.is_none() {
             mote_run::check_run_length(built.steps, built.dt, options.force)
                 .map_err(|m| MdError::Length(format!("{label}: {m}")))?;

@@ -145,3 +145,48 @@ fn a_step_count_is_refused_or_taken_alike_as_option_and_scene_key() {
         }
     }
 }
+
+/// Every engine reads the one `[run]` table: a key an engine cannot take
+/// is refused at its line with the reason, not read as something else
+/// nor passed over.
+#[test]
+fn a_run_key_an_engine_cannot_take_is_refused_at_its_line() {
+    let refused = |template: &str, run: &str| {
+        let (taken, message) = outcome(template, run, RunOptions::default());
+        assert!(!taken, "{run}: {message}");
+        message
+    };
+    let line = |template: &str| template.lines().position(|l| l == "[run]").unwrap() + 2;
+    let m = refused(RIGID, "integrator = \"rk4\"\ndt = 0.01\nsteps = 3");
+    assert_eq!(
+        m,
+        format!(
+            "s.toml:{}: [run] integrator: rigid bodies are moved by the FRBI only",
+            line(RIGID)
+        )
+    );
+    let m = refused(HARD_SPHERES, "dt = 0.01\nuntil = 1.0");
+    assert!(
+        m.starts_with(&format!(
+            "s.toml:{}: [run] dt: event-driven dynamics jumps from collision to collision",
+            line(HARD_SPHERES)
+        )),
+        "{m}"
+    );
+    let m = refused(POINTS, "dt = 0.01\nsteps = 3\nequilibrate = 1.0");
+    assert!(
+        m.starts_with(&format!(
+            "s.toml:{}: [run] equilibrate: point particles are measured from the first step",
+            line(POINTS) + 3
+        )),
+        "{m}"
+    );
+    let m = refused(RIGID, "dt = 0.01\nsteps = 3\nuntil = 1.0");
+    assert_eq!(
+        m,
+        format!(
+            "s.toml:{}: [run] takes steps or until, not both",
+            line(RIGID) + 2
+        )
+    );
+}

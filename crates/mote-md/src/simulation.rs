@@ -10,34 +10,7 @@ use crate::thermostat::Thermostat;
 use glam::DVec3;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-/// How long to run.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum RunLength {
-    /// A number of steps.
-    Steps(u64),
-    /// Until the first step at or past the simulated time T
-    /// ([`mote_run::steps_until`], the rule of every engine).
-    Until(f64),
-}
-
-impl RunLength {
-    /// Number of steps from time `t` with step `dt`; an error where `Until`
-    /// gives no count a run can take (a non-finite end, `dt = 1e-300`).
-    pub fn steps_from(self, t: f64, dt: f64) -> Result<u64, MdError> {
-        match self {
-            RunLength::Steps(n) => Ok(n),
-            RunLength::Until(end) => mote_run::steps_until(t, end, dt).ok_or_else(|| {
-                let n = mote_io::system::human_number;
-                MdError::Length(format!(
-                    "until {} from t = {} with dt = {}: not a number of steps a run can take",
-                    n(end),
-                    n(t),
-                    n(dt)
-                ))
-            }),
-        }
-    }
-}
+pub use mote_run::scene::RunLength;
 
 /// What a time-stepped run did.
 pub type RunReport = mote_run::Report<Observables>;
@@ -86,7 +59,10 @@ impl Simulation {
         length: RunLength,
         mut progress: impl FnMut(&System),
     ) -> Result<RunReport, MdError> {
-        let last = self.system.step + length.steps_from(self.system.time, self.dt)?;
+        let last = self.system.step
+            + length
+                .steps_from(self.system.time, self.dt)
+                .map_err(MdError::Length)?;
         mote_run::Driver::new().run(self, |_| last, |s| progress(&s.system))
     }
 

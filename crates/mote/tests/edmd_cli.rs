@@ -130,7 +130,7 @@ fn scene_file_runs_and_errors_name_file_and_line() {
     let good = dir.path().join("eos.toml");
     std::fs::write(
         &good,
-        "# small hard-sphere fluid\ndimension = 3\nn = 500\npacking_fraction = 0.2\nseed = 3\nequilibrate = 2.0\ntime = 4.0\nobservables = \"eos.csv\"\n",
+        "# small hard-sphere fluid\nseed = 3\n[event_driven]\ndimension = 3\nn = 500\npacking_fraction = 0.2\n[run]\nequilibrate = 2.0\nuntil = 6.0\n",
     )
     .unwrap();
     let out = mote().arg("edmd").arg(&good).output().unwrap();
@@ -141,29 +141,38 @@ fn scene_file_runs_and_errors_name_file_and_line() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Compressibility factor Z"), "{text}");
-    // The first format's top-level keys still work, with a note each on
-    // what to write instead.
-    assert!(dir.path().join("eos.csv").exists());
-    assert!(
-        text.contains("note: top-level `time` and `equilibrate` are deprecated and go in one release: write [run] until = 6, equilibrate = 2"),
-        "{text}"
-    );
-    assert!(
-        text.contains("note: top-level `observables` is deprecated"),
-        "{text}"
-    );
+    assert!(dir.path().join("observables.csv").exists(), "{text}");
 
     let bad = dir.path().join("bad.toml");
     std::fs::write(
         &bad,
-        "dimension = 3\nn = 500\npacking_fraction = 0.2\ntime = \"long\"\n",
+        "[event_driven]\ndimension = 3\nn = 500\npacking_fraction = 0.2\n[run]\nuntil = \"long\"\n",
     )
     .unwrap();
     let out = mote().arg("edmd").arg(&bad).output().unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains(&format!("{}:4: ", bad.display())), "{err}");
+    assert!(err.contains(&format!("{}:6: ", bad.display())), "{err}");
     assert!(!err.contains("panicked"), "{err}");
+
+    // The first format's top-level keys are refused at their line with
+    // the spelling that replaced them.
+    let old = dir.path().join("old.toml");
+    std::fs::write(
+        &old,
+        "dimension = 3\nn = 500\npacking_fraction = 0.2\ntime = 4.0\n",
+    )
+    .unwrap();
+    let out = mote().arg("edmd").arg(&old).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(&format!(
+            "{}:1: `dimension` says what the hard spheres are: it goes in [event_driven]",
+            old.display()
+        )),
+        "{err}"
+    );
 
     let out = mote().args(["edmd", "example:nope"]).output().unwrap();
     assert!(!out.status.success());

@@ -817,14 +817,14 @@ fn requests_too_large_for_the_machine_are_refused_at_once() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
         dir.path().join("hs.toml"),
-        "dimension = 3\nn = 100000000000\npacking_fraction = 0.3\n",
+        "[event_driven]\ndimension = 3\nn = 100000000000\npacking_fraction = 0.3\n",
     )
     .unwrap();
     let o = mote(&["run", "hs.toml"], dir.path());
     assert_eq!(o.status.code(), Some(1));
     let err = stderr(&o);
     assert!(
-        err.contains("hs.toml:2: n = 100000000000 needs at least 30.0 TB, and this machine has"),
+        err.contains("hs.toml:3: n = 100000000000 needs at least 30.0 TB, and this machine has"),
         "{err}"
     );
     std::fs::write(

@@ -32,7 +32,7 @@ impl HardSpheres {
     /// `mote run` refuses it, if it expects more than 10⁹ events unless
     /// `force`d.
     pub fn build(input: &Input, seed: Option<u64>, force: bool) -> Result<(Self, u64), FrontError> {
-        if input.plist || input.engine() != Engine::EventDriven {
+        if input.plist || input.engine()? != Engine::EventDriven {
             return Err(FrontError::request(format!(
                 "{}: not an event-driven scene (no [event_driven] table)",
                 input.label
@@ -42,7 +42,7 @@ impl HardSpheres {
         let (seed, _) = crate::seed::resolve(seed, scene.seed);
         let dir = input.folder();
         let every = 1;
-        let run = if scene.dimension == 2 {
+        let run = if scene.spheres.dimension == 2 {
             HardSpheres::Disks(Stepper::new(
                 EventDriven::new(&scene, seed, &dir, force)?,
                 every,

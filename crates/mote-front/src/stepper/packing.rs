@@ -49,7 +49,7 @@ impl Packing {
     /// The packing `mote run` grows from a `[packing]` scene with `seed`
     /// (the scene's when `None`), with the seed it uses.
     pub fn build(input: &Input, seed: Option<u64>) -> Result<(Self, u64), FrontError> {
-        if input.plist || input.engine() != Engine::Packing {
+        if input.plist || input.engine()? != Engine::Packing {
             return Err(FrontError::request(format!(
                 "{}: not a packing scene (no [packing] table)",
                 input.label

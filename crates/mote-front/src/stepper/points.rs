@@ -77,7 +77,7 @@ impl Points {
                 input.label
             )));
         }
-        match input.engine() {
+        match input.engine()? {
             Engine::Particles => {}
             other => {
                 return Err(FrontError::request(format!(
@@ -240,11 +240,12 @@ impl Points {
     pub fn scene_steps(&self) -> Result<Option<u64>, FrontError> {
         let scene = Scene::parse(&self.text, &self.label)?;
         let src = mote_io::Source::new(&self.label, &self.text);
-        let length = scene.run.schedule(src)?.2;
+        let length = scene.run.length(src)?;
         let sys = &self.sim().system;
-        Ok(length
+        length
             .map(|l| l.steps_from(sys.time, self.sim().dt))
-            .transpose()?)
+            .transpose()
+            .map_err(FrontError::request)
     }
 
     pub fn label(&self) -> &str {

@@ -49,7 +49,7 @@ impl Rigid {
     /// The run `mote run` makes of a rigid scene (text labelled `label`)
     /// with `seed` (the scene's when `None`).
     pub fn build(text: &str, label: &str, seed: Option<u64>) -> Result<Self, FrontError> {
-        if Engine::of_scene(text) != Engine::Rigid {
+        if Engine::read(label, text)? != Engine::Rigid {
             return Err(FrontError::request(format!(
                 "{label}: not a rigid scene (no [rigid] table): use mote.Simulation or mote.run"
             )));

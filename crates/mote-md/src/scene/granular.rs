@@ -101,7 +101,7 @@ impl Section for GranularSettings {
         if radius.iter().any(|r| *r <= 0.0) {
             return bad("[granular] needs every particle to have a radius > 0");
         }
-        let integrator = &scene.run.integrator;
+        let integrator = super::run::integrator_setting(&scene.run);
         if Integrator::from_name(&integrator.value) != Some(Integrator::LeapFrog) {
             return Err(integrator.error(
                 src,

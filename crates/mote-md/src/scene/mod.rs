@@ -45,7 +45,7 @@ use crate::force::{ForceField, SpringNetwork};
 use crate::integrate::Stepper;
 use crate::observe::Probe;
 use crate::particles::{Particles, System};
-use crate::simulation::{RunLength, Simulation};
+use crate::simulation::Simulation;
 use crate::units::UnitSystem;
 
 pub use bath::{BrownianSettings, DampingSettings, ThermostatSettings};
@@ -54,12 +54,13 @@ pub use electric::{CoulombSettings, ElectricFieldSettings};
 pub use granular::{GranularSettings, WallSpec};
 pub use gravity::{FieldSettings, GravitySettings};
 pub use lennard_jones::LennardJonesSettings;
+pub use mote_run::scene::{BoxTable, Origin, RunLength, RunTable, Setting};
 pub use particles::{
     AnnulusSpec, CloudSpec, DataSpec, FccSpec, LatticeSpec, LatticeSprings, ModeSpec, ParticleSpec,
     PlummerSpec, Properties, RandomBoxSpec, RingSpec, SpeedSpec, SpringSpec,
 };
 pub use plist::PlistSystem;
-pub use run::{BoxSettings, Origin, OutputSettings, RunSettings, Setting};
+pub use run::OutputSettings;
 
 /// A whole scene file.
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -74,7 +75,7 @@ pub struct Scene {
     /// Seed of the random generators; chosen and printed when absent.
     pub seed: Option<u64>,
     #[serde(default)]
-    pub run: RunSettings,
+    pub run: RunTable,
     pub gravity: Option<Spanned<GravitySettings>>,
     pub field: Option<Spanned<FieldSettings>>,
     pub damping: Option<Spanned<DampingSettings>>,
@@ -91,7 +92,7 @@ pub struct Scene {
     #[serde(default)]
     pub wall: Vec<Spanned<WallSpec>>,
     #[serde(rename = "box")]
-    pub bounds: Option<Spanned<BoxSettings>>,
+    pub bounds: Option<Spanned<BoxTable>>,
     #[serde(default)]
     pub particle: Vec<Spanned<ParticleSpec>>,
     #[serde(default)]
@@ -222,13 +223,13 @@ impl Scene {
 
         let brownian = bath::brownian(&self.brownian, &b)?;
         let thermostat = bath::thermostat(&self.thermostat, src)?;
-        let (integrator, dt, length) = self.run.schedule(src)?;
+        let (integrator, dt, length) = run::schedule(&self.run, src)?;
         let probes = self.output.probes(src, b.particles.len())?;
         let mut system = System::new(b.particles);
         system.species = made.species;
         system.boundary = b.boundary;
         system.wrap_positions();
-        if self.run.centre_of_mass {
+        if self.run.centre_of_mass.as_ref().is_some_and(|c| c.value) {
             system.to_centre_of_mass_frame();
         }
         let mut forces = b.forces;

@@ -36,8 +36,8 @@ impl Scene {
             units: UnitSystem::Astro,
             ..Scene::default()
         };
-        scene.run.integrator = super::run::Setting::plain(solver.to_string());
-        scene.run.dt = pf.dt.map(super::run::Setting::plain);
+        scene.run.integrator = Some(super::Setting::plain(solver.to_string()));
+        scene.run.dt = pf.dt.map(super::Setting::plain);
         for p in &pf.particles {
             scene.particle.push(Spanned::new(
                 0..0,

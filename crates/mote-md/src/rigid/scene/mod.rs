@@ -149,7 +149,9 @@ pub struct RigidScene {
     #[serde(default)]
     pub title: Option<String>,
     pub rigid: Spanned<RigidSettings>,
-    pub run: Spanned<RunSettings>,
+    /// `[run]`: `dt` and the length (`steps` or `until`).
+    #[serde(default)]
+    pub run: crate::scene::RunTable,
     /// `[[from_file]]`: bodies from a frame of their spheres (the key every
     /// engine starts from a file with; `templates` and `tolerance` are
     /// this engine's own).
@@ -159,7 +161,7 @@ pub struct RigidScene {
     /// periodic axes (default all). The contacts search across its
     /// periodic faces; the planes, the roller and the nip take its faces.
     #[serde(rename = "box", default)]
-    pub bounds: Option<Spanned<crate::scene::BoxSettings>>,
+    pub bounds: Option<Spanned<crate::scene::BoxTable>>,
     /// The `[output]` of every time-stepped engine (`inspect`, which names
     /// point particles, is refused).
     #[serde(default)]
@@ -206,17 +208,6 @@ pub struct RigidSettings {
     /// only lets it through.
     #[serde(default)]
     pub nip: Option<serde::de::IgnoredAny>,
-}
-
-/// `[run]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RunSettings {
-    pub dt: f64,
-    #[serde(default)]
-    pub steps: Option<u64>,
-    #[serde(default)]
-    pub until: Option<f64>,
 }
 
 /// The built scene: bodies, the integrator and what to run.
@@ -424,42 +415,36 @@ impl RigidScene {
         add(&rigid.roller, self, &mut b)?;
 
         // Run length.
-        let (rspan, run) = (self.run.span(), self.run.get_ref());
-        if !positive(run.dt) {
-            return Err(err(rspan, "[run] dt must be > 0".into()));
-        }
-        let steps = match (run.steps, run.until) {
-            (Some(s), None) => s,
-            (None, Some(t)) if t <= 0.0 => {
-                return Err(err(
-                    rspan,
-                    format!("[run] until = {t}: must be a time after the start (t = 0)"),
-                ))
-            }
-            (None, Some(t)) => match mote_run::steps_until(0.0, t, run.dt) {
-                Some(n) => n,
-                None => {
-                    return Err(err(
-                        rspan,
-                        format!(
-                            "[run] until = {} with dt = {}: not a number of steps a run can take",
-                            mote_io::system::human_number(t),
-                            mote_io::system::human_number(run.dt)
-                        ),
-                    ))
-                }
-            },
-            _ => {
-                return Err(err(
-                    rspan,
-                    "[run] needs exactly one of `steps` and `until`".into(),
-                ))
-            }
+        let run = &self.run;
+        run.refuse(
+            src,
+            &[
+                ("integrator", "rigid bodies are moved by the FRBI only"),
+                (
+                    "equilibrate",
+                    "rigid bodies are measured from the first step; equilibrate is the event-driven engine's",
+                ),
+                (
+                    "centre_of_mass",
+                    "rigid bodies keep the frame they are placed in",
+                ),
+            ],
+        )?;
+        let dt = run
+            .time_step(src)?
+            .ok_or_else(|| src.whole("[run] needs a time step: dt = ..."))?;
+        let Some(length) = run.length(src)? else {
+            return Err(src.whole("[run] needs exactly one of `steps` and `until`"));
         };
+        // Only an end time can fail to give a count.
+        let steps = length.steps_from(0.0, dt).map_err(|m| match &run.until {
+            Some(until) => until.error(src, m),
+            None => src.whole(m),
+        })?;
         Ok(BuiltRigid {
             bodies: b.bodies,
             frbi: b.frbi,
-            dt: run.dt,
+            dt,
             steps,
             seed,
         })
@@ -481,7 +466,12 @@ impl RigidScene {
     /// has one.
     pub fn box_faces(&self) -> Option<(DVec3, DVec3, [bool; 3])> {
         let b = self.bounds.as_ref()?.get_ref();
-        Some((DVec3::from(b.lo), DVec3::from(b.hi), b.periodic))
+        let corner = |c: &Option<Spanned<Vec<f64>>>| {
+            let c = c.as_ref()?.get_ref();
+            (c.len() == 3).then(|| DVec3::from_slice(c))
+        };
+        let p = b.periodic(3);
+        Some((corner(&b.lo)?, corner(&b.hi)?, [p[0], p[1], p[2]]))
     }
 
     /// `[box]` checked (lo < hi on every axis), with its span.
