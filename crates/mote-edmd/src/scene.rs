@@ -15,7 +15,7 @@ use crate::init::{
     thermal_velocities,
 };
 
-use mote_run::scene::{BoxTable, RunTable};
+use mote_run::scene::{BoxTable, OutputTable, RunTable};
 use toml::Spanned;
 
 use crate::system::{Boundary, SimBox, System};
@@ -50,9 +50,10 @@ pub struct Scene {
     /// `[run]`: `until` and `equilibrate` (the time-stepped keys are refused).
     #[serde(default)]
     pub run: RunTable,
-    /// `[output]`: the files, as for every engine.
+    /// `[output]`: the files, as for every engine (`interval` and the
+    /// files on or off; the step counts are refused).
     #[serde(default)]
-    pub output: OutputSection,
+    pub output: OutputTable,
     /// `[box]`, as every engine spells it (`lo` must be the origin).
     #[serde(rename = "box")]
     bounds: Option<Spanned<BoxTable>>,
@@ -211,47 +212,6 @@ impl Default for BoundarySpec {
 struct FileStart {
     file: String,
     frame: Option<i64>,
-}
-
-/// `[output]` of an event-driven scene. Files go to `dir` (default
-/// `out/<scene name>`) under the names every engine uses.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputSection {
-    pub dir: Option<String>,
-    /// Simulated time between rows of observables.csv and frames of
-    /// trajectory.xyz (default a hundredth of the measured time).
-    pub interval: Option<f64>,
-    /// Write observables.csv (default true).
-    #[serde(default = "yes")]
-    pub observables: bool,
-    /// Write the trajectory (default true).
-    #[serde(default = "yes")]
-    pub trajectory: bool,
-    /// Its format: `xyz` (default), `dump`, `gsd` or `vtk`; the file is
-    /// `trajectory.<xyz|dump|gsd|pvd>`.
-    pub trajectory_format: Option<String>,
-    /// Write speeds.csv, the speed histogram at the end (default true).
-    #[serde(default = "yes")]
-    pub histogram: bool,
-    /// Keys of the time-stepped engines, read only to be refused with the reason.
-    observables_every: Option<toml::Value>,
-    trajectory_every: Option<toml::Value>,
-}
-
-impl Default for OutputSection {
-    fn default() -> Self {
-        Self {
-            dir: None,
-            interval: None,
-            observables: true,
-            trajectory: true,
-            trajectory_format: None,
-            histogram: true,
-            observables_every: None,
-            trajectory_every: None,
-        }
-    }
 }
 
 /// The keys of `[event_driven]`: what the hard spheres or disks are and
@@ -431,16 +391,22 @@ impl Scene {
                 ),
             ],
         )?;
-        let stepped = [
-            ("observables_every", self.output.observables_every.is_some()),
-            ("trajectory_every", self.output.trajectory_every.is_some()),
-        ];
-        if let Some((key, _)) = stepped.iter().find(|(_, given)| *given) {
-            return Err(err(
-                key,
-                format!("`{key}` is for time-stepped engines; {NO_STEP}: give [output] interval = (simulated time)"),
-            ));
-        }
+        let stepped = format!("{NO_STEP}: give [output] interval = (simulated time)");
+        self.output.refuse(
+            source,
+            &[
+                ("observables_every", &stepped),
+                ("trajectory_every", &stepped),
+                (
+                    "inspect",
+                    "it adds columns of point particles to a time-stepped run's table",
+                ),
+                (
+                    "pressure_tensor",
+                    "hard spheres' pressure is the collision virial, in the summary (Z = PV/NkT)",
+                ),
+            ],
+        )?;
         self.equilibrate = self.run.equilibrate.as_ref().map_or(0.0, |e| e.value);
         self.time = match &self.run.until {
             Some(until) => {
@@ -462,24 +428,15 @@ impl Scene {
             None => DEFAULT_TIME,
         };
         let o = &self.output;
-        self.output_interval = o.interval;
-        let format = match &o.trajectory_format {
-            None => mote_io::trajectory::Format::Xyz,
-            Some(f) => mote_io::trajectory::Format::named(f).ok_or_else(|| {
-                err(
-                    "trajectory_format",
-                    format!(
-                        "trajectory_format '{f}' is not one of {}",
-                        mote_io::trajectory::Format::NAMES
-                    ),
-                )
-            })?,
-        };
+        self.output_interval = o.interval.as_ref().map(|i| i.value);
+        let format = o.trajectory_format(source)?;
         self.trajectory = o
-            .trajectory
+            .writes(&o.trajectory)
             .then(|| format!("trajectory.{}", format.extension()));
-        self.observables = o.observables.then(|| "observables.csv".to_string());
-        self.histogram = o.histogram.then(|| "speeds.csv".to_string());
+        self.observables = o
+            .writes(&o.observables)
+            .then(|| "observables.csv".to_string());
+        self.histogram = o.writes(&o.histogram).then(|| "speeds.csv".to_string());
         Ok(())
     }
     /// Reads and parses a scene file.
@@ -946,7 +903,7 @@ mod tests {
         let text = format!("{SYSTEM}[output]\ntrajectory_every = 10\n");
         let e = Scene::parse(&text, "stepped.toml").unwrap_err().to_string();
         assert!(
-            e.starts_with("stepped.toml:6: `trajectory_every` is for time-stepped engines"),
+            e.starts_with("stepped.toml:6: [output] trajectory_every: event-driven dynamics jumps from collision to collision, with no time step: give [output] interval"),
             "{e}"
         );
         let text = format!("{SYSTEM}[run]\nuntil = 1.0\nequilibrate = 2.0\n");

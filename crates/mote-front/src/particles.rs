@@ -214,7 +214,7 @@ impl EngineRun for PointsRun {
 
     fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
         Ok(crate::runner::scene_trajectory(
-            self.scene.output.trajectory_every,
+            self.scene.output.trajectory_every(),
             self.format,
         ))
     }
@@ -281,12 +281,12 @@ pub(crate) fn table_observers(
     let (dir, provenance, append) = (&files.dir, &files.provenance, files.append);
     let out = &scene.output;
     let mut observers: Vec<Box<dyn mote_run::Observer<Simulation>>> = Vec::new();
-    if out.observables_every > 0 {
+    if out.observables_every() > 0 {
         let mut csv = ObservablesCsv::create(
             &dir.join("observables.csv"),
             provenance,
             scene.units,
-            out.observables_every,
+            out.observables_every(),
             probes.to_vec(),
             sim.system.boundary.periodic.iter().all(|p| *p)
                 && sim.forces.without_virial().is_empty(),
@@ -381,14 +381,14 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
 /// row) against the free space of the nearest folder that exists.
 fn check_disk(
     dir: &Path,
-    out: &mote_md::scene::OutputSettings,
+    out: &mote_md::scene::OutputTable,
     steps: u64,
     particles: usize,
 ) -> Result<(), String> {
     // Every `every` steps and at the start; never where `every` is 0.
     let frames = |every: u64| steps.checked_div(every).map_or(0.0, |n| (n + 1) as f64);
-    let bytes = frames(out.trajectory_every) * particles as f64 * 12.0
-        + frames(out.observables_every) * 100.0;
+    let bytes = frames(out.trajectory_every()) * particles as f64 * 12.0
+        + frames(out.observables_every()) * 100.0;
     let existing = dir
         .ancestors()
         .find(|p| p.exists())

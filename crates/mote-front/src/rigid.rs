@@ -146,7 +146,7 @@ impl EngineRun for RigidRun {
                 &files.dir.join("observables.csv"),
                 &files.provenance,
                 &self.walls,
-                self.scene.output.observables_every.max(1),
+                self.scene.output.observables_every().max(1),
                 self.pressure,
                 files.append,
             )?)];
@@ -164,7 +164,7 @@ impl EngineRun for RigidRun {
 
     fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
         Ok(crate::runner::scene_trajectory(
-            self.scene.output.trajectory_every,
+            self.scene.output.trajectory_every(),
             self.format,
         ))
     }

@@ -190,3 +190,56 @@ fn a_run_key_an_engine_cannot_take_is_refused_at_its_line() {
         )
     );
 }
+
+/// Every engine reads the one `[output]` table: the step counts of the
+/// time-stepped engines, the time interval and file switches of the
+/// event-driven one, a packing's folder and format; a key an engine cannot
+/// take is refused at its line with the reason.
+#[test]
+fn an_output_key_an_engine_cannot_take_is_refused_at_its_line() {
+    let refused = |text: &str| {
+        let (taken, message) = outcome(text, "", RunOptions::default());
+        assert!(!taken, "{text}: {message}");
+        message
+    };
+    let line_of =
+        |text: &str, key: &str| text.lines().position(|l| l.starts_with(key)).expect(key) + 1;
+    let points = POINTS.replace("{run}", "dt = 0.01\nsteps = 3\n[output]\ninterval = 0.5");
+    let m = refused(&points);
+    assert!(
+        m.starts_with(&format!(
+            "s.toml:{}: [output] interval: a time-stepped run counts steps",
+            line_of(&points, "interval")
+        )),
+        "{m}"
+    );
+    let hard = HARD_SPHERES
+        .replace("{run}", "until = 0.5")
+        .replace("[output]\n", "[output]\nobservables_every = 5\n");
+    let m = refused(&hard);
+    assert!(
+        m.starts_with(&format!(
+            "s.toml:{}: [output] observables_every: event-driven dynamics jumps",
+            line_of(&hard, "observables_every")
+        )),
+        "{m}"
+    );
+    let rigid = RIGID.replace(
+        "{run}",
+        "dt = 0.01\nsteps = 3\n[output]\ninspect = [\"z[0]\"]",
+    );
+    let m = refused(&rigid);
+    assert!(
+        m.starts_with(&format!(
+            "s.toml:{}: [output] inspect: it names point particles",
+            line_of(&rigid, "inspect")
+        )),
+        "{m}"
+    );
+    let packing = "seed = 1\n[packing]\nn = 100\n[output]\ninterval = 1.0\n";
+    assert!(
+        refused(packing).starts_with("s.toml:5: [output] interval: a packing writes packing.xyz")
+    );
+    let packing = "seed = 1\n[packing]\nn = 100\n[run]\nuntil = 1.0\n";
+    assert!(refused(packing).starts_with("s.toml:5: [run] until: a packing grows until it jams"));
+}

@@ -112,7 +112,7 @@ pub fn probe(
             ))
         }
         Some(n) => n,
-        None => scene.output.observables_every.max(1),
+        None => scene.output.observables_every().max(1),
     };
     Ok(Some((probe, every)))
 }

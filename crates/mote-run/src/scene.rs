@@ -1,5 +1,6 @@
 //! The tables of the scene envelope every engine reads the same way:
-//! `[run]` (what the run's length and step are) and `[box]` (the box), with
+//! `[run]` (what the run's length and step are), `[output]` (the folder and
+//! when files are written) and `[box]` (the box), with
 //! each value's origin, so that an error names the line that gave it, or
 //! the command-line option that replaced it.
 //!
@@ -10,6 +11,7 @@
 use serde::Deserialize;
 use toml::Spanned;
 
+use mote_io::trajectory::Format;
 use mote_io::{ParseError, Source};
 
 /// A setting and where it was given.
@@ -122,12 +124,38 @@ pub struct RunTable {
     pub centre_of_mass: Option<Setting<bool>>,
 }
 
+/// A `file:line: [table] key: why` error for the first of `keys` that
+/// `given` finds (its origin and value as written), `file: --option value:
+/// why` where an option gave it.
+fn refuse_given(
+    table: &str,
+    src: Source,
+    keys: &[(&str, &str)],
+    given: impl Fn(&str) -> Option<(Origin, String)>,
+) -> Result<(), ParseError> {
+    for (key, why) in keys {
+        if let Some((origin, value)) = given(key) {
+            let message = format!("[{table}] {key}: {why}");
+            return Err(match origin {
+                Origin::Scene(span) => src.error(span, message),
+                Origin::Option(option) => {
+                    ParseError::new(src.file, 0, format!("{option} {value}: {why}"))
+                }
+                Origin::Default => src.whole(message),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The origin and the value as written of a setting, if it was given.
+fn shown<T: std::fmt::Display>(s: &Option<Setting<T>>) -> Option<(Origin, String)> {
+    s.as_ref().map(|s| (s.origin.clone(), s.value.to_string()))
+}
+
 impl RunTable {
     /// Where `key` was given and its value as written, if it was.
-    fn given(&self, key: &str) -> Option<(&Origin, String)> {
-        fn shown<T: std::fmt::Display>(s: &Option<Setting<T>>) -> Option<(&Origin, String)> {
-            s.as_ref().map(|s| (&s.origin, s.value.to_string()))
-        }
+    fn given(&self, key: &str) -> Option<(Origin, String)> {
         match key {
             "integrator" => shown(&self.integrator),
             "dt" => shown(&self.dt),
@@ -142,19 +170,7 @@ impl RunTable {
     /// Refuses the first of `keys` the scene (or an option) gave, with its
     /// reason: `file:line: [run] key: why`.
     pub fn refuse(&self, src: Source, keys: &[(&str, &str)]) -> Result<(), ParseError> {
-        for (key, why) in keys {
-            if let Some((origin, value)) = self.given(key) {
-                let message = format!("[run] {key}: {why}");
-                return Err(match origin {
-                    Origin::Scene(span) => src.error(span.clone(), message),
-                    Origin::Option(option) => {
-                        ParseError::new(src.file, 0, format!("{option} {value}: {why}"))
-                    }
-                    Origin::Default => src.whole(message),
-                });
-            }
-        }
-        Ok(())
+        refuse_given("run", src, keys, |k| self.given(k))
     }
 
     /// The time step, where one is given: positive and finite, else an
@@ -201,6 +217,99 @@ impl RunTable {
             self.until = Some(Setting::from_option("--until", t));
             self.steps = None;
         }
+    }
+}
+
+/// `[output]`, as every engine spells it: the folder, and when and how
+/// the files are written. The time-stepped engines count steps
+/// (`observables_every`, `trajectory_every`; 0 turns a file off), the
+/// event-driven engine counts time (`interval`) and switches files on and
+/// off (`observables`, `trajectory`, `histogram`); each engine refuses the
+/// keys it cannot take at their line ([`OutputTable::refuse`]).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputTable {
+    /// Folder of the output files (default `out/<scene name>`).
+    pub dir: Option<String>,
+    /// Steps between rows of observables.csv (default 10); 0 turns it off.
+    pub observables_every: Option<Setting<u64>>,
+    /// Steps between frames of the trajectory (default 100); 0 turns it off.
+    pub trajectory_every: Option<Setting<u64>>,
+    /// Simulated time between rows and frames (event-driven runs).
+    pub interval: Option<Setting<f64>>,
+    /// Write observables.csv (event-driven runs; default true).
+    pub observables: Option<Setting<bool>>,
+    /// Write the trajectory (event-driven runs; default true).
+    pub trajectory: Option<Setting<bool>>,
+    /// Write speeds.csv, the speed histogram (event-driven runs; default true).
+    pub histogram: Option<Setting<bool>>,
+    /// Format of the trajectory: `xyz` (default), `dump`, `gsd` or `vtk`.
+    pub trajectory_format: Option<Setting<String>>,
+    /// Per-particle quantities added to observables.csv (point particles).
+    #[serde(default)]
+    pub inspect: Vec<Spanned<String>>,
+    /// Add the pressure tensor to observables.csv (point particles).
+    pub pressure_tensor: Option<Setting<bool>>,
+}
+
+impl OutputTable {
+    /// Steps between rows of observables.csv (default 10; 0: none).
+    pub fn observables_every(&self) -> u64 {
+        self.observables_every.as_ref().map_or(10, |s| s.value)
+    }
+
+    /// Steps between frames of the trajectory (default 100; 0: none).
+    pub fn trajectory_every(&self) -> u64 {
+        self.trajectory_every.as_ref().map_or(100, |s| s.value)
+    }
+
+    /// Whether a file the event-driven engine switches (`observables`,
+    /// `trajectory`, `histogram`) is written: as given, else yes.
+    pub fn writes(&self, file: &Option<Setting<bool>>) -> bool {
+        file.as_ref().is_none_or(|s| s.value)
+    }
+
+    /// The trajectory's format (`trajectory_format`, default extended XYZ),
+    /// else an error at its line naming the formats.
+    pub fn trajectory_format(&self, src: Source) -> Result<Format, ParseError> {
+        match &self.trajectory_format {
+            None => Ok(Format::Xyz),
+            Some(f) => Format::named(&f.value).ok_or_else(|| {
+                f.error(
+                    src,
+                    format!(
+                        "trajectory_format '{}' is not one of {}",
+                        f.value,
+                        Format::NAMES
+                    ),
+                )
+            }),
+        }
+    }
+
+    /// Where `key` was given and its value as written, if it was.
+    fn given(&self, key: &str) -> Option<(Origin, String)> {
+        match key {
+            "observables_every" => shown(&self.observables_every),
+            "trajectory_every" => shown(&self.trajectory_every),
+            "interval" => shown(&self.interval),
+            "observables" => shown(&self.observables),
+            "trajectory" => shown(&self.trajectory),
+            "histogram" => shown(&self.histogram),
+            "trajectory_format" => shown(&self.trajectory_format),
+            "pressure_tensor" => shown(&self.pressure_tensor),
+            "inspect" => self
+                .inspect
+                .first()
+                .map(|p| (Origin::Scene(p.span()), p.get_ref().clone())),
+            _ => None,
+        }
+    }
+
+    /// Refuses the first of `keys` the scene gave, with its reason:
+    /// `file:line: [output] key: why`.
+    pub fn refuse(&self, src: Source, keys: &[(&str, &str)]) -> Result<(), ParseError> {
+        refuse_given("output", src, keys, |k| self.given(k))
     }
 }
 

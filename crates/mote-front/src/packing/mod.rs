@@ -650,7 +650,9 @@ fn write_pov(frame: &mote_io::xyz::Frame, path: &Path) -> Result<(), FrontError>
     Ok(())
 }
 
-/// A packing scene: `title`, `seed`, `[packing]` and `[output] dir`.
+/// A packing scene: `title`, `seed`, `[packing]` and `[output]` (`dir`,
+/// `trajectory_format`); the envelope's other keys are refused with the
+/// reason.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PackingScene {
@@ -659,22 +661,46 @@ struct PackingScene {
     seed: Option<u64>,
     packing: PackingSpec,
     #[serde(default)]
-    output: PackingOutput,
+    output: mote_run::scene::OutputTable,
     /// Read only to be refused with the reason.
-    run: Option<toml::Value>,
+    #[serde(default)]
+    run: mote_run::scene::RunTable,
 }
 
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PackingOutput {
-    dir: Option<String>,
-}
+/// Why a packing takes no run length.
+const WHY_NO_TIME: &str =
+    "a packing grows until it jams; bound it with [packing] phi, max_pressure, max_collisions or time_limit";
 
 impl PackingScene {
     /// The scene of `source`, its errors at their line.
     fn parse(source: mote_io::Source) -> Result<Self, FrontError> {
-        toml::from_str(source.text)
-            .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))
+        let scene: Self = toml::from_str(source.text)
+            .map_err(|e| FrontError::Parse(source.parser_error(e.span(), e.message())))?;
+        let run_keys = [
+            "integrator",
+            "dt",
+            "steps",
+            "until",
+            "equilibrate",
+            "centre_of_mass",
+        ];
+        let refused: Vec<(&str, &str)> = run_keys.iter().map(|k| (*k, WHY_NO_TIME)).collect();
+        scene.run.refuse(source, &refused)?;
+        const FILES: &str = "a packing writes packing.xyz (with .csv and .pov beside it); [output] takes dir and trajectory_format";
+        let output_keys = [
+            "observables_every",
+            "trajectory_every",
+            "interval",
+            "observables",
+            "trajectory",
+            "histogram",
+            "inspect",
+            "pressure_tensor",
+        ];
+        let refused: Vec<(&str, &str)> = output_keys.iter().map(|k| (*k, FILES)).collect();
+        scene.output.refuse(source, &refused)?;
+        scene.output.trajectory_format(source)?;
+        Ok(scene)
     }
 }
 
@@ -686,8 +712,6 @@ pub(crate) fn run(
     options: &RunOptions,
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
-    const WHY_NO_TIME: &str =
-        "a packing grows until it jams; bound it with [packing] phi, max_pressure, max_collisions or time_limit";
     options.refuse(
         "packings",
         &[
@@ -701,15 +725,8 @@ pub(crate) fn run(
     let source = mote_io::Source::new(&input.label, &input.text);
     source.finite_numbers().map_err(FrontError::Parse)?;
     let scene = PackingScene::parse(source)?;
-    if scene.run.is_some() {
-        refuse!(
-            "{}:{}: [run] has nothing to set for a packing: {WHY_NO_TIME}",
-            source.file,
-            source.key_line("run")
-        );
-    }
     let spec = &scene.packing;
-    let format = options.trajectory_format(Format::Xyz)?;
+    let format = options.trajectory_format(scene.output.trajectory_format(source)?)?;
     let grown = RefCell::new(None);
     PackRun {
         spec,

@@ -104,7 +104,7 @@ impl Points {
                 "{label}: no time step ([run] dt)"
             )));
         }
-        let mut stepper = Stepper::new(built.simulation, scene.output.observables_every);
+        let mut stepper = Stepper::new(built.simulation, scene.output.observables_every());
         let folder = match output {
             None => None,
             Some(dir) => {
@@ -127,7 +127,7 @@ impl Points {
                     stepper.observe_with(o);
                 }
                 if let Some(spec) =
-                    crate::runner::scene_trajectory(scene.output.trajectory_every, format)
+                    crate::runner::scene_trajectory(scene.output.trajectory_every(), format)
                 {
                     stepper
                         .observe_with(Box::new(crate::runner::trajectory_observer(&spec, &files)?));

@@ -56,7 +56,7 @@ impl Rigid {
         }
         let scene = RigidScene::parse(text, label)?;
         let built = scene.build(text, label, seed)?;
-        let every = scene.output.observables_every.max(1);
+        let every = scene.output.observables_every().max(1);
         let seed = built.seed;
         Ok(Rigid {
             stepper: Stepper::new(RigidDynamics::new(built), every),

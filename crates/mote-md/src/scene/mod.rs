@@ -54,13 +54,12 @@ pub use electric::{CoulombSettings, ElectricFieldSettings};
 pub use granular::{GranularSettings, WallSpec};
 pub use gravity::{FieldSettings, GravitySettings};
 pub use lennard_jones::LennardJonesSettings;
-pub use mote_run::scene::{BoxTable, Origin, RunLength, RunTable, Setting};
+pub use mote_run::scene::{BoxTable, Origin, OutputTable, RunLength, RunTable, Setting};
 pub use particles::{
     AnnulusSpec, CloudSpec, DataSpec, FccSpec, LatticeSpec, LatticeSprings, ModeSpec, ParticleSpec,
     PlummerSpec, Properties, RandomBoxSpec, RingSpec, SpeedSpec, SpringSpec,
 };
 pub use plist::PlistSystem;
-pub use run::OutputSettings;
 
 /// A whole scene file.
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -114,7 +113,7 @@ pub struct Scene {
     #[serde(default)]
     pub spring: Vec<Spanned<SpringSpec>>,
     #[serde(default)]
-    pub output: OutputSettings,
+    pub output: OutputTable,
 }
 
 /// A scene turned into its parts, ready to run.
@@ -224,7 +223,8 @@ impl Scene {
         let brownian = bath::brownian(&self.brownian, &b)?;
         let thermostat = bath::thermostat(&self.thermostat, src)?;
         let (integrator, dt, length) = run::schedule(&self.run, src)?;
-        let probes = self.output.probes(src, b.particles.len())?;
+        run::refuse_event_driven_output(&self.output, src)?;
+        let probes = run::probes(&self.output, src, b.particles.len())?;
         let mut system = System::new(b.particles);
         system.species = made.species;
         system.boundary = b.boundary;
@@ -234,8 +234,8 @@ impl Scene {
         }
         let mut forces = b.forces;
         if let Some(asked) = &self.output.pressure_tensor {
-            forces.pressure_tensor = *asked.get_ref();
-            pressure_tensor_measurable(&system, &mut forces, asked.span(), src)?;
+            forces.pressure_tensor = asked.value;
+            pressure_tensor_measurable(&system, &mut forces, asked, src)?;
         }
         Ok(Built {
             simulation: {
@@ -257,15 +257,15 @@ impl Scene {
 fn pressure_tensor_measurable(
     system: &System,
     forces: &mut ForceField,
-    span: Range<usize>,
+    asked: &Setting<bool>,
     src: Source,
 ) -> Result<(), ParseError> {
     if !forces.pressure_tensor {
         return Ok(());
     }
     if !system.boundary.periodic.iter().all(|p| *p) {
-        return Err(src.error(
-            span,
+        return Err(asked.error(
+            src,
             "pressure_tensor needs a box periodic on every axis ([box] periodic = [true, true, true])",
         ));
     }
@@ -273,8 +273,8 @@ fn pressure_tensor_measurable(
     let state = crate::force::State::of(system, &p.position, &p.velocity, system.time, 0.0);
     let without = forces.without_virial_tensor(&state);
     if !without.is_empty() {
-        return Err(src.error(
-            span,
+        return Err(asked.error(
+            src,
             format!(
                 "pressure_tensor: {} do{} not compute the virial tensor yet",
                 without.join(", "),

@@ -1,61 +1,17 @@
 //! `[run]` (integrator, time step, length: the envelope's
-//! [`RunTable`], read here for point particles), `[output]` (files and their
-//! intervals) and `[box]` (the simulation box).
+//! [`RunTable`], read here for point particles), `[output]` (the
+//! envelope's [`OutputTable`]: the inspected particles, the event-driven
+//! keys refused) and `[box]` (the simulation box).
 
 use glam::DVec3;
-use serde::Deserialize;
 use toml::Spanned;
 
-use mote_io::trajectory::Format;
 use mote_io::{ParseError, Source};
 
 use crate::boundary::Boundary;
 use crate::integrate::Integrator;
 use crate::observe::Probe;
-use mote_run::scene::{BoxTable, RunLength, RunTable, Setting};
-
-/// `[output]`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputSettings {
-    /// Folder of the output files (default `out/<scene name>`).
-    pub dir: Option<String>,
-    /// Steps between rows of observables.csv; 0 turns it off.
-    #[serde(default = "default_observables_every")]
-    pub observables_every: u64,
-    /// Steps between frames of the trajectory; 0 turns it off.
-    #[serde(default = "default_trajectory_every")]
-    pub trajectory_every: u64,
-    /// Format of the trajectory: `xyz` (default), `dump`, `gsd` or `vtk`;
-    /// the file is `trajectory.<xyz|dump|gsd|pvd>`.
-    pub trajectory_format: Option<Spanned<String>>,
-    /// Per-particle quantities added to observables.csv, e.g. `["z[30]", "speed[1]"]`.
-    #[serde(default)]
-    pub inspect: Vec<Spanned<String>>,
-    /// Add the pressure tensor (`pxx pyy pzz pxy pxz pyz`) to
-    /// observables.csv; a box periodic on every axis is needed.
-    pub pressure_tensor: Option<Spanned<bool>>,
-}
-
-fn default_observables_every() -> u64 {
-    10
-}
-fn default_trajectory_every() -> u64 {
-    100
-}
-
-impl Default for OutputSettings {
-    fn default() -> Self {
-        Self {
-            dir: None,
-            observables_every: default_observables_every(),
-            trajectory_every: default_trajectory_every(),
-            trajectory_format: None,
-            inspect: Vec::new(),
-            pressure_tensor: None,
-        }
-    }
-}
+use mote_run::scene::{BoxTable, OutputTable, RunLength, RunTable, Setting};
 
 /// The box of a time-stepped scene's `[box]` (the envelope's
 /// [`BoxTable`]): `lo` and `hi` on three axes, the periodic axes (default
@@ -126,37 +82,38 @@ pub fn schedule(
     Ok((known, dt, run.length(src)?))
 }
 
-impl OutputSettings {
-    /// The trajectory's format (`trajectory_format`, default extended XYZ).
-    pub fn trajectory_format(&self, src: Source) -> Result<Format, ParseError> {
-        match &self.trajectory_format {
-            None => Ok(Format::Xyz),
-            Some(f) => Format::named(f.get_ref()).ok_or_else(|| {
-                src.error(
-                    f.span(),
-                    format!(
-                        "trajectory_format '{}' is not one of {}",
-                        f.get_ref(),
-                        Format::NAMES
-                    ),
-                )
-            }),
-        }
-    }
+/// Refuses the `[output]` keys of the event-driven engine in a
+/// time-stepped scene (points or rigid bodies), with the spelling that
+/// counts steps.
+pub fn refuse_event_driven_output(output: &OutputTable, src: Source) -> Result<(), ParseError> {
+    const STEPS: &str = "a time-stepped run counts steps: observables_every = N, trajectory_every = N (0 turns a file off)";
+    output.refuse(
+        src,
+        &[
+            ("interval", STEPS),
+            ("observables", STEPS),
+            ("trajectory", STEPS),
+            (
+                "histogram",
+                "speeds.csv is the event-driven engine's; the speeds are in the trajectory",
+            ),
+        ],
+    )
+}
 
-    /// The per-particle columns of `inspect`, checked against the `n` particles.
-    pub fn probes(&self, src: Source, n: usize) -> Result<Vec<Probe>, ParseError> {
-        let mut probes = Vec::new();
-        for p in &self.inspect {
-            let probe = Probe::parse(p.get_ref()).map_err(|m| src.error(p.span(), m))?;
-            if probe.particle >= n {
-                return Err(src.error(
-                    p.span(),
-                    format!("inspect '{}': there are only {n} particles", p.get_ref()),
-                ));
-            }
-            probes.push(probe);
+/// The per-particle columns of `[output] inspect`, checked against the
+/// `n` particles.
+pub fn probes(output: &OutputTable, src: Source, n: usize) -> Result<Vec<Probe>, ParseError> {
+    let mut probes = Vec::new();
+    for p in &output.inspect {
+        let probe = Probe::parse(p.get_ref()).map_err(|m| src.error(p.span(), m))?;
+        if probe.particle >= n {
+            return Err(src.error(
+                p.span(),
+                format!("inspect '{}': there are only {n} particles", p.get_ref()),
+            ));
         }
-        Ok(probes)
+        probes.push(probe);
     }
+    Ok(probes)
 }

@@ -165,7 +165,7 @@ pub struct RigidScene {
     /// The `[output]` of every time-stepped engine (`inspect`, which names
     /// point particles, is refused).
     #[serde(default)]
-    pub output: crate::scene::OutputSettings,
+    pub output: crate::scene::OutputTable,
 }
 
 #[derive(Debug, Deserialize)]
@@ -310,18 +310,14 @@ impl RigidScene {
         let err = |span: Range<usize>, msg: String| src.error(span, msg);
         let seed = seed.or(self.seed).unwrap_or(1);
         let rigid = self.rigid.get_ref();
-        if let Some(p) = self.output.inspect.first() {
-            return Err(err(
-                p.span(),
-                "[output] inspect names point particles; a rigid scene has bodies (their observables are in observables.csv)".into(),
-            ));
-        }
-        if let Some(p) = &self.output.pressure_tensor {
-            return Err(err(
-                p.span(),
-                "[output] pressure_tensor: the rigid engine measures the scalar pressure only (observables.csv's pressure column, in a periodic box)".into(),
-            ));
-        }
+        self.output.refuse(
+            src,
+            &[
+                ("inspect", "it names point particles; a rigid scene has bodies (their observables are in observables.csv)"),
+                ("pressure_tensor", "the rigid engine measures the scalar pressure only (observables.csv's pressure column, in a periodic box)"),
+            ],
+        )?;
+        crate::scene::run::refuse_event_driven_output(&self.output, src)?;
         let mut frbi = Frbi::new();
         if let Some(f) = &rigid.free_flight {
             frbi.flight = match f.get_ref().as_str() {
