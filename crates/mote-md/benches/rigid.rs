@@ -95,8 +95,8 @@ fn bench_dipolar(c: &mut Criterion) {
     let n = 1000;
     let mut b = clumps(n);
     let mut f = fields()
-        .with(Coulomb::new(8.9875517923e9))
-        .with(DipoleDipole { k: 1e-7 });
+        .with(Coulomb::coulomb(8.9875517923e9))
+        .with(DipoleDipole::dipoles(1e-7));
     g.throughput(Throughput::Elements(n as u64));
     g.bench_with_input(BenchmarkId::from_parameter(n), &n, |bench, _| {
         bench.iter(|| f.step(&mut b, 1e-6))

@@ -47,8 +47,8 @@ fn pair() -> RigidBodies {
 
 fn frbi(spin: SpinUpdate) -> Frbi {
     let mut f = Frbi::new()
-        .with(Coulomb::new(1.0))
-        .with(DipoleDipole { k: 1.0 });
+        .with(Coulomb::coulomb(1.0))
+        .with(DipoleDipole::dipoles(1.0));
     f.spin = spin;
     f
 }

@@ -10,8 +10,10 @@
 //!   as a structure of arrays — and its observables;
 //! - [`interaction`]: the [`BodyInteraction`] trait and the world-frame view
 //!   of spheres and dipoles it reads (where contact models plug in);
-//! - [`sources`]: fields, gravity, drag, Coulomb (in open space or between
-//!   conducting planes), dipole–dipole, the latent image;
+//! - [`sources`]: fields, gravity, drag, Coulomb between conducting planes,
+//!   the latent image;
+//! - [`centres`]: point-particle interactions between the bodies' centres
+//!   (Coulomb and dipole–dipole in open space: the point particles' kernels);
 //! - [`magnet`]: the magnetic roller and the moments it induces;
 //! - [`contacts`]: Hertz–Mindlin contacts between spheres of different
 //!   bodies and with walls;
@@ -22,6 +24,7 @@
 //! The algebra (E, dE, I, exp, log) is the crate `mote-geom`.
 
 pub mod bodies;
+pub mod centres;
 pub mod contacts;
 pub mod frbi;
 mod free8;
@@ -35,11 +38,12 @@ pub mod sources;
 pub mod template;
 
 pub use bodies::{BodyObservables, RigidBodies};
+pub use centres::{AtCentres, Coulomb, DipoleDipole};
 pub use contacts::RigidContacts;
 pub use frbi::{free_step, react, BodyEnergies, Frbi, FreeFlight, SpinUpdate};
 pub use interaction::{BodyInteraction, BodyView, WorldFrame};
 pub use shapes::{dumbbell, linear_trimer, IrregularClump};
-pub use sources::{AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity};
+pub use sources::{AirDrag, ExternalFields, Field, Gravity};
 pub use template::{
     mass_properties, principal, BodyTemplate, ClumpSpec, Integration, MassErrors, MassProperties,
     TemplateError,

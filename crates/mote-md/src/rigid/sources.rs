@@ -1,6 +1,6 @@
 //! Force and torque sources on rigid bodies: homogeneous external fields,
-//! gravity, air drag, Coulomb forces between charges and magnetic
-//! dipole–dipole forces and torques (seed 000, FBI step 3: "electric,
+//! gravity, air drag, Coulomb forces between conducting planes and the
+//! latent image (seed 000, FBI step 3: "electric,
 //! magnetic, and elastic contributions … If there are external electric and
 //! magnetic fields, these add to the force and torque on p in a
 //! straightforward manner").
@@ -14,10 +14,8 @@ use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
-use crate::force::dipolar::dipole_pair;
 use crate::force::latent::LatentImage;
 use crate::force::slab::ConductingPlanes;
-use crate::force::DirectGravity;
 use crate::viewer::ViewerHooks;
 
 /// A homogeneous field as a function of time.
@@ -263,43 +261,7 @@ impl ViewerHooks for AirDrag {
     }
 }
 
-/// Coulomb forces between the bodies' point charges (all pairs):
-/// `Fᵢ = k Σⱼ qᵢqⱼ (xᵢ − xⱼ)/|xᵢ − xⱼ|³`, k = 1/(4πε₀) in SI. No torque:
-/// the charges sit at the centres of mass. The pair sums are the point
-/// particles' (`DirectCoulomb`): the tiled inverse-square kernel gravity
-/// uses, unsoftened.
-#[derive(Clone, Debug)]
-pub struct Coulomb {
-    pub k: f64,
-    kernel: DirectGravity,
-    charge: Vec<f64>,
-    field: Vec<DVec3>,
-}
-
-impl Coulomb {
-    /// Coulomb's law with constant `k`.
-    pub fn new(k: f64) -> Self {
-        Self {
-            k,
-            kernel: DirectGravity::new(1.0, 0.0),
-            charge: Vec::new(),
-            field: Vec::new(),
-        }
-    }
-}
-
-/// Magnetic dipole–dipole interaction between the bodies' dipoles (all
-/// pairs), with k = μ₀/4π (1e-7 in SI):
-/// `U = k [mᵢ·mⱼ/r³ − 3(mᵢ·r)(mⱼ·r)/r⁵]`, `r = xᵢ − xⱼ`,
-/// `Fᵢ = 3k/r⁵ [(mᵢ·mⱼ) r + mᵢ(mⱼ·r) + mⱼ(mᵢ·r) − 5(mᵢ·r)(mⱼ·r) r/r²]`,
-/// `Tᵢ = mᵢ × Bⱼ(xᵢ)`, `Bⱼ(x) = k [3 r(mⱼ·r)/r⁵ − mⱼ/r³]`.
-/// Torques and forces together keep the total angular momentum.
-#[derive(Clone, Copy, Debug)]
-pub struct DipoleDipole {
-    pub k: f64,
-}
-
-/// Bodies at or above this count use rayon for the all-pairs sums.
+/// Bodies at or above this count use rayon for the per-body sums.
 const PARALLEL_PAIRS: usize = 256;
 
 fn for_each_body(n: usize, wrench: &mut [DE], f: impl Fn(usize) -> DE + Sync + Send) {
@@ -312,78 +274,6 @@ fn for_each_body(n: usize, wrench: &mut [DE], f: impl Fn(usize) -> DE + Sync + S
         for (i, w) in wrench.iter_mut().enumerate() {
             *w += f(i);
         }
-    }
-}
-
-impl BodyInteraction for Coulomb {
-    fn name(&self) -> &str {
-        "Coulomb"
-    }
-
-    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
-        let b = view.bodies;
-        self.charge.clear();
-        self.charge
-            .extend((0..b.len()).map(|i| b.template(i).charge));
-        self.field.clear();
-        self.field.resize(b.len(), DVec3::ZERO);
-        // The kernel gives Σ_j q_j (x_j − x_i)/r³: like charges repel.
-        self.kernel
-            .inverse_square_field(&b.position, &self.charge, &mut self.field);
-        for ((w, e), q) in wrench.iter_mut().zip(&self.field).zip(&self.charge) {
-            w.v -= *e * (self.k * q);
-        }
-    }
-
-    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
-        let b = view.bodies;
-        self.charge.clear();
-        self.charge
-            .extend((0..b.len()).map(|i| b.template(i).charge));
-        0.5 * self.k * self.kernel.pair_potential_sum(&b.position, &self.charge)
-    }
-}
-
-impl BodyInteraction for DipoleDipole {
-    fn name(&self) -> &str {
-        "dipole-dipole"
-    }
-
-    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
-        let b = view.bodies;
-        let m = &view.world.dipole;
-        let n = b.len();
-        for_each_body(n, wrench, |i| {
-            let mi = m[i];
-            if mi == DVec3::ZERO {
-                return DE::ZERO;
-            }
-            let xi = b.position[i];
-            let (mut f, mut torque) = (DVec3::ZERO, DVec3::ZERO);
-            for j in 0..n {
-                if j == i {
-                    continue;
-                }
-                let d = xi - b.position[j];
-                let (_, fij, ti, _) = dipole_pair(self.k, d, 1.0 / d.length_squared(), mi, m[j]);
-                f += fij;
-                torque += ti;
-            }
-            DE::new(torque, f)
-        });
-    }
-
-    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
-        let b = view.bodies;
-        let m = &view.world.dipole;
-        let mut u = 0.0;
-        for i in 0..b.len() {
-            for j in 0..i {
-                let d = b.position[i] - b.position[j];
-                u += dipole_pair(self.k, d, 1.0 / d.length_squared(), m[i], m[j]).0;
-            }
-        }
-        u
     }
 }
 

@@ -9,7 +9,8 @@ use mote_io::ParseError;
 use serde::Deserialize;
 
 use super::{Clumps, RigidBuild, RigidScene};
-use crate::rigid::sources::{AirDrag, Coulomb, DipoleDipole, ExternalFields, Field, Gravity};
+use crate::rigid::centres::{Coulomb, DipoleDipole};
+use crate::rigid::sources::{AirDrag, ExternalFields, Field, Gravity};
 use crate::scene::Section;
 
 #[derive(Debug, Deserialize)]
@@ -76,10 +77,10 @@ impl Section<Clumps> for FieldSettings {
             b.frbi.push(Box::new(ExternalFields { electric, magnetic }));
         }
         if let Some(k) = fs.coulomb {
-            b.frbi.push(Box::new(Coulomb::new(k)));
+            b.frbi.push(Box::new(Coulomb::coulomb(k)));
         }
         if let Some(k) = fs.dipole_dipole {
-            b.frbi.push(Box::new(DipoleDipole { k }));
+            b.frbi.push(Box::new(DipoleDipole::dipoles(k)));
         }
         if let Some(d) = &fs.drag {
             b.frbi.push(Box::new(AirDrag {
