@@ -199,7 +199,9 @@ simulation_class! {
 
     /// The observables measured so far (the columns of `mote run`'s
     /// observables.csv): time, kinetic, translational, rotational,
-    /// potential, total (n,), momentum, angular_momentum (n, 3).
+    /// potential, total (n,), momentum, angular_momentum (n, 3), and
+    /// pressure (n,) where the run measures it (a box periodic on every
+    /// axis, every interaction with a virial).
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let guard = self.engine()?;
@@ -222,6 +224,9 @@ simulation_class! {
         )?;
         d.set_item("momentum", vec3(|o| o.momentum)?)?;
         d.set_item("angular_momentum", vec3(|o| o.angular_momentum)?)?;
+        if guard.measures_pressure() {
+            d.set_item("pressure", col(|o| o.pressure.unwrap_or(f64::NAN)))?;
+        }
         Ok(d)
     }
 

@@ -9,6 +9,7 @@
 
 use std::sync::{Mutex, MutexGuard};
 
+use mote_run::scene::RunLength;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
@@ -137,23 +138,22 @@ pub fn time_steps(
     dt: f64,
     scene_end: impl FnOnce() -> PyResult<Option<u64>>,
 ) -> PyResult<u64> {
-    match (steps, until) {
-        (Some(_), Some(_)) => Err(PyValueError::new_err("give steps or until, not both")),
-        (Some(n), None) => Ok(n),
-        (None, Some(t)) if t.is_finite() => mote_run::steps_until(time, t, dt).ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "until = {} with dt = {}: not a number of steps a run can take",
-                mote_io::system::human_number(t),
-                mote_io::system::human_number(dt)
-            ))
-        }),
-        (None, Some(t)) => Err(PyValueError::new_err(format!(
-            "until = {t}: must be a finite time"
-        ))),
-        (None, None) => scene_end()?.ok_or_else(|| {
-            PyValueError::new_err("the scene gives no run length: give steps= or until=")
-        }),
-    }
+    let length = match (steps, until) {
+        (Some(_), Some(_)) => return Err(PyValueError::new_err("give steps or until, not both")),
+        (Some(n), None) => RunLength::Steps(n),
+        (None, Some(t)) if t.is_finite() => RunLength::Until(t),
+        (None, Some(t)) => {
+            return Err(PyValueError::new_err(format!(
+                "until = {t}: must be a finite time"
+            )))
+        }
+        (None, None) => {
+            return scene_end()?.ok_or_else(|| {
+                PyValueError::new_err("the scene gives no run length: give steps= or until=")
+            })
+        }
+    };
+    length.steps_from(time, dt).map_err(PyValueError::new_err)
 }
 
 /// A Python class that holds a [`Stepped`] engine behind a lock.

@@ -272,6 +272,56 @@ def test_rcp_optimiser_finds_the_densest_binary_mixture():
         mote.rcp_optimise([1.0, 4.0], sigmas=[0.1])
 
 
+def test_rigid_bodies_in_a_periodic_box_have_the_pressure_of_mote_run(tmp_path):
+    gas = """seed = 5
+[rigid]
+[[rigid.template]]
+name = "trimer"
+generator = "trimer"
+radius = 0.5
+distance = 0.5
+mass = 1.5
+[[rigid.lattice]]
+template = "trimer"
+n = 27
+lo = [0.0, 0.0, 0.0]
+hi = [6.0, 6.0, 6.0]
+spacing = 2.05
+random_orientation = true
+speed = 2.0
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [6.2, 6.2, 6.2]
+periodic = [true, true, true]
+[rigid.contacts]
+young = 136500.0
+poisson = 0.3
+restitution = 0.9
+friction = 0.3
+[run]
+dt = 5e-4
+steps = 400
+[output]
+observables_every = 50
+"""
+    sim = mote.RigidSimulation.from_toml(gas)
+    sim.run()
+    out = mote.run(gas, output=tmp_path)
+    assert out["ending"] == "finished", out
+    table = csv_columns(tmp_path / "observables.csv")
+    obs = sim.observables
+    assert np.array_equal(table["pressure"], obs["pressure"])
+    # the first row is the ideal gas of the bodies' centres: 2 K_t / 3V
+    ideal = 2.0 * obs["translational"][0] / (3.0 * 6.2**3)
+    assert obs["pressure"][0] == pytest.approx(ideal, rel=1e-12)
+    # an open box has no pressure, as mote run's table has no column
+    here = __import__("pathlib").Path(__file__).resolve().parents[3]
+    text = (here / "examples/rigid/clumps-settling.toml").read_text().replace("until = 0.5", "steps = 2")
+    settling = mote.RigidSimulation.from_toml(text)
+    settling.run()
+    assert "pressure" not in settling.observables
+
+
 def test_progress_shows_the_opening_line_on_stderr(capfd, tmp_path):
     sim = mote.Simulation.from_toml(LJ)
     sim.run(steps=10)

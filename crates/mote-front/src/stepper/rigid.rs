@@ -20,6 +20,9 @@ pub struct Rigid {
     /// The scene text and seed, for checkpoints.
     text: String,
     seed: u64,
+    /// Whether the run measures the pressure (`mote run`'s column): a box
+    /// periodic on every axis and a virial from every interaction.
+    pressure: bool,
 }
 
 /// A per-body vector.
@@ -43,6 +46,9 @@ pub struct RigidObservables {
     pub potential: f64,
     pub momentum: DVec3,
     pub angular_momentum: DVec3,
+    /// P = (Σ M V² + W)/3V, where the run measures it
+    /// ([`Rigid::measures_pressure`]).
+    pub pressure: Option<f64>,
 }
 
 impl Rigid {
@@ -58,11 +64,14 @@ impl Rigid {
         let built = scene.build(text, label, seed)?;
         let every = scene.output.observables_every().max(1);
         let seed = built.seed;
+        let mut dynamics = RigidDynamics::new(built);
+        let pressure = dynamics.pressure_volume().is_some() && dynamics.without_virial().is_empty();
         Ok(Rigid {
-            stepper: Stepper::new(RigidDynamics::new(built), every),
+            stepper: Stepper::new(dynamics, every),
             label: label.into(),
             text: text.into(),
             seed,
+            pressure,
         })
     }
 
@@ -117,6 +126,12 @@ impl Rigid {
         progress: &mut dyn FnMut(u64, f64),
     ) -> Result<(), FrontError> {
         Ok(self.stepper.advance_every_16(n, ends_run, progress)?)
+    }
+
+    /// Whether the samples have the pressure: as `mote run`'s table, in a
+    /// box periodic on every axis where every interaction gives a virial.
+    pub fn measures_pressure(&self) -> bool {
+        self.pressure
     }
 
     /// The steps from now to the scene's end.
@@ -190,6 +205,7 @@ impl Rigid {
                 potential: o.potential_energy,
                 momentum: o.linear_momentum,
                 angular_momentum: o.angular_momentum,
+                pressure: self.pressure.then_some(o.pressure),
             })
             .collect()
     }
