@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use mote_geom::{DE, E};
+use mote_md::force::StepParameters;
 use mote_md::rigid::magnet::{InducedDipoles, MagneticRoller, MU0};
 use mote_md::rigid::{BodyInteraction, BodyTemplate, BodyView, RigidBodies, WorldFrame};
 
@@ -108,10 +109,10 @@ fn forces(model: &mut InducedDipoles, b: &RigidBodies, t: f64) -> Vec<DVec3> {
     let view = BodyView {
         bodies: b,
         world: &world,
-        dt: 0.0,
+        step: StepParameters { time: t, dt: 0.0 },
     };
     let mut w = vec![DE::ZERO; b.len()];
-    model.add_wrenches(&view, t, &mut w);
+    model.add_wrenches(&view, &mut w);
     w.iter().map(|x| x.v).collect()
 }
 
@@ -230,7 +231,7 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
                 w.update(&b);
                 w
             },
-            dt: 0.0,
+            step: StepParameters { time: t, dt: 0.0 },
         },
         t,
     );

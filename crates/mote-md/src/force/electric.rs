@@ -113,7 +113,7 @@ impl Interaction for ElectricField {
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
-        let e = self.at(state.time);
+        let e = self.at(state.step.time);
         for (f, q) in force.iter_mut().zip(state.charges()) {
             *f += e * *q;
         }
@@ -122,7 +122,7 @@ impl Interaction for ElectricField {
     /// −Σ q E·r, or 0 where the box is periodic along the field (there the
     /// potential is not defined).
     fn potential_energy(&mut self, state: &State) -> f64 {
-        let e = self.at(state.time);
+        let e = self.at(state.step.time);
         if (0..3).any(|a| state.boundary.periodic[a] && self.amplitude[a] != 0.0) {
             return 0.0;
         }
@@ -241,7 +241,7 @@ mod tests {
         let pos = [DVec3::new(1.0, 4.0, 0.0)];
         let (vel, mass) = ([DVec3::ZERO], [1.0]);
         let mut s = state(&pos, &vel, &mass, &[-0.5]);
-        s.time = 0.4;
+        s.step.time = 0.4;
         let mut f = [DVec3::ZERO];
         e.add_forces(&s, &mut f);
         let c = (3.0f64 * 0.4 + 0.25).cos();

@@ -37,6 +37,22 @@ use crate::neighbor::VerletList;
 use crate::particles::System;
 pub use crate::viewer::ViewerHooks;
 
+/// The parameters of one force evaluation that every interaction reads,
+/// for point particles ([`State::step`]) and rigid bodies
+/// ([`BodyView::step`](crate::rigid::BodyView)) alike — one struct for both
+/// contexts, as rapier's `IntegrationParameters` is.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepParameters {
+    /// The time t of the evaluation.
+    pub time: f64,
+    /// The time since the previous force evaluation of the run, by which
+    /// history-dependent forces advance (the tangential springs of
+    /// granular contacts, ξ += v_t dt): the step h after a step, 0 where an
+    /// evaluation repeats or only measures a state (the first evaluation
+    /// of a leap-frog run, observables). Set by the integrator.
+    pub dt: f64,
+}
+
 /// The per-step context of every interaction: a read-only view of the
 /// state at which forces are evaluated (the integrator's stage, which need
 /// not be the system's current state) and the particles' properties and box
@@ -47,13 +63,8 @@ pub struct State<'a> {
     pub position: &'a [DVec3],
     pub velocity: &'a [DVec3],
     pub mass: &'a [f64],
-    pub time: f64,
-    /// The time since the previous force evaluation of the run, by which
-    /// history-dependent forces advance (the tangential springs of
-    /// granular contacts, ξ += v_t dt): the step h after a step, 0 where an
-    /// evaluation repeats or only measures a state (the first evaluation
-    /// of a leap-frog run, observables). Set by the integrator.
-    pub dt: f64,
+    /// The time of the evaluation and the time since the previous one.
+    pub step: StepParameters,
     /// Radius of each particle (empty when the caller gives none).
     pub radius: &'a [f64],
     /// Charge of each particle (empty when the caller gives none).
@@ -84,8 +95,7 @@ impl<'a> State<'a> {
             position,
             velocity,
             mass,
-            time,
-            dt: 0.0,
+            step: StepParameters { time, dt: 0.0 },
             radius: &[],
             charge: &[],
             dipole: &[],
@@ -109,8 +119,7 @@ impl<'a> State<'a> {
             position,
             velocity,
             mass: &p.mass,
-            time,
-            dt,
+            step: StepParameters { time, dt },
             radius: &p.radius,
             charge: &p.charge,
             dipole: &p.dipole,
@@ -147,7 +156,10 @@ impl<'a> State<'a> {
 
     /// The same state, `dt` after the previous evaluation.
     pub fn after(self, dt: f64) -> Self {
-        Self { dt, ..self }
+        Self {
+            step: StepParameters { dt, ..self.step },
+            ..self
+        }
     }
 
     /// The same state in this box.

@@ -74,7 +74,7 @@ impl<I: Interaction> AtCentres<I> {
         let b = view.bodies;
         let c = &mut self.centres;
         let state = State::new(&b.position, &b.velocity, &c.mass, t)
-            .after(view.dt)
+            .after(view.step.dt)
             .with_charges(&c.charge)
             .with_dipoles(&view.world.dipole);
         if self.inner.exerts_torques() {
@@ -94,7 +94,8 @@ impl<I: Interaction + Sync + 'static> BodyInteraction for AtCentres<I> {
         self.inner.name()
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
+        let t = view.step.time;
         self.evaluate(view, t);
         let c = &self.centres;
         for ((w, f), tq) in wrench.iter_mut().zip(&c.force).zip(&c.torque) {
@@ -103,7 +104,8 @@ impl<I: Interaction + Sync + 'static> BodyInteraction for AtCentres<I> {
         }
     }
 
-    fn potential_energy(&mut self, view: &BodyView<'_>, t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>) -> f64 {
+        let t = view.step.time;
         self.centres.gather(view);
         let b = view.bodies;
         let c = &self.centres;

@@ -227,7 +227,8 @@ impl BodyInteraction for RigidContacts {
         "contacts"
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
+        let t = view.step.time;
         let world = view.world;
         let bodies = view.bodies;
         let centres = &world.sphere_centre;
@@ -237,7 +238,7 @@ impl BodyInteraction for RigidContacts {
         let r_max = radius.iter().cloned().fold(0.0, f64::max);
         let st = &mut self.state;
         st.refresh(centres, body, r_max, &self.boundary);
-        let dt = view.dt;
+        let dt = view.step.dt;
         let image = self.boundary.image();
         let periodic = self.boundary.is_periodic();
         let pos: &[DVec3] = if periodic { &st.wrapped } else { centres };
@@ -399,7 +400,7 @@ impl BodyInteraction for RigidContacts {
     /// centres), F the law's whole force on sphere a — elastic, damping and
     /// tangential from the carried history, which is not advanced (dt = 0).
     /// Walls add nothing (LAMMPS's fix convention).
-    fn virial(&mut self, view: &BodyView<'_>, _t: f64) -> Option<f64> {
+    fn virial(&mut self, view: &BodyView<'_>) -> Option<f64> {
         let world = view.world;
         let (centres, radius, body) = (
             &world.sphere_centre,
@@ -436,7 +437,8 @@ impl BodyInteraction for RigidContacts {
     /// of different bodies and sphere–wall contacts at the view's placement
     /// (pairs taken from the list of the last force evaluation, whose skin
     /// covers the half step since).
-    fn potential_energy(&mut self, view: &BodyView<'_>, t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>) -> f64 {
+        let t = view.step.time;
         let world = view.world;
         let centres = &world.sphere_centre;
         let radius = &world.sphere_radius;

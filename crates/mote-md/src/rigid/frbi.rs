@@ -14,6 +14,7 @@ use rayon::prelude::*;
 use super::bodies::RigidBodies;
 use super::free8::{free_step8, react8, Group, LANES};
 use super::interaction::{BodyInteraction, BodyView, WorldFrame};
+use crate::force::StepParameters;
 
 /// How the centre of mass moves in a free step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -301,10 +302,10 @@ impl Frbi {
         let view = BodyView {
             bodies: b,
             world: &self.world,
-            dt,
+            step: StepParameters { time: t, dt },
         };
         for it in &mut self.interactions {
-            it.add_wrenches(&view, t, &mut self.wrench);
+            it.add_wrenches(&view, &mut self.wrench);
         }
         &self.wrench
     }
@@ -398,12 +399,15 @@ impl Frbi {
         let view = BodyView {
             bodies: b,
             world: &self.world,
-            dt: 0.0,
+            step: StepParameters {
+                time: b.time,
+                dt: 0.0,
+            },
         };
         let mut total = 0.0;
         let mut without = Vec::new();
         for it in self.interactions.iter_mut() {
-            match it.virial(&view, b.time) {
+            match it.virial(&view) {
                 Some(w) => total += w,
                 None => without.push(it.name().to_string()),
             }
@@ -421,12 +425,15 @@ impl Frbi {
         let view = BodyView {
             bodies: b,
             world: &self.world,
-            dt: 0.0,
+            step: StepParameters {
+                time: b.time,
+                dt: 0.0,
+            },
         };
         let potential = self
             .interactions
             .iter_mut()
-            .map(|it| it.potential_energy(&view, b.time))
+            .map(|it| it.potential_energy(&view))
             .sum();
         BodyEnergies {
             kinetic: b.observables().kinetic_energy(),

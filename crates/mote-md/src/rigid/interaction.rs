@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use super::bodies::RigidBodies;
 use super::free8::{world8, LANES};
+use crate::force::StepParameters;
 
 /// A source of forces and torques on bodies; one virtual call per step.
 /// Interactions that carry state from step to step (contact histories,
@@ -26,23 +27,23 @@ pub trait BodyInteraction: AsAny + Send + Sync {
     fn name(&self) -> &str;
 
     /// Adds to `wrench[i]` the torque (about the centre of mass, in `omega`)
-    /// and force (in `v`) on body i at time `t`.
-    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]);
+    /// and force (in `v`) on body i at the view's time.
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]);
 
-    /// The potential energy at time `t` (zero for dissipative forces).
-    fn potential_energy(&mut self, _view: &BodyView<'_>, _t: f64) -> f64 {
+    /// The potential energy at the view's time (zero for dissipative forces).
+    fn potential_energy(&mut self, _view: &BodyView<'_>) -> f64 {
         0.0
     }
 
     /// The molecular virial W = Σ_{I<J} (R_I − R_J)·F_IJ of the forces at
-    /// the view's placement and time `t`: R the body centres (the minimum
+    /// the view's placement and time: R the body centres (the minimum
     /// image of the pair), F_IJ the force body J exerts on body I — the
     /// body-centre virial of LAMMPS's `fix rigid`, so that a periodic box
     /// has the pressure P = (Σ_I M_I V_I² + W)/3V. A force from outside
     /// (gravity, fields, drag; walls, by LAMMPS's fix convention) adds 0;
     /// `None` where the interaction cannot give it (the pressure column is
     /// then left out, and the summary says why).
-    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+    fn virial(&mut self, _view: &BodyView<'_>) -> Option<f64> {
         None
     }
     /// The live viewer's hooks (steering the fields it owns), where this
@@ -190,10 +191,11 @@ const WORLD_BLOCK: usize = 256;
 pub struct BodyView<'a> {
     pub bodies: &'a RigidBodies,
     pub world: &'a WorldFrame,
-    /// The time since the previous evaluation of the run, by which contact
-    /// histories advance (ξ += v_t dt): the step length within a step, 0
-    /// where a state is only measured.
-    pub dt: f64,
+    /// The time of the evaluation and the time since the previous one, by
+    /// which contact histories advance (ξ += v_t dt): the step length
+    /// within a step, 0 where a state is only measured — the parameters
+    /// point particles' interactions read from their [`State`](crate::force::State).
+    pub step: StepParameters,
 }
 
 impl BodyView<'_> {

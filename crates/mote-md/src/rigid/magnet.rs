@@ -185,7 +185,8 @@ impl BodyInteraction for InducedDipoles {
         "magnetic roller"
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
+        let t = view.step.time;
         let (index, x, m) = self.moments(view, t);
         let k = self.dipole_dipole;
         let force: Vec<DVec3> = (0..x.len())

@@ -99,11 +99,12 @@ impl BodyInteraction for ExternalFields {
     }
 
     /// A force from outside: no virial (LAMMPS's fix convention).
-    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+    fn virial(&mut self, _view: &BodyView<'_>) -> Option<f64> {
         Some(0.0)
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
+        let t = view.step.time;
         let (e, b) = (self.electric.at(t), self.magnetic.at(t));
         let bodies = view.bodies;
         for (i, w) in wrench.iter_mut().enumerate() {
@@ -113,7 +114,8 @@ impl BodyInteraction for ExternalFields {
         }
     }
 
-    fn potential_energy(&mut self, view: &BodyView<'_>, t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>) -> f64 {
+        let t = view.step.time;
         let (e, b) = (self.electric.at(t), self.magnetic.at(t));
         let bodies = view.bodies;
         (0..bodies.len())
@@ -168,17 +170,17 @@ impl BodyInteraction for Gravity {
     }
 
     /// A force from outside: no virial (LAMMPS's fix convention).
-    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+    fn virial(&mut self, _view: &BodyView<'_>) -> Option<f64> {
         Some(0.0)
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
         for (i, w) in wrench.iter_mut().enumerate() {
             w.v += view.bodies.template(i).mass() * self.g;
         }
     }
 
-    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>) -> f64 {
         let b = view.bodies;
         (0..b.len())
             .map(|i| -b.template(i).mass() * self.g.dot(b.position[i]))
@@ -232,11 +234,11 @@ impl BodyInteraction for AirDrag {
     }
 
     /// A force from outside: no virial (LAMMPS's fix convention).
-    fn virial(&mut self, _view: &BodyView<'_>, _t: f64) -> Option<f64> {
+    fn virial(&mut self, _view: &BodyView<'_>) -> Option<f64> {
         Some(0.0)
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
         let b = view.bodies;
         for (i, w) in wrench.iter_mut().enumerate() {
             let r = b.template(i).equivalent_radius;
@@ -340,7 +342,7 @@ impl BodyInteraction for PlaneCoulomb {
         "Coulomb between conducting planes"
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, _t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
         let (index, position, charge) = self.charged(view);
         let held = &mut self.held;
         if held.calls.is_multiple_of(self.every) || held.force.len() != index.len() {
@@ -361,7 +363,7 @@ impl BodyInteraction for PlaneCoulomb {
         }
     }
 
-    fn potential_energy(&mut self, view: &BodyView<'_>, _t: f64) -> f64 {
+    fn potential_energy(&mut self, view: &BodyView<'_>) -> f64 {
         let (_, position, charge) = self.charged(view);
         self.planes.evaluate(&position, &charge, None).total()
     }
@@ -417,7 +419,8 @@ impl BodyInteraction for LatentField {
         "latent image"
     }
 
-    fn add_wrenches(&mut self, view: &BodyView<'_>, t: f64, wrench: &mut [DE]) {
+    fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
+        let t = view.step.time;
         let b = view.bodies;
         for_each_body(b.len(), wrench, |i| {
             let q = b.template(i).charge;

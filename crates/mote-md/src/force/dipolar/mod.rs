@@ -935,7 +935,13 @@ impl Interaction for Zeeman {
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         if !self.field.is_uniform() && state.dipole.len() == state.position.len() {
             let mut torque = vec![DVec3::ZERO; force.len()];
-            self.forces_and_torques(state.position, state.dipole, state.time, force, &mut torque);
+            self.forces_and_torques(
+                state.position,
+                state.dipole,
+                state.step.time,
+                force,
+                &mut torque,
+            );
         }
     }
 
@@ -951,14 +957,14 @@ impl Interaction for Zeeman {
         torque: &mut [DVec3],
     ) {
         if state.dipole.len() == state.position.len() {
-            self.forces_and_torques(state.position, state.dipole, state.time, force, torque);
+            self.forces_and_torques(state.position, state.dipole, state.step.time, force, torque);
         }
     }
 
     /// Σ_i −μ₀ m_i·H(r_i, t) (0 for a state without dipoles).
     fn potential_energy(&mut self, state: &State) -> f64 {
         if state.dipole.len() == state.position.len() {
-            self.energy(state.position, state.dipole, state.time)
+            self.energy(state.position, state.dipole, state.step.time)
         } else {
             0.0
         }

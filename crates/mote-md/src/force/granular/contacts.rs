@@ -81,7 +81,7 @@ impl GranularContacts {
         self.refresh_own(state);
         let list = state.neighbours.unwrap_or(&self.list);
         Self::follow(&mut self.pairs, &mut self.carried_to_build, list);
-        let dt = state.dt;
+        let dt = state.step.dt;
 
         let blocks = Self::blocks(n);
         let firsts = Self::block_firsts(&list.start, blocks);

@@ -172,8 +172,8 @@ impl GranularWalls {
         torque: &mut [DVec3],
     ) {
         const CHUNK: usize = 1024;
-        let dt = state.dt;
-        let t = state.time;
+        let dt = state.step.dt;
+        let t = state.step.time;
         let law = self.law;
         let walls = &self.walls;
         let n_walls = walls.len();
@@ -336,7 +336,7 @@ impl Interaction for GranularWalls {
         for wall in &self.walls {
             for (i, &x) in state.position.iter().enumerate() {
                 let r = state.radius[i];
-                let (gap, _) = wall.gap(x, state.time);
+                let (gap, _) = wall.gap(x, state.step.time);
                 if gap < r && gap > -r {
                     u += self.law.elastic_energy(r - gap, r);
                 }
