@@ -210,8 +210,8 @@ impl EngineRun for RigidRun {
             crate::seed_phrase(done.seed, done.chosen),
             last.kinetic_energy(),
             last.potential_energy,
-            last.linear_momentum,
-            last.angular_momentum,
+            vector(last.linear_momentum),
+            vector(last.angular_momentum),
         )];
         for (name, f) in &last.wall_forces {
             summary.push(format!("  force on wall {name}: {f}"));
@@ -240,4 +240,11 @@ pub(crate) fn md_ending(e: MdError) -> Result<Ending, FrontError> {
         }),
         e => Err(e.into()),
     }
+}
+
+/// `[x, y, z]` with each component as [`mote_io::system::human_number`]
+/// writes it (`6.4e-32`, not 32 zeros and the digits).
+fn vector(v: glam::DVec3) -> String {
+    let n = mote_io::system::human_number;
+    format!("[{}, {}, {}]", n(v.x), n(v.y), n(v.z))
 }

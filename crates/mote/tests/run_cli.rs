@@ -730,6 +730,94 @@ fn rigid_bodies_in_a_periodic_box_have_a_pressure() {
     );
 }
 
+/// Charged rigid bodies in a periodic box take the point particles'
+/// `[coulomb]` table between their centres: a static rock-salt crystal of
+/// 64 single-sphere bodies under Ewald has the Madelung energy
+/// U = −(N/2) M k q²/a (M = 1.747564594633, NaCl) and the pressure
+/// P = U/(3V) (the Coulomb virial W = U of charges in a periodic box).
+#[test]
+fn charged_bodies_in_a_periodic_box_have_the_madelung_energy_and_its_pressure() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = String::from(
+        "seed = 1\n[rigid]\n\
+         [[rigid.template]]\nname = \"plus\"\nspheres = [[0.0, 0.0, 0.0, 0.2]]\ndensity = 1.0\ncharge = 1.0\n\
+         [[rigid.template]]\nname = \"minus\"\nspheres = [[0.0, 0.0, 0.0, 0.2]]\ndensity = 1.0\ncharge = -1.0\n",
+    );
+    // Rock salt of side 2a (a = 1) as eight simple-cubic sublattices of
+    // spacing 2, two sites per axis each: 64 ions in a box of side 4.
+    for (x, y, z) in [
+        (0, 0, 0),
+        (1, 1, 0),
+        (1, 0, 1),
+        (0, 1, 1),
+        (1, 0, 0),
+        (0, 1, 0),
+        (0, 0, 1),
+        (1, 1, 1),
+    ] {
+        let template = if (x + y + z) % 2 == 0 {
+            "plus"
+        } else {
+            "minus"
+        };
+        let lo = [x, y, z].map(|c| c as f64 + 0.5);
+        scene += &format!(
+            "[[rigid.lattice]]\ntemplate = \"{template}\"\nn = 8\nlo = {lo:?}\nhi = {:?}\nspacing = 2.0\n",
+            lo.map(|c| c + 2.0)
+        );
+    }
+    scene += "[box]\nlo = [0.0, 0.0, 0.0]\nhi = [4.0, 4.0, 4.0]\nperiodic = [true, true, true]\n\
+              [coulomb]\nmethod = \"ewald\"\nk = 1.0\naccuracy = 1e-7\n\
+              [rigid.contacts]\nyoung = 1e5\npoisson = 0.3\nrestitution = 0.9\nfriction = 0.3\n\
+              [run]\ndt = 1e-3\nsteps = 20\n[output]\nobservables_every = 10\n";
+    std::fs::write(dir.path().join("salt.toml"), &scene).unwrap();
+    let o = mote(&["run", "salt.toml", "-q", "-o", "salt"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = mote_io::csv::read_table(&dir.path().join("salt/observables.csv")).unwrap();
+    let u = t.column("potential_energy").unwrap();
+    let p = t.column("pressure").unwrap();
+    let madelung = -32.0 * 1.747_564_594_633;
+    let volume = 64.0;
+    for (u, p) in u.iter().zip(p) {
+        assert!(
+            (u - madelung).abs() <= 1e-6 * madelung.abs(),
+            "U = {u} against {madelung}"
+        );
+        let expected = u / (3.0 * volume);
+        assert!(
+            (p - expected).abs() <= 1e-6 * expected.abs(),
+            "P = {p} against U/3V = {expected}"
+        );
+    }
+    // The same table between open-space sums and a periodic box is refused.
+    let open = scene.replace("method = \"ewald\"\nk = 1.0\naccuracy = 1e-7", "k = 1.0");
+    std::fs::write(dir.path().join("open.toml"), &open).unwrap();
+    let o = mote(&["run", "open.toml", "-q", "-o", "open"], dir.path());
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("sums over open space: a periodic box needs method = \"ewald\""),
+        "{}",
+        stderr(&o)
+    );
+    // So is the open-space sum of [rigid.fields] in a periodic box (it ran,
+    // missing every image).
+    let fields = scene.replace(
+        "[coulomb]\nmethod = \"ewald\"\nk = 1.0\naccuracy = 1e-7\n",
+        "[rigid.fields]\ncoulomb = 1.0\n",
+    );
+    std::fs::write(dir.path().join("fields.toml"), &fields).unwrap();
+    let o = mote(&["run", "fields.toml", "-q", "-o", "fields"], dir.path());
+    assert!(!o.status.success());
+    let line = fields.lines().position(|l| l == "[rigid.fields]").unwrap() + 1;
+    assert!(
+        stderr(&o).contains(&format!(
+            "fields.toml:{line}: [rigid.fields] coulomb sums over open space, and the [box] is periodic"
+        )),
+        "{}",
+        stderr(&o)
+    );
+}
+
 /// A granular run's observables give the kinetic energy whole and split
 /// into its translational part (what LAMMPS's `ke` reports) and its
 /// rotational part, with the units in the header, as rigid runs do.

@@ -104,6 +104,14 @@ impl<I: Interaction + Sync + 'static> BodyInteraction for AtCentres<I> {
         }
     }
 
+    /// The inner interaction's virial at the centres, Σ (R_I − R_J)·F_IJ:
+    /// the molecular virial of forces between centres (where the inner
+    /// interaction computes it).
+    fn virial(&mut self, view: &BodyView<'_>) -> Option<f64> {
+        self.evaluate(view, view.step.time);
+        self.inner.virial()
+    }
+
     fn potential_energy(&mut self, view: &BodyView<'_>) -> f64 {
         let t = view.step.time;
         self.centres.gather(view);

@@ -38,15 +38,49 @@ pub struct CoulombSettings {
     pub accuracy: Option<f64>,
 }
 
+/// The Coulomb law a `[coulomb]` table chooses.
+#[derive(Debug)]
+pub enum CoulombLaw {
+    Direct(DirectCoulomb),
+    Tree(TreeCoulomb),
+    Ewald(EwaldCoulomb),
+}
+
 impl Section for CoulombSettings {
     fn add_to(&self, span: Range<usize>, scene: &Scene, b: &mut Build) -> Result<(), ParseError> {
-        let src = b.src;
+        let law = self.law(
+            span,
+            b.src,
+            scene.units.coulomb_constant(),
+            &b.particles.charge,
+            b.boundary,
+        )?;
+        match law {
+            CoulombLaw::Direct(c) => b.forces.push(c),
+            CoulombLaw::Tree(c) => b.forces.push(c),
+            CoulombLaw::Ewald(c) => b.forces.push(c),
+        }
+        Ok(())
+    }
+}
+
+impl CoulombSettings {
+    /// The law of this table between point charges `charge` in `boundary`
+    /// (point particles, or the centres of rigid bodies), `k` the unit
+    /// system's where the table gives none; errors at the table's line.
+    pub fn law(
+        &self,
+        span: Range<usize>,
+        src: Source,
+        units_k: Option<f64>,
+        charge: &[f64],
+        boundary: Boundary,
+    ) -> Result<CoulombLaw, ParseError> {
         let err = |msg: String| src.error(span.clone(), msg);
-        let k = match self.k.or(scene.units.coulomb_constant()) {
+        let k = match self.k.or(units_k) {
             Some(k) => positive(src, span.clone(), "[coulomb] k", k)?,
             None => return Err(err("[coulomb] needs k = 1/(4πε₀) in these units".into())),
         };
-        let charge = &b.particles.charge;
         if charge.iter().all(|q| *q == 0.0) {
             return Err(err(
                 "[coulomb] no particle has a charge: give the particles `charge = ...`".into(),
@@ -58,7 +92,7 @@ impl Section for CoulombSettings {
             )));
         }
         let open = |method: &str| {
-            if b.boundary.periodic.iter().any(|p| *p) {
+            if boundary.periodic.iter().any(|p| *p) {
                 Err(err(format!(
                     "[coulomb] method = \"{method}\" sums over open space: a periodic box needs method = \"ewald\""
                 )))
@@ -81,13 +115,13 @@ impl Section for CoulombSettings {
                 "[coulomb] softening must not be negative, found {softening}"
             )));
         }
-        match self.method.as_str() {
+        Ok(match self.method.as_str() {
             "direct" => {
                 open("direct")?;
                 refuse("theta", self.theta.is_some(), "direct")?;
                 refuse("cutoff", self.cutoff.is_some(), "direct")?;
                 refuse("accuracy", self.accuracy.is_some(), "direct")?;
-                b.forces.push(DirectCoulomb::new(k, softening));
+                CoulombLaw::Direct(DirectCoulomb::new(k, softening))
             }
             "tree" => {
                 open("tree")?;
@@ -99,12 +133,12 @@ impl Section for CoulombSettings {
                         "[coulomb] theta must be in [0, 1.2), found {theta}"
                     )));
                 }
-                b.forces.push(TreeCoulomb::new(k, softening, theta));
+                CoulombLaw::Tree(TreeCoulomb::new(k, softening, theta))
             }
             "ewald" => {
                 refuse("softening", self.softening.is_some(), "ewald")?;
                 refuse("theta", self.theta.is_some(), "ewald")?;
-                let l = ewald_box(src, span.clone(), b.boundary, "coulomb")?;
+                let l = ewald_box(src, span.clone(), boundary, "coulomb")?;
                 let rc = positive(
                     src,
                     span.clone(),
@@ -120,15 +154,14 @@ impl Section for CoulombSettings {
                     err("[coulomb] method = \"ewald\" needs accuracy = the RMS force error aimed at (force units)".into())
                 })?;
                 positive(src, span.clone(), "[coulomb] accuracy", accuracy)?;
-                b.forces.push(EwaldCoulomb::new(k, charge, l, rc, accuracy));
+                CoulombLaw::Ewald(EwaldCoulomb::new(k, charge, l, rc, accuracy))
             }
             other => {
                 return Err(err(format!(
                     "[coulomb] unknown method '{other}': expected direct, tree or ewald"
                 )))
             }
-        }
-        Ok(())
+        })
     }
 }
 

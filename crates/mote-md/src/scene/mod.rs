@@ -50,7 +50,7 @@ use crate::units::UnitSystem;
 
 pub use bath::{BrownianSettings, DampingSettings, ThermostatSettings};
 pub use dipolar::{DipolarSettings, MagneticFieldSettings, WcaSettings};
-pub use electric::{CoulombSettings, ElectricFieldSettings};
+pub use electric::{CoulombLaw, CoulombSettings, ElectricFieldSettings};
 pub use granular::{GranularSettings, WallSpec};
 pub use gravity::{FieldSettings, GravitySettings};
 pub use lennard_jones::LennardJonesSettings;
@@ -217,7 +217,7 @@ impl Scene {
         granular::refuse_walls_without_contacts(self, src)?;
         add(&self.dipolar, self, &mut b)?;
         add(&self.magnetic_field, self, &mut b)?;
-        add(&self.coulomb, self, &mut b)?;
+        add::<Points, _>(&self.coulomb, self, &mut b)?;
         add(&self.electric_field, self, &mut b)?;
 
         let brownian = bath::brownian(&self.brownian, &b)?;

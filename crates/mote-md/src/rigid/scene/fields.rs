@@ -9,9 +9,11 @@ use mote_io::ParseError;
 use serde::Deserialize;
 
 use super::{Clumps, RigidBuild, RigidScene};
-use crate::rigid::centres::{Coulomb, DipoleDipole};
+use crate::boundary::Boundary;
+use crate::rigid::centres::{AtCentres, Coulomb, DipoleDipole};
 use crate::rigid::sources::{AirDrag, ExternalFields, Field, Gravity};
-use crate::scene::Section;
+use crate::scene::{CoulombLaw, CoulombSettings, Section};
+use crate::units::UnitSystem;
 
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
@@ -64,10 +66,13 @@ impl Section<Clumps> for FieldSettings {
     fn add_to(
         &self,
         span: Range<usize>,
-        _: &RigidScene,
+        scene: &RigidScene,
         b: &mut RigidBuild<'_>,
     ) -> Result<(), ParseError> {
         let fs = self;
+        // With conducting planes, [rigid.planes] says what to do with the
+        // charges (its table is the one to keep).
+        let planes = scene.rigid.get_ref().planes.is_some();
         if let Some(g) = fs.gravity {
             b.frbi.push(Box::new(Gravity { g: DVec3::from(g) }));
         }
@@ -77,6 +82,16 @@ impl Section<Clumps> for FieldSettings {
             b.frbi.push(Box::new(ExternalFields { electric, magnetic }));
         }
         if let Some(k) = fs.coulomb {
+            let periodic = b
+                .scene_box
+                .as_ref()
+                .is_some_and(|(bx, _)| bx.periodic.iter().any(|p| *p));
+            if periodic && !planes {
+                return Err(b.error(
+                    span,
+                    "[rigid.fields] coulomb sums over open space, and the [box] is periodic: give [coulomb] method = \"ewald\" (a box periodic on every axis) or [rigid.planes] coulomb (periodic along the planes)".into(),
+                ));
+            }
             b.frbi.push(Box::new(Coulomb::coulomb(k)));
         }
         if let Some(k) = fs.dipole_dipole {
@@ -89,6 +104,56 @@ impl Section<Clumps> for FieldSettings {
                 drag_coefficient: d.drag_coefficient,
                 wind: DVec3::from(d.wind),
             }));
+        }
+        Ok(())
+    }
+}
+
+/// `[coulomb]` in a rigid scene: the point particles' table and law
+/// ([`CoulombSettings::law`]) between the bodies' centres, where their
+/// charges sit ([`AtCentres`]): one Coulomb law for points and clumps.
+impl Section<Clumps> for CoulombSettings {
+    fn add_to(
+        &self,
+        span: Range<usize>,
+        scene: &RigidScene,
+        b: &mut RigidBuild<'_>,
+    ) -> Result<(), ParseError> {
+        let rigid = scene.rigid.get_ref();
+        if let Some(f) = rigid
+            .fields
+            .as_ref()
+            .filter(|f| f.get_ref().coulomb.is_some())
+        {
+            return Err(b.error(
+                span,
+                format!(
+                    "[coulomb] beside [rigid.fields] coulomb (line {}): give the charges' forces once",
+                    b.src.line_of(f.span().start)
+                ),
+            ));
+        }
+        if rigid.planes.is_some() {
+            return Err(b.error(
+                span,
+                "[coulomb] between conducting planes is [rigid.planes] coulomb (with the planes' images)".into(),
+            ));
+        }
+        let charge: Vec<f64> = (0..b.bodies.len())
+            .map(|i| b.bodies.template(i).charge)
+            .collect();
+        let boundary = b.scene_box.as_ref().map_or(Boundary::open(), |(bx, _)| *bx);
+        let law = self.law(
+            span,
+            b.src,
+            UnitSystem::Si.coulomb_constant(),
+            &charge,
+            boundary,
+        )?;
+        match law {
+            CoulombLaw::Direct(c) => b.frbi.push(Box::new(AtCentres::new(c))),
+            CoulombLaw::Tree(c) => b.frbi.push(Box::new(AtCentres::new(c))),
+            CoulombLaw::Ewald(c) => b.frbi.push(Box::new(AtCentres::new(c))),
         }
         Ok(())
     }

@@ -47,6 +47,10 @@
 //! dipole_dipole = 1e-7         # k = μ0/4π of dipole–dipole forces (off if absent)
 //! drag = { viscosity = 1.8e-5, air_density = 1.2, drag_coefficient = 0.47 }
 //!
+//! [coulomb]                    # the point particles' table, between the centres:
+//! method = "ewald"             # direct or tree (open space), ewald (cubic, periodic)
+//! accuracy = 1e-3              # Ewald's RMS force error aimed at
+//!
 //! [rigid.contacts]
 //! young = 1e7
 //! poisson = 0.3
@@ -162,6 +166,11 @@ pub struct RigidScene {
     /// periodic faces; the planes, the roller and the nip take its faces.
     #[serde(rename = "box", default)]
     pub bounds: Option<Spanned<crate::scene::BoxTable>>,
+    /// `[coulomb]`, the point particles' table, between the bodies'
+    /// centres (their charges sit there): `direct` or `tree` in open space,
+    /// `ewald` in a cubic box periodic on every axis.
+    #[serde(default)]
+    pub coulomb: Option<Spanned<crate::scene::CoulombSettings>>,
     /// The `[output]` of every time-stepped engine (`inspect`, which names
     /// point particles, is refused).
     #[serde(default)]
@@ -392,6 +401,7 @@ impl RigidScene {
             ));
         }
         add(&rigid.fields, self, &mut b)?;
+        add::<Clumps, _>(&self.coulomb, self, &mut b)?;
         match contact {
             Some(_) => add(&rigid.contacts, self, &mut b)?,
             None => {
