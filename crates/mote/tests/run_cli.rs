@@ -816,6 +816,17 @@ fn charged_bodies_in_a_periodic_box_have_the_madelung_energy_and_its_pressure() 
         "{}",
         stderr(&o)
     );
+    let dipoles = fields.replace("coulomb = 1.0", "dipole_dipole = 1.0");
+    std::fs::write(dir.path().join("dipoles.toml"), &dipoles).unwrap();
+    let o = mote(&["run", "dipoles.toml", "-q", "-o", "dipoles"], dir.path());
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains(&format!(
+            "dipoles.toml:{line}: [rigid.fields] dipole_dipole sums over open space, and the [box] is periodic"
+        )),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// A granular run's observables give the kinetic energy whole and split

@@ -147,6 +147,12 @@ impl Section for DipolarSettings {
                 "[dipolar] accuracy needs method = \"ewald\"".into(),
             ));
         }
+        if v.cutoff.is_none() && boundary.periodic.iter().any(|p| *p) {
+            return Err(err(
+                span.clone(),
+                "[dipolar] without cutoff sums every pair over open space, and the [box] is periodic: give cutoff = r_c (the minimum image, with a reaction field) or method = \"ewald\"".into(),
+            ));
+        }
         let mut pair = match v.cutoff {
             None => DipoleDipole::all_pairs(mu0),
             Some(rc) => DipoleDipole::cut_off(mu0, rc, v.skin.unwrap_or(0.3), boundary)

@@ -81,11 +81,11 @@ impl Section<Clumps> for FieldSettings {
             let magnetic = field(&fs.magnetic).map_err(|m| b.error(span.clone(), m))?;
             b.frbi.push(Box::new(ExternalFields { electric, magnetic }));
         }
+        let periodic = b
+            .scene_box
+            .as_ref()
+            .is_some_and(|(bx, _)| bx.periodic.iter().any(|p| *p));
         if let Some(k) = fs.coulomb {
-            let periodic = b
-                .scene_box
-                .as_ref()
-                .is_some_and(|(bx, _)| bx.periodic.iter().any(|p| *p));
             if periodic && !planes {
                 return Err(b.error(
                     span,
@@ -95,6 +95,12 @@ impl Section<Clumps> for FieldSettings {
             b.frbi.push(Box::new(Coulomb::coulomb(k)));
         }
         if let Some(k) = fs.dipole_dipole {
+            if periodic {
+                return Err(b.error(
+                    span,
+                    "[rigid.fields] dipole_dipole sums over open space, and the [box] is periodic: the images would be missed (the roller's induced moments, [rigid.roller] dipole_dipole, take the minimum image)".into(),
+                ));
+            }
             b.frbi.push(Box::new(DipoleDipole::dipoles(k)));
         }
         if let Some(d) = &fs.drag {
