@@ -186,7 +186,8 @@ fn a_charge_is_accelerated_by_the_electric_field() {
 
 /// One stretched spring in a periodic box: W = r_ij · F_ij = −D (r − l) r,
 /// so P = W/(3V) at rest; an interaction without a virial (direct
-/// gravity) takes the pressure away, never leaving a number without its part.
+/// gravity, put in by hand: a scene refuses it in a periodic box) takes the
+/// pressure away, never leaving a number without its part.
 #[test]
 fn spring_pressure_and_a_pressure_not_given() {
     let text = "units = \"lj\"\n[run]\ndt = 1e-12\n\
@@ -205,9 +206,23 @@ fn spring_pressure_and_a_pressure_not_given() {
         o.pressure
     );
     assert!(sim.forces.without_virial().is_empty());
+    // A scene cannot put open-space gravity into a periodic box (it is
+    // refused at its table); put in by hand, it takes the pressure away.
     let charged = text.replace("[[spring]]", "[gravity]\nG = 1.0\n[[spring]]");
-    let mut built = common::build(&charged);
+    let e = mote_md::scene::Scene::parse(&charged, "g.toml")
+        .unwrap()
+        .build(&charged, "g.toml", 1)
+        .err()
+        .unwrap();
+    assert!(
+        e.to_string()
+            .contains("[gravity] sums over open space, and the [box] is periodic"),
+        "{e}"
+    );
+    let mut built = common::build(text);
     let sim = &mut built.simulation;
+    sim.forces
+        .push(mote_md::force::DirectGravity::new(1.0, 0.0));
     common::steps(sim, 1, |_| {});
     assert_eq!(sim.forces.without_virial(), ["gravity"]);
     assert!(Observables::measure(&sim.system, &mut sim.forces)

@@ -61,6 +61,13 @@ impl Section for GravitySettings {
                 )));
             }
         }
+        if b.boundary.periodic.iter().any(|p| *p) {
+            // Both methods sum over open space; a periodic box would have
+            // every pair at its open-space distance, not its image's.
+            return Err(err(
+                "[gravity] sums over open space, and the [box] is periodic: leave out [box], or make it open (periodic = [false, false, false])".into(),
+            ));
+        }
         let g = self.g.unwrap_or(scene.units.gravitational_constant());
         match (self.method.as_str(), self.theta) {
             ("direct", None) => b.forces.push(DirectGravity::new(g, self.softening)),
