@@ -116,7 +116,7 @@ impl Engine {
                 engine.title()
             )));
         }
-        Ok(Engine::of_scene(text))
+        Ok(named.first().map_or(Engine::Particles, |n| n.2))
     }
 
     /// The heading `mote examples` groups this engine's examples under.

@@ -313,8 +313,9 @@ impl OutputTable {
     }
 }
 
-/// `[box]`, as every engine spells it: the corners `lo` and `hi` and which
-/// axes are `periodic` (default all), each with its span. Each engine checks the number
+/// `[box]`, as every engine spells it: the corners `lo` (default the
+/// origin) and `hi` and which axes are `periodic` (default all), each with
+/// its span. Each engine checks the number
 /// of axes and what it requires ([`BoxTable::axes`]).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -347,13 +348,21 @@ impl BoxTable {
         if let Some(p) = &self.periodic {
             count("periodic", p.span(), p.get_ref().len())?;
         }
-        if let (Some(lo), Some(hi)) = (&self.lo, &self.hi) {
-            let (l, h) = (lo.get_ref(), hi.get_ref());
+        if let Some(hi) = &self.hi {
+            let (l, h) = (self.lo(d), hi.get_ref());
             if (0..d).any(|k| h[k] <= l[k] || h[k].is_nan() || l[k].is_nan()) {
                 return Err(src.error(hi.span(), "[box] needs lo < hi on every axis"));
             }
         }
         Ok(())
+    }
+
+    /// The lower corner: as given, else the origin (the default of every
+    /// engine).
+    pub fn lo(&self, d: usize) -> Vec<f64> {
+        self.lo
+            .as_ref()
+            .map_or_else(|| vec![0.0; d], |lo| lo.get_ref().clone())
     }
 
     /// Which axes are periodic: as given, else every axis (the default
@@ -421,5 +430,10 @@ mod tests {
         let b = toml::from_str::<Scene>(text).unwrap().bounds;
         assert_eq!(b.axes(Source::new("s.toml", text), 2).unwrap_err().line, 3);
         assert_eq!(b.periodic(2), vec![true, true]);
+        // lo defaults to the origin, and hi must lie beyond it
+        let text = "[box]\nhi = [1, -1, 1]\n";
+        let b = toml::from_str::<Scene>(text).unwrap().bounds;
+        assert_eq!(b.lo(3), vec![0.0; 3]);
+        assert_eq!(b.axes(Source::new("s.toml", text), 3).unwrap_err().line, 2);
     }
 }

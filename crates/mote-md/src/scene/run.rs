@@ -14,20 +14,20 @@ use crate::observe::Probe;
 use mote_run::scene::{BoxTable, OutputTable, RunLength, RunTable, Setting};
 
 /// The box of a time-stepped scene's `[box]` (the envelope's
-/// [`BoxTable`]): `lo` and `hi` on three axes, the periodic axes (default
-/// all).
+/// [`BoxTable`]): `hi` and `lo` (default the origin) on three axes, the
+/// periodic axes (default all).
 pub fn scene_box(table: &Spanned<BoxTable>, src: Source) -> Result<Boundary, ParseError> {
     let b = table.get_ref();
     b.axes(src, 3)?;
-    let (Some(lo), Some(hi)) = (&b.lo, &b.hi) else {
+    let Some(hi) = &b.hi else {
         return Err(src.error(
             table.span(),
-            "[box] needs lo and hi, its lower and upper corners: lo = [0, 0, 0], hi = [10, 10, 10]",
+            "[box] needs hi, its upper corner: hi = [10, 10, 10] (lo, the lower one, defaults to the origin)",
         ));
     };
     let periodic = b.periodic(3);
     Ok(Boundary {
-        lo: DVec3::from_slice(lo.get_ref()),
+        lo: DVec3::from_slice(&b.lo(3)),
         hi: DVec3::from_slice(hi.get_ref()),
         periodic: [periodic[0], periodic[1], periodic[2]],
     })

@@ -472,12 +472,15 @@ impl RigidScene {
     /// has one.
     pub fn box_faces(&self) -> Option<(DVec3, DVec3, [bool; 3])> {
         let b = self.bounds.as_ref()?.get_ref();
-        let corner = |c: &Option<Spanned<Vec<f64>>>| {
-            let c = c.as_ref()?.get_ref();
-            (c.len() == 3).then(|| DVec3::from_slice(c))
-        };
+        let (lo, hi) = (b.lo(3), b.hi.as_ref()?.get_ref());
         let p = b.periodic(3);
-        Some((corner(&b.lo)?, corner(&b.hi)?, [p[0], p[1], p[2]]))
+        (lo.len() == 3 && hi.len() == 3).then(|| {
+            (
+                DVec3::from_slice(&lo),
+                DVec3::from_slice(hi),
+                [p[0], p[1], p[2]],
+            )
+        })
     }
 
     /// `[box]` checked (lo < hi on every axis), with its span.
