@@ -396,14 +396,7 @@ impl Frbi {
     /// cannot give one.
     pub fn virial(&mut self, b: &RigidBodies) -> Result<f64, Vec<String>> {
         self.world.update(b);
-        let view = BodyView {
-            bodies: b,
-            world: &self.world,
-            step: StepParameters {
-                time: b.time,
-                dt: 0.0,
-            },
-        };
+        let view = BodyView::measured(b, &self.world);
         let mut total = 0.0;
         let mut without = Vec::new();
         for it in self.interactions.iter_mut() {
@@ -422,14 +415,7 @@ impl Frbi {
     /// Kinetic and potential energy at the bodies' current time.
     pub fn energies(&mut self, b: &RigidBodies) -> BodyEnergies {
         self.world.update(b);
-        let view = BodyView {
-            bodies: b,
-            world: &self.world,
-            step: StepParameters {
-                time: b.time,
-                dt: 0.0,
-            },
-        };
+        let view = BodyView::measured(b, &self.world);
         let potential = self
             .interactions
             .iter_mut()

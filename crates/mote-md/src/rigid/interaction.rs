@@ -198,7 +198,20 @@ pub struct BodyView<'a> {
     pub step: StepParameters,
 }
 
-impl BodyView<'_> {
+impl<'a> BodyView<'a> {
+    /// The bodies as they are, measured rather than stepped: at their
+    /// time, no time since a previous evaluation (histories do not advance).
+    pub fn measured(bodies: &'a RigidBodies, world: &'a WorldFrame) -> Self {
+        BodyView {
+            bodies,
+            world,
+            step: StepParameters {
+                time: bodies.time,
+                dt: 0.0,
+            },
+        }
+    }
+
     /// The velocity of the material point `p` of body i: `v + ω × (p − x)`.
     #[inline]
     pub fn point_velocity(&self, i: usize, p: DVec3) -> DVec3 {
