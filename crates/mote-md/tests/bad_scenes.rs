@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use mote_md::rigid::scene::{is_rigid_scene, RigidScene};
 use mote_md::scene::Scene;
 
 /// The error a fixture expects, as `file:line: message` for `file`.
@@ -37,8 +38,14 @@ fn every_bad_scene_is_refused_with_its_file_line_and_message() {
         let file = format!("bad/{}", path.file_name().unwrap().to_string_lossy());
         let text = std::fs::read_to_string(path).unwrap();
         let want = expected(&file, &text);
-        let got = match Scene::parse(&text, &file).and_then(|s| s.build(&text, &file, 1)) {
-            Ok(_) => "accepted".to_string(),
+        // One scene file for both kinds: a [rigid] table makes it rigid.
+        let built = if is_rigid_scene(&text) {
+            RigidScene::parse(&text, &file).and_then(|s| s.build(&text, &file, None).map(|_| ()))
+        } else {
+            Scene::parse(&text, &file).and_then(|s| s.build(&text, &file, 1).map(|_| ()))
+        };
+        let got = match built {
+            Ok(()) => "accepted".to_string(),
             Err(e) => e.to_string(),
         };
         if got != want {

@@ -82,12 +82,7 @@ pub fn probe(
             "[rigid.nip] needs the scene's [box] (the shell and the belt are its faces)",
         ));
     };
-    let latent = scene
-        .rigid
-        .get_ref()
-        .latent_image
-        .as_ref()
-        .map(|l| l.get_ref());
+    let latent = scene.settings().latent_image.as_ref().map(|l| l.get_ref());
     let contrast = latent
         .map(|l| l.patches.first().map_or(0.0, |p| p[2] - l.background))
         .unwrap_or(0.0);

@@ -176,7 +176,7 @@ pub struct Spin<'a> {
 }
 
 /// Something that exerts forces.
-pub trait Interaction: Send {
+pub trait Interaction: Send + Sync {
     /// A short name for reports (`gravity`, `springs`, ...).
     fn name(&self) -> &'static str;
     /// Adds this interaction's force on each particle to `force`.
@@ -249,6 +249,53 @@ pub trait Interaction: Send {
     /// shared neighbour list ([`State::neighbours`]); `None` if it reads none.
     fn neighbour_reach(&self) -> Option<(f64, f64)> {
         None
+    }
+}
+
+/// A boxed interaction is one: a scene's tables make them so, and a law
+/// between rigid bodies' centres wraps what its table made.
+impl Interaction for Box<dyn Interaction> {
+    fn name(&self) -> &'static str {
+        (**self).name()
+    }
+    fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
+        (**self).add_forces(state, force)
+    }
+    fn exerts_torques(&self) -> bool {
+        (**self).exerts_torques()
+    }
+    fn add_forces_and_torques(
+        &mut self,
+        state: &State,
+        spin: &Spin,
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+    ) {
+        (**self).add_forces_and_torques(state, spin, force, torque)
+    }
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        (**self).potential_energy(state)
+    }
+    fn carried_state(&self) -> Vec<f64> {
+        (**self).carried_state()
+    }
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        (**self).restore_carried_state(state)
+    }
+    fn viewer(&self) -> Option<&dyn ViewerHooks> {
+        (**self).viewer()
+    }
+    fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {
+        (**self).viewer_mut()
+    }
+    fn virial(&self) -> Option<f64> {
+        (**self).virial()
+    }
+    fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        (**self).virial_tensor(state)
+    }
+    fn neighbour_reach(&self) -> Option<(f64, f64)> {
+        (**self).neighbour_reach()
     }
 }
 

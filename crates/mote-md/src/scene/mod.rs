@@ -12,8 +12,10 @@
 //! - [`run`]: `[run]`, `[output]`, `[box]`; [`plist`]: MPPphys particle files.
 //!
 //! A new force law is a settings type implementing [`Section`] in a file of
-//! its own, a field of [`Scene`], and one line in [`Scene::build`] where the
-//! interactions are listed in the order their forces are summed.
+//! its own, a field of [`SceneFile`], and one line in [`Scene::build`] where
+//! the interactions are listed in the order their forces are summed; a law
+//! between rigid bodies' centres (masses, charges, dipoles) is one more
+//! entry in [`SceneFile::centre_laws`], and rigid scenes take it as it is.
 //!
 //! Particles are numbered in this order: `[[particle]]` tables, then
 //! `[[lattice]]`, `[[ring]]`, `[[annulus]]`, `[[random_box]]`, `[[fcc]]`,
@@ -61,10 +63,17 @@ pub use particles::{
 };
 pub use plist::PlistSystem;
 
-/// A whole scene file.
+/// A whole scene file: the envelope every time-stepped engine shares
+/// (`title`, `seed`, `units`, `[run]`, `[output]`, `[box]`,
+/// `[[from_file]]`), the point particles' tables, and `[rigid]`, the rigid
+/// clumps' engine table, of type `R`: a point-particle scene ([`Scene`])
+/// reads it only to refuse it, a rigid scene (`rigid::scene::RigidScene`,
+/// `SceneFile<RigidSettings>`) is built from it, with the laws between
+/// point particles its bodies feel between their centres
+/// ([`SceneFile::centre_laws`]).
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Scene {
+pub struct SceneFile<R> {
     /// One line saying what the scene is.
     #[serde(default)]
     pub title: String,
@@ -114,7 +123,12 @@ pub struct Scene {
     pub spring: Vec<Spanned<SpringSpec>>,
     #[serde(default)]
     pub output: OutputTable,
+    /// `[rigid]`: the rigid clumps' engine table.
+    pub rigid: Option<Spanned<R>>,
 }
+
+/// A point-particle scene.
+pub type Scene = SceneFile<serde::de::IgnoredAny>;
 
 /// A scene turned into its parts, ready to run.
 pub struct Built {
@@ -180,17 +194,57 @@ pub(crate) fn add<K: Kind, T: Section<K>>(
     }
 }
 
+/// Parses a scene of either kind; errors are `file:line: message`.
+pub(crate) fn parse<S: serde::de::DeserializeOwned>(
+    text: &str,
+    file: &str,
+) -> Result<S, ParseError> {
+    Source::new(file, text).finite_numbers()?;
+    toml::from_str::<S>(text)
+        .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
+}
+
+impl<R> SceneFile<R> {
+    /// The tables of laws between point particles that rigid bodies feel
+    /// between their centres of mass, where their masses, charges and
+    /// dipoles sit (`rigid::AtCentres`), in the order their forces are
+    /// summed: a law listed here is one kernel for points and clumps.
+    pub fn centre_laws(&self) -> Vec<(&dyn Section, Range<usize>)> {
+        fn listed<T: Section>(t: &Option<Spanned<T>>) -> Option<(&dyn Section, Range<usize>)> {
+            t.as_ref().map(|t| (t.get_ref() as &dyn Section, t.span()))
+        }
+        [listed(&self.gravity), listed(&self.coulomb)]
+            .into_iter()
+            .flatten()
+            .collect()
+    }
+}
+
 impl Scene {
-    /// Parses a scene; errors are `file:line: message`.
+    /// Parses a point-particle scene; errors are `file:line: message`.
     pub fn parse(text: &str, file: &str) -> Result<Scene, ParseError> {
-        Source::new(file, text).finite_numbers()?;
-        toml::from_str::<Scene>(text)
-            .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
+        parse(text, file)
     }
 
     /// Builds the simulation. `text` and `file` locate errors; `seed` overrides the scene's.
     pub fn build(&self, text: &str, file: &str, seed: u64) -> Result<Built, ParseError> {
         let src = Source::new(file, text);
+        if let Some(r) = &self.rigid {
+            return Err(src.error(
+                r.span(),
+                "[rigid] makes rigid bodies: the scene is the rigid engine's (mote run builds it so)",
+            ));
+        }
+        let files = (self.lammps_data.iter().map(|s| ("lammps_data", s)))
+            .chain(self.from_file.iter().map(|s| ("from_file", s)));
+        for (table, spec) in files {
+            if let [key, ..] = spec.get_ref().given(&["templates", "tolerance"])[..] {
+                return Err(src.error(
+                    spec.span(),
+                    format!("[[{table}]] {key}: it matches a frame's spheres to the templates of rigid bodies, and the scene has no [rigid]"),
+                ));
+            }
+        }
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let made = particles::make(self, src, &mut rng)?;
         let boundary = run::boundary(&self.bounds, made.fcc_box, src)?;

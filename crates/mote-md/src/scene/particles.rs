@@ -252,8 +252,42 @@ pub struct DataSpec {
     /// The species of every particle (default: the file's names, a data
     /// file's `Atom Type Labels`, else `X`).
     pub species: Option<String>,
-    #[serde(default = "white")]
-    pub color: [f64; 3],
+    /// The particles' colour (default white).
+    pub color: Option<[f64; 3]>,
+    /// Rigid bodies only: the templates a frame's spheres are matched to
+    /// (default: all the scene's, in order).
+    pub templates: Option<Vec<String>>,
+    /// Rigid bodies only: the largest misfit of a sphere centre, as a
+    /// fraction of the template's bounding radius (default 1e-6; files of
+    /// few digits need more).
+    pub tolerance: Option<f64>,
+}
+
+impl DataSpec {
+    /// The particles' colour.
+    fn color(&self) -> [f64; 3] {
+        self.color.unwrap_or_else(white)
+    }
+
+    /// The keys this table gives, of `keys`.
+    pub fn given<'k>(&self, keys: &[&'k str]) -> Vec<&'k str> {
+        let given = |k: &str| match k {
+            "frame" => self.frame.is_some(),
+            "periodic" => self.periodic.is_some(),
+            "replicate" => self.replicate.is_some(),
+            "atom_style" => self.atom_style.is_some(),
+            "units" => self.units.is_some(),
+            "radius" => self.radius.is_some(),
+            "mass" => self.mass.is_some(),
+            "density" => self.density.is_some(),
+            "species" => self.species.is_some(),
+            "color" => self.color.is_some(),
+            "templates" => self.templates.is_some(),
+            "tolerance" => self.tolerance.is_some(),
+            _ => false,
+        };
+        keys.iter().copied().filter(|k| given(k)).collect()
+    }
 }
 
 /// The particles of a file, their species, the file's box if it has one,
@@ -343,7 +377,7 @@ fn from_file(
                 mass,
                 radius,
                 charge: a.charge * k.charge,
-                color: s.color,
+                color: s.color(),
                 ..ParticleInit::default()
             });
         }
@@ -415,7 +449,7 @@ fn from_file(
             dipole: get(&f.dipoles, i),
             mass,
             radius,
-            color: s.color,
+            color: s.color(),
             ..ParticleInit::default()
         });
     }

@@ -54,7 +54,7 @@ impl Section<Clumps> for ContactSettings {
     ) -> Result<(), ParseError> {
         let cs = self;
         let mut walls = Vec::new();
-        for (k, w) in scene.rigid.get_ref().wall.iter().enumerate() {
+        for (k, w) in scene.settings().wall.iter().enumerate() {
             walls.extend(w.get_ref().walls(k).map_err(|m| b.error(w.span(), m))?);
         }
         if !positive(cs.young) || !(0.0..0.5).contains(&cs.poisson) {

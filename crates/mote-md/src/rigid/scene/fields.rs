@@ -9,11 +9,9 @@ use mote_io::ParseError;
 use serde::Deserialize;
 
 use super::{Clumps, RigidBuild, RigidScene};
-use crate::boundary::Boundary;
-use crate::rigid::centres::{AtCentres, Coulomb, DipoleDipole};
+use crate::rigid::centres::{Coulomb, DipoleDipole};
 use crate::rigid::sources::{AirDrag, ExternalFields, Field, Gravity};
-use crate::scene::{CoulombLaw, CoulombSettings, Section};
-use crate::units::UnitSystem;
+use crate::scene::Section;
 
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
@@ -72,7 +70,7 @@ impl Section<Clumps> for FieldSettings {
         let fs = self;
         // With conducting planes, [rigid.planes] says what to do with the
         // charges (its table is the one to keep).
-        let planes = scene.rigid.get_ref().planes.is_some();
+        let planes = scene.settings().planes.is_some();
         if let Some(g) = fs.gravity {
             b.frbi.push(Box::new(Gravity { g: DVec3::from(g) }));
         }
@@ -110,56 +108,6 @@ impl Section<Clumps> for FieldSettings {
                 drag_coefficient: d.drag_coefficient,
                 wind: DVec3::from(d.wind),
             }));
-        }
-        Ok(())
-    }
-}
-
-/// `[coulomb]` in a rigid scene: the point particles' table and law
-/// ([`CoulombSettings::law`]) between the bodies' centres, where their
-/// charges sit ([`AtCentres`]): one Coulomb law for points and clumps.
-impl Section<Clumps> for CoulombSettings {
-    fn add_to(
-        &self,
-        span: Range<usize>,
-        scene: &RigidScene,
-        b: &mut RigidBuild<'_>,
-    ) -> Result<(), ParseError> {
-        let rigid = scene.rigid.get_ref();
-        if let Some(f) = rigid
-            .fields
-            .as_ref()
-            .filter(|f| f.get_ref().coulomb.is_some())
-        {
-            return Err(b.error(
-                span,
-                format!(
-                    "[coulomb] beside [rigid.fields] coulomb (line {}): give the charges' forces once",
-                    b.src.line_of(f.span().start)
-                ),
-            ));
-        }
-        if rigid.planes.is_some() {
-            return Err(b.error(
-                span,
-                "[coulomb] between conducting planes is [rigid.planes] coulomb (with the planes' images)".into(),
-            ));
-        }
-        let charge: Vec<f64> = (0..b.bodies.len())
-            .map(|i| b.bodies.template(i).charge)
-            .collect();
-        let boundary = b.scene_box.as_ref().map_or(Boundary::open(), |(bx, _)| *bx);
-        let law = self.law(
-            span,
-            b.src,
-            UnitSystem::Si.coulomb_constant(),
-            &charge,
-            boundary,
-        )?;
-        match law {
-            CoulombLaw::Direct(c) => b.frbi.push(Box::new(AtCentres::new(c))),
-            CoulombLaw::Tree(c) => b.frbi.push(Box::new(AtCentres::new(c))),
-            CoulombLaw::Ewald(c) => b.frbi.push(Box::new(AtCentres::new(c))),
         }
         Ok(())
     }

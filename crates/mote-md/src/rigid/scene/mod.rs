@@ -115,6 +115,7 @@
 //! (planes.rs); [`RigidScene::build`] adds them in that order.
 
 use std::ops::Range;
+use std::sync::LazyLock;
 
 use glam::DVec3;
 use mote_io::{ParseError, Source};
@@ -129,55 +130,30 @@ use super::frbi::{Frbi, FreeFlight, SpinUpdate};
 use crate::boundary::Boundary;
 use crate::force::granular::Material;
 use crate::force::slab::ConductingPlanes;
-use crate::scene::{add, Kind, Section};
+use crate::scene::{add, Kind, SceneFile, Section};
 
+mod centres;
 mod contacts;
 mod fields;
 mod placement;
 mod planes;
+mod point_tables;
 mod templates;
 
 pub use contacts::ContactSettings;
 pub use fields::{DragSpec, FieldSettings, FieldSpec};
-pub use placement::{BodySpec, FileSpec, Lattice, PlacementSpec, Random};
+pub use placement::{BodySpec, Lattice, PlacementSpec, Random};
 pub use planes::{LatentSettings, MagneticSpec, PlaneSettings, RollerSettings};
 pub use templates::TemplateSpec;
 
-/// A whole rigid scene file.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RigidScene {
-    #[serde(default)]
-    pub seed: Option<u64>,
-    /// Free text, ignored.
-    #[serde(default)]
-    pub title: Option<String>,
-    pub rigid: Spanned<RigidSettings>,
-    /// `[run]`: `dt` and the length (`steps` or `until`).
-    #[serde(default)]
-    pub run: crate::scene::RunTable,
-    /// `[[from_file]]`: bodies from a frame of their spheres (the key every
-    /// engine starts from a file with; `templates` and `tolerance` are
-    /// this engine's own).
-    #[serde(default)]
-    pub from_file: Vec<Spanned<FileSpec>>,
-    /// `[box]`, spelled as every engine spells it: `lo`, `hi` and the
-    /// periodic axes (default all). The contacts search across its
-    /// periodic faces; the planes, the roller and the nip take its faces.
-    #[serde(rename = "box", default)]
-    pub bounds: Option<Spanned<crate::scene::BoxTable>>,
-    /// `[coulomb]`, the point particles' table, between the bodies'
-    /// centres (their charges sit there): `direct` or `tree` in open space,
-    /// `ewald` in a cubic box periodic on every axis.
-    #[serde(default)]
-    pub coulomb: Option<Spanned<crate::scene::CoulombSettings>>,
-    /// The `[output]` of every time-stepped engine (`inspect`, which names
-    /// point particles, is refused).
-    #[serde(default)]
-    pub output: crate::scene::OutputTable,
-}
+/// A whole rigid scene file: the one scene of every time-stepped engine
+/// with its `[rigid]` table. Of the point particles' tables, the laws
+/// between point particles the bodies feel between their centres
+/// ([`SceneFile::centre_laws`]: `[gravity]`, `[coulomb]`) are taken; the
+/// others are refused at their line with what a rigid scene says instead.
+pub type RigidScene = SceneFile<RigidSettings>;
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigidSettings {
     #[serde(default)]
@@ -301,11 +277,16 @@ fn add_each<T: Section<Clumps>>(
 }
 
 impl RigidScene {
-    /// Parses a scene; errors are `file:line: message`.
-    pub fn parse(text: &str, file: &str) -> Result<Self, ParseError> {
-        Source::new(file, text).finite_numbers()?;
-        toml::from_str::<RigidScene>(text)
-            .map_err(|e| Source::new(file, text).parser_error(e.span(), e.message()))
+    /// Parses a rigid scene; errors are `file:line: message`.
+    pub fn parse(text: &str, file: &str) -> Result<RigidScene, ParseError> {
+        crate::scene::parse(text, file)
+    }
+
+    /// The `[rigid]` table (an empty one where the scene has none, which
+    /// [`RigidScene::build`] refuses first).
+    pub fn settings(&self) -> &RigidSettings {
+        static NONE: LazyLock<RigidSettings> = LazyLock::new(RigidSettings::default);
+        self.rigid.as_ref().map_or(&NONE, |r| r.get_ref())
     }
 
     /// Builds bodies and integrator; `seed` overrides the scene's.
@@ -317,8 +298,12 @@ impl RigidScene {
     ) -> Result<BuiltRigid, ParseError> {
         let src = Source::new(file, text);
         let err = |span: Range<usize>, msg: String| src.error(span, msg);
+        let Some(rigid_table) = &self.rigid else {
+            return Err(src.whole("a rigid scene needs its [rigid] table"));
+        };
+        point_tables::refuse(self, src)?;
         let seed = seed.or(self.seed).unwrap_or(1);
-        let rigid = self.rigid.get_ref();
+        let rigid = rigid_table.get_ref();
         self.output.refuse(
             src,
             &[
@@ -396,12 +381,15 @@ impl RigidScene {
         add_each(&rigid.random, self, &mut b)?;
         if b.bodies.is_empty() {
             return Err(src.error(
-                self.rigid.span(),
+                rigid_table.span(),
                 "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]] or [[from_file]]",
             ));
         }
         add(&rigid.fields, self, &mut b)?;
-        add::<Clumps, _>(&self.coulomb, self, &mut b)?;
+        centres::refuse_charges_twice(self, &b)?;
+        for (law, span) in self.centre_laws() {
+            centres::add_law(law, span, &mut b)?;
+        }
         match contact {
             Some(_) => add(&rigid.contacts, self, &mut b)?,
             None => {
@@ -461,7 +449,7 @@ impl RigidScene {
     /// The body kind (template index) of the template named `name`:
     /// templates are numbered in the order `[[rigid.template]]` lists them.
     pub fn template_kind(&self, name: &str) -> Option<u32> {
-        let templates = &self.rigid.get_ref().template;
+        let templates = &self.settings().template;
         templates
             .iter()
             .position(|t| t.get_ref().name == name)

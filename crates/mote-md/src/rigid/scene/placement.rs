@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use super::{positive, Clumps, RigidBuild, RigidScene};
 use crate::rigid::bodies::RigidBodies;
-use crate::scene::Section;
+use crate::scene::{DataSpec, Section};
 
 /// `[[rigid.body]]`.
 #[derive(Debug, Deserialize)]
@@ -70,30 +70,17 @@ impl Section<Clumps> for BodySpec {
     }
 }
 
-/// `[[from_file]]` of a rigid scene: the bodies of a trajectory frame (`.xyz`,
+/// `[[from_file]]` of a rigid scene, the table every time-stepped engine
+/// starts from a file with: the bodies of a trajectory frame (`.xyz`,
 /// `.dump`, `.gsd`, `.vtp`/`.vtu`/`.pvd`; path relative to the scene file;
 /// the last frame unless `frame` says which, negative counting from the
 /// end), as a rigid run writes them: one row per sphere with its radius and
 /// body id (a LAMMPS dump's `mol`), and where present the orientation
 /// quaternion and angular velocity. Each body is matched to a template by
-/// its spheres (see [`super::from_file`]).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FileSpec {
-    pub file: String,
-    #[serde(default)]
-    pub frame: Option<i64>,
-    /// Only these templates (default: all the scene's, in order).
-    #[serde(default)]
-    pub templates: Option<Vec<String>>,
-    /// The largest misfit of a sphere centre, as a fraction of the
-    /// template's bounding radius (default 1e-6; files of few digits need
-    /// more).
-    #[serde(default)]
-    pub tolerance: Option<f64>,
-}
-
-impl Section<Clumps> for FileSpec {
+/// its spheres (see [`super::from_file`]); `templates` and `tolerance` are
+/// this engine's keys, the point particles' (masses, radii, units, box)
+/// are refused: a body's are its template's.
+impl Section<Clumps> for DataSpec {
     /// The bodies of the frame, each matched to one of the templates
     /// named (all, by default) by its spheres.
     fn add_to(
@@ -104,6 +91,22 @@ impl Section<Clumps> for FileSpec {
     ) -> Result<(), ParseError> {
         let fs = self;
         let at = |m: String| b.error(span.clone(), m);
+        let points = [
+            "periodic",
+            "replicate",
+            "atom_style",
+            "units",
+            "radius",
+            "mass",
+            "density",
+            "species",
+            "color",
+        ];
+        if let [key, ..] = fs.given(&points)[..] {
+            return Err(at(format!(
+                "[[from_file]] {key}: a key of point particles; a body's spheres, mass and charge are its template's (this table takes file, frame, templates, tolerance)"
+            )));
+        }
         let candidates: Vec<(String, u32)> = match &fs.templates {
             None => b.names.clone(),
             Some(list) => list

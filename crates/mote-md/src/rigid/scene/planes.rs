@@ -88,13 +88,8 @@ impl Section<Clumps> for PlaneSettings {
         scene: &RigidScene,
         b: &mut RigidBuild<'_>,
     ) -> Result<(), ParseError> {
-        let built = plane_coulomb(
-            self,
-            scene.box_faces(),
-            &scene.rigid.get_ref().fields,
-            &b.bodies,
-        )
-        .map_err(|m| b.error(span, m))?;
+        let built = plane_coulomb(self, scene.box_faces(), &scene.settings().fields, &b.bodies)
+            .map_err(|m| b.error(span, m))?;
         b.planes = Some((built.planes.clone(), built.z0));
         b.frbi.push(Box::new(built));
         Ok(())
