@@ -227,3 +227,87 @@ fn mutual_gravity_acts_between_the_bodies_centres() {
         "{energy} vs {want}"
     );
 }
+
+/// `[dipolar] method = "ewald"`, the point particles' table, between rigid
+/// bodies in a periodic cube: eight magnetised one-sphere bodies get the
+/// forces, torques and energy eight point dipoles at their centres get from
+/// the same table — one Ewald dipole sum for points and clumps.
+#[test]
+fn ewald_dipoles_between_bodies_are_the_point_particles() {
+    use glam::DVec3;
+    use mote_md::force::{Spin, State};
+    use mote_md::scene::Scene;
+    let places = [
+        [0.4, 0.7, 1.1],
+        [2.9, 0.3, 4.6],
+        [5.1, 2.2, 0.9],
+        [1.7, 3.8, 2.5],
+        [4.2, 4.9, 5.3],
+        [0.8, 5.6, 3.9],
+        [3.3, 1.9, 2.8],
+        [5.7, 4.1, 1.6],
+    ];
+    let moments = [
+        [0.3, -0.8, 0.5],
+        [-0.6, 0.1, 0.9],
+        [1.0, 0.4, -0.2],
+        [0.0, 0.7, 0.7],
+        [-0.4, -0.4, 0.8],
+        [0.9, -0.3, 0.1],
+        [0.2, 1.1, -0.5],
+        [-0.7, 0.6, 0.3],
+    ];
+    let envelope = "[box]\nhi = [6.0, 6.0, 6.0]\n\n[dipolar]\nmethod = \"ewald\"\nmu0 = 2.0\naccuracy = 1e-6\n\n[run]\ndt = 0.01\nsteps = 1\n";
+    let mut points = envelope.to_string();
+    let mut rigid = format!("{envelope}\n[rigid]\n");
+    for (k, (x, m)) in places.iter().zip(moments).enumerate() {
+        points += &format!(
+            "\n[[particle]]\nposition = {x:?}\nmass = 1.0\nradius = 0.3\ndipole = {m:?}\n"
+        );
+        rigid += &format!(
+            "\n[[rigid.template]]\nname = \"t{k}\"\ngenerator = \"sphere\"\nradius = 0.3\ndensity = 1.0\ndipole = {m:?}\n\n[[rigid.body]]\ntemplate = \"t{k}\"\nposition = {x:?}\n"
+        );
+    }
+    let mut sim = Scene::parse(&points, "points.toml")
+        .and_then(|s| s.build(&points, "points.toml", 1))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .simulation;
+    let p = &sim.system.particles;
+    let state = State::new(&p.position, &p.velocity, &p.mass, 0.0).with_dipoles(&p.dipole);
+    let spin = Spin {
+        angular_velocity: &p.angular_velocity,
+    };
+    let n = places.len();
+    let (mut force, mut torque) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+    sim.forces
+        .add_forces_and_torques(&state, &spin, &mut force, &mut torque);
+    let point_energy = sim.forces.potential_energy(&state).0;
+
+    let built = RigidScene::parse(&rigid, "rigid.toml")
+        .unwrap()
+        .build(&rigid, "rigid.toml", None)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut frbi = built.frbi;
+    let w = frbi.wrenches(&built.bodies, 0.0, 0.0).to_vec();
+    let scale = force.iter().map(|f| f.length()).fold(0.0, f64::max);
+    assert!(scale > 0.0 && point_energy != 0.0, "the dipoles interact");
+    for i in 0..n {
+        assert!(
+            (w[i].v - force[i]).length() <= 1e-12 * scale,
+            "force {i}: {} vs {}",
+            w[i].v,
+            force[i]
+        );
+        assert!(
+            (w[i].omega - torque[i]).length() <= 1e-12 * scale,
+            "torque {i}: {} vs {}",
+            w[i].omega,
+            torque[i]
+        );
+    }
+    let energy = frbi.energies(&built.bodies).potential;
+    assert!(
+        (energy - point_energy).abs() <= 1e-12 * point_energy.abs(),
+        "{energy} vs {point_energy}"
+    );
+}

@@ -296,19 +296,21 @@ steps = 1
         w.v.z
     );
     assert!(w.v.x.abs() < 1e-9 && w.v.y.abs() < 1e-9);
-    // With Coulomb in [rigid.fields] too, the scene is refused at the table.
-    let twice = text.replace(
-        "[rigid.planes]",
-        "[rigid.fields]\ncoulomb = 1.0\n\n[rigid.planes]",
-    );
+    // With the point particles' Coulomb table too, the scene is refused
+    // at that table: the planes sum the charges' forces with their images.
+    let twice = text.replace("[rigid.planes]", "[coulomb]\nk = 1.0\n\n[rigid.planes]");
     let e = RigidScene::parse(&twice, "planes.toml")
         .unwrap()
         .build(&twice, "planes.toml", None)
         .err()
         .unwrap();
-    assert!(e.to_string().contains("remove coulomb"), "{e}");
-    let planes_line = twice.lines().position(|l| l == "[rigid.planes]").unwrap() + 1;
-    assert_eq!(e.line, planes_line, "{e}");
+    assert!(
+        e.to_string()
+            .contains("[coulomb] between conducting planes is [rigid.planes] coulomb"),
+        "{e}"
+    );
+    let coulomb_line = twice.lines().position(|l| l == "[coulomb]").unwrap() + 1;
+    assert_eq!(e.line, coulomb_line, "{e}");
     // The box's first spelling, inside [rigid.contacts], is refused with
     // the one every engine uses.
     let old = text

@@ -799,8 +799,9 @@ fn charged_bodies_in_a_periodic_box_have_the_madelung_energy_and_its_pressure() 
         "{}",
         stderr(&o)
     );
-    // So is the open-space sum of [rigid.fields] in a periodic box (it ran,
-    // missing every image).
+    // The first spelling of the laws between centres, in [rigid.fields]
+    // (summed over open space, even in a periodic box), is refused with
+    // the point particles' tables that replaced it.
     let fields = scene.replace(
         "[coulomb]\nmethod = \"ewald\"\nk = 1.0\naccuracy = 1e-7\n",
         "[rigid.fields]\ncoulomb = 1.0\n",
@@ -811,7 +812,7 @@ fn charged_bodies_in_a_periodic_box_have_the_madelung_energy_and_its_pressure() 
     let line = fields.lines().position(|l| l == "[rigid.fields]").unwrap() + 1;
     assert!(
         stderr(&o).contains(&format!(
-            "fields.toml:{line}: [rigid.fields] coulomb sums over open space, and the [box] is periodic"
+            "fields.toml:{line}: [rigid.fields] coulomb: Coulomb's law between the bodies is the point particles' table, [coulomb] k = ..."
         )),
         "{}",
         stderr(&o)
@@ -822,7 +823,7 @@ fn charged_bodies_in_a_periodic_box_have_the_madelung_energy_and_its_pressure() 
     assert!(!o.status.success());
     assert!(
         stderr(&o).contains(&format!(
-            "dipoles.toml:{line}: [rigid.fields] dipole_dipole sums over open space, and the [box] is periodic"
+            "dipoles.toml:{line}: [rigid.fields] dipole_dipole: the dipoles' law between the bodies is the point particles' table, [dipolar] mu0 = 4π k"
         )),
         "{}",
         stderr(&o)

@@ -81,6 +81,12 @@ impl Section for DipolarSettings {
             .mu0
             .or(mu0_default)
             .ok_or_else(|| err(span.clone(), "[dipolar] needs mu0 in these units".into()))?;
+        if v.random_orientation && b.centres_of_bodies {
+            return Err(err(
+                span,
+                "[dipolar] random_orientation turns point particles' dipoles; a body's dipole is its template's, turned with the body (random_orientation of [[rigid.lattice]] and [[rigid.random]])".into(),
+            ));
+        }
         if v.random_orientation {
             use rand::Rng;
             for m in b.particles.dipole.iter_mut() {

@@ -149,6 +149,10 @@ pub struct Build<'a> {
     pub particles: Particles,
     pub boundary: Boundary,
     pub forces: ForceField,
+    /// The particles are rigid bodies' centres (`SceneFile::centre_laws`):
+    /// their masses, charges and dipoles are the templates', and a table
+    /// that would change them refuses.
+    pub centres_of_bodies: bool,
 }
 
 /// The kind of scene a table belongs to: the scene as parsed and what its
@@ -213,10 +217,14 @@ impl<R> SceneFile<R> {
         fn listed<T: Section>(t: &Option<Spanned<T>>) -> Option<(&dyn Section, Range<usize>)> {
             t.as_ref().map(|t| (t.get_ref() as &dyn Section, t.span()))
         }
-        [listed(&self.gravity), listed(&self.coulomb)]
-            .into_iter()
-            .flatten()
-            .collect()
+        [
+            listed(&self.gravity),
+            listed(&self.dipolar),
+            listed(&self.coulomb),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
     }
 }
 
@@ -255,6 +263,7 @@ impl Scene {
             particles: made.particles,
             boundary,
             forces: ForceField::new(),
+            centres_of_bodies: false,
         };
         // The interactions, in the order their forces are summed.
         add(&self.gravity, self, &mut b)?;

@@ -1,5 +1,5 @@
 //! The point particles' laws between the bodies' centres: a table of
-//! [`SceneFile::centre_laws`](crate::scene::SceneFile::centre_laws) (`[gravity]`, `[coulomb]`) is built by its own
+//! [`SceneFile::centre_laws`](crate::scene::SceneFile::centre_laws) (`[gravity]`, `[dipolar]`, `[coulomb]`) is built by its own
 //! point-particle section, on the bodies as point particles — each body's
 //! centre of mass with its mass, charge, dipole and velocity — and each
 //! interaction it makes acts between the centres ([`AtCentres`]). A law
@@ -46,6 +46,7 @@ pub(super) fn add_law(
         particles,
         boundary: b.scene_box.as_ref().map_or(Boundary::open(), |(bx, _)| *bx),
         forces: ForceField::new(),
+        centres_of_bodies: true,
     };
     // A law between centres reads no other point-particle table.
     law.add_to(span, &Scene::default(), &mut centres)?;

@@ -1,6 +1,7 @@
 //! `[rigid.fields]`: gravity, external electric and magnetic fields
-//! (constant or rotating), Coulomb and dipole–dipole forces between the
-//! bodies, and air drag.
+//! (constant or rotating) and air drag. (Coulomb and dipole–dipole forces
+//! between the bodies are the point particles' `[coulomb]` and `[dipolar]`,
+//! between the centres: centres.rs.)
 
 use std::ops::Range;
 
@@ -9,7 +10,6 @@ use mote_io::ParseError;
 use serde::Deserialize;
 
 use super::{Clumps, RigidBuild, RigidScene};
-use crate::rigid::centres::{Coulomb, DipoleDipole};
 use crate::rigid::sources::{AirDrag, ExternalFields, Field, Gravity};
 use crate::scene::Section;
 
@@ -52,8 +52,12 @@ pub struct FieldSettings {
     pub electric: Option<FieldSpec>,
     #[serde(default)]
     pub magnetic: Option<FieldSpec>,
+    /// The first spelling of `[coulomb]` between the bodies, refused with
+    /// it.
     #[serde(default)]
     pub coulomb: Option<f64>,
+    /// The first spelling of `[dipolar]` between the bodies, refused with
+    /// it.
     #[serde(default)]
     pub dipole_dipole: Option<f64>,
     #[serde(default)]
@@ -64,13 +68,24 @@ impl Section<Clumps> for FieldSettings {
     fn add_to(
         &self,
         span: Range<usize>,
-        scene: &RigidScene,
+        _: &RigidScene,
         b: &mut RigidBuild<'_>,
     ) -> Result<(), ParseError> {
         let fs = self;
-        // With conducting planes, [rigid.planes] says what to do with the
-        // charges (its table is the one to keep).
-        let planes = scene.settings().planes.is_some();
+        // The laws between the bodies' centres are the point particles'
+        // tables (their first spelling was here).
+        if fs.coulomb.is_some() {
+            return Err(b.error(
+                span,
+                "[rigid.fields] coulomb: Coulomb's law between the bodies is the point particles' table, [coulomb] k = ... (method direct, tree or ewald)".into(),
+            ));
+        }
+        if fs.dipole_dipole.is_some() {
+            return Err(b.error(
+                span,
+                "[rigid.fields] dipole_dipole: the dipoles' law between the bodies is the point particles' table, [dipolar] mu0 = 4π k (all pairs, cutoff or method = \"ewald\")".into(),
+            ));
+        }
         if let Some(g) = fs.gravity {
             b.frbi.push(Box::new(Gravity { g: DVec3::from(g) }));
         }
@@ -78,28 +93,6 @@ impl Section<Clumps> for FieldSettings {
             let electric = field(&fs.electric).map_err(|m| b.error(span.clone(), m))?;
             let magnetic = field(&fs.magnetic).map_err(|m| b.error(span.clone(), m))?;
             b.frbi.push(Box::new(ExternalFields { electric, magnetic }));
-        }
-        let periodic = b
-            .scene_box
-            .as_ref()
-            .is_some_and(|(bx, _)| bx.periodic.iter().any(|p| *p));
-        if let Some(k) = fs.coulomb {
-            if periodic && !planes {
-                return Err(b.error(
-                    span,
-                    "[rigid.fields] coulomb sums over open space, and the [box] is periodic: give [coulomb] method = \"ewald\" (a box periodic on every axis) or [rigid.planes] coulomb (periodic along the planes)".into(),
-                ));
-            }
-            b.frbi.push(Box::new(Coulomb::coulomb(k)));
-        }
-        if let Some(k) = fs.dipole_dipole {
-            if periodic {
-                return Err(b.error(
-                    span,
-                    "[rigid.fields] dipole_dipole sums over open space, and the [box] is periodic: the images would be missed (the roller's induced moments, [rigid.roller] dipole_dipole, take the minimum image)".into(),
-                ));
-            }
-            b.frbi.push(Box::new(DipoleDipole::dipoles(k)));
         }
         if let Some(d) = &fs.drag {
             b.frbi.push(Box::new(AirDrag {

@@ -43,13 +43,18 @@
 //! gravity = [0.0, 0.0, -9.81]
 //! electric = [0.0, 0.0, 0.0]
 //! magnetic = { amplitude = 1.0, axis = [0, 0, 1], start = [1, 0, 0], frequency = 0.5 }
-//! coulomb = 8.99e9             # k of Coulomb forces between charges (off if absent)
-//! dipole_dipole = 1e-7         # k = μ0/4π of dipole–dipole forces (off if absent)
 //! drag = { viscosity = 1.8e-5, air_density = 1.2, drag_coefficient = 0.47 }
 //!
 //! [coulomb]                    # the point particles' table, between the centres:
 //! method = "ewald"             # direct or tree (open space), ewald (cubic, periodic)
 //! accuracy = 1e-3              # Ewald's RMS force error aimed at
+//!
+//! [dipolar]                    # the point particles' table, between the centres'
+//! method = "ewald"             # dipoles (each body's its template's, turned with it):
+//! accuracy = 1e-3              # all pairs, cutoff (minimum image) or ewald
+//!
+//! [gravity]                    # the point particles' table: mutual gravitation
+//! G = 6.674e-11                # of the bodies' masses (open space)
 //!
 //! [rigid.contacts]
 //! young = 1e7
@@ -149,7 +154,7 @@ pub use templates::TemplateSpec;
 /// A whole rigid scene file: the one scene of every time-stepped engine
 /// with its `[rigid]` table. Of the point particles' tables, the laws
 /// between point particles the bodies feel between their centres
-/// ([`SceneFile::centre_laws`]: `[gravity]`, `[coulomb]`) are taken; the
+/// ([`SceneFile::centre_laws`]: `[gravity]`, `[dipolar]`, `[coulomb]`) are taken; the
 /// others are refused at their line with what a rigid scene says instead.
 pub type RigidScene = SceneFile<RigidSettings>;
 

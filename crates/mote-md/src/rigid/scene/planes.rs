@@ -10,9 +10,8 @@ use std::ops::Range;
 use glam::DVec3;
 use mote_io::ParseError;
 use serde::Deserialize;
-use toml::Spanned;
 
-use super::{positive, Clumps, FieldSettings, RigidBuild, RigidScene};
+use super::{positive, Clumps, RigidBuild, RigidScene};
 use crate::force::latent::{LatentImage, Patch};
 use crate::force::slab::ConductingPlanes;
 use crate::rigid::bodies::RigidBodies;
@@ -88,8 +87,8 @@ impl Section<Clumps> for PlaneSettings {
         scene: &RigidScene,
         b: &mut RigidBuild<'_>,
     ) -> Result<(), ParseError> {
-        let built = plane_coulomb(self, scene.box_faces(), &scene.settings().fields, &b.bodies)
-            .map_err(|m| b.error(span, m))?;
+        let built =
+            plane_coulomb(self, scene.box_faces(), &b.bodies).map_err(|m| b.error(span, m))?;
         b.planes = Some((built.planes.clone(), built.z0));
         b.frbi.push(Box::new(built));
         Ok(())
@@ -213,15 +212,8 @@ fn induced_dipoles(
 fn plane_coulomb(
     ps: &PlaneSettings,
     scene_box: Option<(DVec3, DVec3, [bool; 3])>,
-    fields: &Option<Spanned<FieldSettings>>,
     bodies: &RigidBodies,
 ) -> Result<PlaneCoulomb, String> {
-    if fields
-        .as_ref()
-        .is_some_and(|f| f.get_ref().coulomb.is_some())
-    {
-        return Err("[rigid.planes] sums the Coulomb forces with their images: remove coulomb from [rigid.fields]".into());
-    }
     let Some((lo, hi, [true, true, false])) = scene_box else {
         return Err("[rigid.planes] needs a [box] with periodic = [true, true, false] (the planes are its faces z = lo.z and z = hi.z)".into());
     };

@@ -36,17 +36,56 @@ pub(super) fn refuse(scene: &RigidScene, src: Source) -> Result<(), ParseError> 
         ));
     }
     let refused = [
-        (table(&scene.field), "[field]", "a uniform field on rigid bodies is [rigid.fields] gravity = [gx, gy, gz]"),
-        (table(&scene.damping), "[damping]", "air drag on rigid bodies is [rigid.fields] drag"),
-        (table(&scene.lennard_jones), "[lennard_jones]", "rigid bodies touch through [rigid.contacts]"),
-        (table(&scene.thermostat), "[thermostat]", "rigid bodies have no thermostat"),
-        (table(&scene.brownian), "[brownian]", "rigid bodies have no Brownian dynamics"),
-        (table(&scene.granular), "[granular]", "contacts between rigid bodies are [rigid.contacts]"),
-        (table(&scene.dipolar), "[dipolar]", "dipoles between rigid bodies are [rigid.fields] dipole_dipole (each body's moment is its template's dipole)"),
-        (table(&scene.magnetic_field), "[magnetic_field]", "a field on rigid bodies is [rigid.fields] magnetic"),
-        (table(&scene.electric_field), "[electric_field]", "a field on rigid bodies is [rigid.fields] electric"),
-        (first(&scene.wall), "[[wall]]", "walls of rigid bodies are [[rigid.wall]]"),
-        (first(&scene.spring), "[[spring]]", "springs join point particles"),
+        (
+            table(&scene.field),
+            "[field]",
+            "a uniform field on rigid bodies is [rigid.fields] gravity = [gx, gy, gz]",
+        ),
+        (
+            table(&scene.damping),
+            "[damping]",
+            "air drag on rigid bodies is [rigid.fields] drag",
+        ),
+        (
+            table(&scene.lennard_jones),
+            "[lennard_jones]",
+            "rigid bodies touch through [rigid.contacts]",
+        ),
+        (
+            table(&scene.thermostat),
+            "[thermostat]",
+            "rigid bodies have no thermostat",
+        ),
+        (
+            table(&scene.brownian),
+            "[brownian]",
+            "rigid bodies have no Brownian dynamics",
+        ),
+        (
+            table(&scene.granular),
+            "[granular]",
+            "contacts between rigid bodies are [rigid.contacts]",
+        ),
+        (
+            table(&scene.magnetic_field),
+            "[magnetic_field]",
+            "a field on rigid bodies is [rigid.fields] magnetic",
+        ),
+        (
+            table(&scene.electric_field),
+            "[electric_field]",
+            "a field on rigid bodies is [rigid.fields] electric",
+        ),
+        (
+            first(&scene.wall),
+            "[[wall]]",
+            "walls of rigid bodies are [[rigid.wall]]",
+        ),
+        (
+            first(&scene.spring),
+            "[[spring]]",
+            "springs join point particles",
+        ),
         (first(&scene.particle), "[[particle]]", PLACED),
         (first(&scene.lattice), "[[lattice]]", PLACED),
         (first(&scene.ring), "[[ring]]", PLACED),
