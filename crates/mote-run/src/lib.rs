@@ -246,8 +246,12 @@ impl<P: Propagator> Driver<P> {
         if let Some(live) = self.live.as_mut() {
             live.last(state.step(), state.time(), &mut || Self::shown(state));
         }
+        // The last step's sample, measured here where no observer took it
+        // (observables switched off): the summary's end time and energy
+        // are the run's end, not its start.
         let last = match last {
             Some(s) => s,
+            None if state.step() > first => state.measure(),
             None => initial.clone(),
         };
         let mut files: Vec<String> = self.observers.iter().flat_map(|o| o.files()).collect();
@@ -543,6 +547,30 @@ mod tests {
             self.0.lock().unwrap().push((s.step, text.to_string()));
             Ok(())
         }
+    }
+
+    /// Without observers the report still ends at the last step: its
+    /// sample is measured there (it was the first step's, so a summary
+    /// said a run of 10 steps ended at t = 0 with no energy drift).
+    #[test]
+    fn a_run_without_observers_reports_its_last_step() {
+        let mut p = Decay {
+            x: 1.0,
+            h: 0.1,
+            step: 0,
+        };
+        let report = Driver::new().run(&mut p, |_| 10, |_| {}).unwrap();
+        assert_eq!(report.steps, 10);
+        assert_eq!(report.initial, 1.0);
+        let x10 = (0..10).fold(1.0, |x: f64, _| x * (1.0 - 0.1));
+        assert_eq!(report.last, x10);
+        let mut q = Decay {
+            x: 1.0,
+            h: 0.1,
+            step: 0,
+        };
+        let none = Driver::new().run(&mut q, |_| 0, |_| {}).unwrap();
+        assert_eq!((none.steps, none.last), (0, 1.0));
     }
 
     #[test]

@@ -1197,3 +1197,21 @@ fn the_simd_level_is_named_and_a_forced_one_the_cpu_lacks_is_refused() {
         );
     }
 }
+
+/// A run with its observables switched off still ends its summary at its
+/// last step: the end time and the energy there (it said "Ran 10 steps to
+/// t = 0" and a drift of 0, the first step's numbers).
+#[test]
+fn a_run_without_observables_reports_its_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = "units = \"lj\"\n[run]\ndt = 0.01\nsteps = 10\n[gravity]\nG = 1.0\n\
+                 [[particle]]\nposition = [0.0, 0.0, 0.0]\nmass = 1.0\n\
+                 [[particle]]\nposition = [1.0, 0.0, 0.0]\nvelocity = [0.0, 0.7, 0.0]\nmass = 0.001\n\
+                 [output]\nobservables_every = 0\ntrajectory_every = 0\n";
+    std::fs::write(dir.path().join("quiet.toml"), scene).unwrap();
+    let o = mote(&["run", "quiet.toml", "-o", "quiet"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(out.contains("Ran 10 steps to t = 1.000000e-1 tau"), "{out}");
+    assert!(!out.contains("relative drift 0.000e0 at the end"), "{out}");
+}
