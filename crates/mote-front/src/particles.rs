@@ -364,14 +364,15 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
         String::new()
     };
     format!(
-        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). {energy}{pressure} Output in {}: {}.",
+        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). {energy}{pressure} Output in {}: {}. {}",
         report.steps,
         report.last.time,
         t_unit,
         secs,
         report.steps as f64 / secs.max(1e-9),
         dir.display(),
-        files
+        files,
+        sim.breakdown(report.wall).sentence(),
     )
 }
 

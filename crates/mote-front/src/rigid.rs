@@ -199,7 +199,7 @@ impl EngineRun for RigidRun {
         let last = &report.last;
         let mut summary = vec![format!(
             "mote run {}: {} rigid bodies ({} spheres), FRBI with dt = {}, {} steps to t = {:.6e} in {:.3} s of wall time, {}. \
-             Final kinetic energy {:.6e}, potential {:.6e}; momentum {}, angular momentum {}.",
+             Final kinetic energy {:.6e}, potential {:.6e}; momentum {}, angular momentum {}. {}",
             done.input.label,
             b.len(),
             (0..b.len()).map(|i| b.template(i).sphere_count()).sum::<usize>(),
@@ -212,6 +212,7 @@ impl EngineRun for RigidRun {
             last.potential_energy,
             vector(last.linear_momentum),
             vector(last.angular_momentum),
+            d.frbi.breakdown(d.stepping, report.wall).sentence(),
         )];
         for (name, f) in &last.wall_forces {
             summary.push(format!("  force on wall {name}: {f}"));

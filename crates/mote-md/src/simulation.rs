@@ -34,9 +34,20 @@ pub struct Simulation {
     /// Total energy at the first measurement of the current run and the
     /// largest relative departure from it measured since.
     energy_watch: Option<(f64, f64)>,
+    /// Wall time spent stepping in this run (the force field's
+    /// [`Timing`](crate::force::timing::Timing) says how much of it went
+    /// to each interaction and the neighbour list).
+    pub stepping: std::time::Duration,
 }
 
 impl Simulation {
+    /// Where this run's wall time `wall` went: each interaction, the
+    /// neighbour list, the rest of the steps, and between the steps.
+    pub fn breakdown(&self, wall: std::time::Duration) -> crate::force::timing::Breakdown {
+        let names: Vec<&str> = self.forces.interactions.iter().map(|i| i.name()).collect();
+        crate::force::timing::Breakdown::new(&names, &self.forces.timing, self.stepping, wall)
+    }
+
     /// The simulation of `system` under `forces`, stepped by `stepper`.
     pub fn new(system: System, forces: ForceField, stepper: Stepper, dt: f64, seed: u64) -> Self {
         Simulation {
@@ -48,6 +59,7 @@ impl Simulation {
             seed,
             brownian: None,
             energy_watch: None,
+            stepping: std::time::Duration::ZERO,
         }
     }
 
@@ -99,10 +111,14 @@ impl mote_run::Propagator for Simulation {
             self.stepper.prime(&mut self.system, &mut self.forces);
         }
         self.energy_watch = None;
+        // The run's timing starts with its first step.
+        self.forces.timing = Default::default();
+        self.stepping = std::time::Duration::ZERO;
         Ok(())
     }
 
     fn advance(&mut self) -> Result<(), MdError> {
+        let since = std::time::Instant::now();
         if let Some(bd) = &mut self.brownian {
             let index = self.system.step + 1;
             bd.step(
@@ -120,6 +136,7 @@ impl mote_run::Propagator for Simulation {
             let mut rng = self.noise(self.system.step);
             t.apply(&mut self.system, self.dt, &mut rng);
         }
+        self.stepping += since.elapsed();
         Ok(())
     }
 

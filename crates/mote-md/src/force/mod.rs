@@ -13,6 +13,7 @@ pub mod latent;
 pub mod lennard_jones;
 pub mod slab;
 mod springs;
+pub mod timing;
 mod uniform;
 mod virial;
 
@@ -347,6 +348,8 @@ pub struct ForceField {
     torque: Vec<DVec3>,
     /// The shared half list and the number of interactions it was made for.
     neighbours: Option<(VerletList, usize)>,
+    /// Wall time of the force passes, by interaction, and of the list.
+    pub timing: timing::Timing,
 }
 
 impl ForceField {
@@ -400,7 +403,11 @@ impl ForceField {
             };
         }
         if let Some((list, _)) = &mut self.neighbours {
-            list.update(state.position, state.boundary);
+            let since = std::time::Instant::now();
+            if list.update(state.position, state.boundary) {
+                self.timing.builds += 1;
+            }
+            self.timing.neighbours += since.elapsed();
         }
     }
 
@@ -416,8 +423,10 @@ impl ForceField {
         let state = &sharing(state, &self.neighbours);
         self.force.clear();
         self.force.resize(n, DVec3::ZERO);
-        for interaction in &mut self.interactions {
+        for (k, interaction) in self.interactions.iter_mut().enumerate() {
+            let since = std::time::Instant::now();
             interaction.add_forces(state, &mut self.force);
+            self.timing.interaction(k, since);
         }
         let (force, mass) = (&self.force, state.mass);
         acc.par_iter_mut()
@@ -480,8 +489,10 @@ impl ForceField {
     ) {
         self.refresh_neighbours(state);
         let state = &sharing(state, &self.neighbours);
-        for interaction in &mut self.interactions {
+        for (k, interaction) in self.interactions.iter_mut().enumerate() {
+            let since = std::time::Instant::now();
             interaction.add_forces_and_torques(state, spin, force, torque);
+            self.timing.interaction(k, since);
         }
     }
 

@@ -163,6 +163,8 @@ pub struct Frbi {
     interactions: Vec<Box<dyn BodyInteraction>>,
     world: WorldFrame,
     wrench: Vec<DE>,
+    /// Wall time of each interaction's wrench passes.
+    pub timing: crate::force::timing::Timing,
 }
 
 /// Energies of the bodies at their current state.
@@ -192,6 +194,7 @@ impl Frbi {
             interactions: Vec::new(),
             world: WorldFrame::default(),
             wrench: Vec::new(),
+            timing: Default::default(),
         }
     }
 
@@ -292,6 +295,18 @@ impl Frbi {
         }
     }
 
+    /// Where a run's wall time `wall` went, `stepping` of it in steps:
+    /// each interaction, the rest of the steps (the free flight, the
+    /// kick), and between the steps.
+    pub fn breakdown(
+        &self,
+        stepping: std::time::Duration,
+        wall: std::time::Duration,
+    ) -> crate::force::timing::Breakdown {
+        let names: Vec<&str> = self.interactions.iter().map(|i| i.name()).collect();
+        crate::force::timing::Breakdown::new(&names, &self.timing, stepping, wall)
+    }
+
     /// The wrenches `dE(T, F)` of all interactions on all bodies at time
     /// `t`, `dt` after the previous evaluation (also refreshes the world
     /// frame).
@@ -304,8 +319,10 @@ impl Frbi {
             world: &self.world,
             step: StepParameters { time: t, dt },
         };
-        for it in &mut self.interactions {
+        for (k, it) in self.interactions.iter_mut().enumerate() {
+            let since = std::time::Instant::now();
             it.add_wrenches(&view, &mut self.wrench);
+            self.timing.interaction(k, since);
         }
         &self.wrench
     }

@@ -26,6 +26,9 @@ pub struct RigidDynamics {
     pub step: u64,
     /// The last step of the run (recorded in checkpoints).
     pub last_step: u64,
+    /// Wall time spent stepping (the FRBI's timing says how much of it
+    /// went to each interaction).
+    pub stepping: std::time::Duration,
 }
 
 impl RigidDynamics {
@@ -69,6 +72,7 @@ impl RigidDynamics {
             dt: built.dt,
             step: 0,
             last_step: built.steps,
+            stepping: std::time::Duration::ZERO,
         }
     }
 }
@@ -108,8 +112,10 @@ impl Propagator for RigidDynamics {
     }
 
     fn advance(&mut self) -> Result<(), MdError> {
+        let since = std::time::Instant::now();
         self.frbi.step(&mut self.bodies, self.dt);
         self.step += 1;
+        self.stepping += since.elapsed();
         Ok(())
     }
 
