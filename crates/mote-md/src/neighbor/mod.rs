@@ -68,10 +68,14 @@ impl VerletList {
         let stale = self.reference.len() != pos.len()
             || (self.every > 0 && self.since_build >= self.every)
             || {
+                // Wrapped positions: a displacement is less than a box
+                // length, so the compare-and-shift image serves.
                 let limit = 0.25 * self.skin * self.skin;
+                let image = boundary.image();
                 pos.par_iter()
+                    .with_min_len(4096)
                     .zip(&self.reference)
-                    .any(|(r, r0)| boundary.minimum_image(*r - *r0).length_squared() > limit)
+                    .any(|(r, r0)| image.apply(*r - *r0).length_squared() > limit)
             };
         if stale {
             self.build(pos, boundary);
@@ -79,33 +83,49 @@ impl VerletList {
         stale
     }
 
-    /// Builds the list from scratch.
+    /// Builds the list from scratch: blocks of particles in parallel, each
+    /// filling its rows into one buffer (no allocation per particle),
+    /// every row's partners sorted, the blocks joined in order.
     pub fn build(&mut self, pos: &[DVec3], boundary: &Boundary) {
+        const BLOCK: usize = 512;
         let reach = self.cutoff + self.skin;
         let reach2 = reach * reach;
         let cells = CellGrid::new(pos, boundary, reach);
         let image = boundary.image();
-        let lists: Vec<Vec<u32>> = (0..pos.len())
+        let half = self.half;
+        let blocks: Vec<(Vec<u32>, Vec<u32>)> = (0..pos.len().div_ceil(BLOCK))
             .into_par_iter()
-            .with_min_len(256)
-            .map(|i| {
-                let mut near = Vec::new();
-                cells.for_each_candidate(pos[i], |j| {
-                    let wanted = if self.half { j > i } else { j != i };
-                    if wanted && image.apply(pos[j] - pos[i]).length_squared() < reach2 {
-                        near.push(j as u32);
-                    }
-                });
-                near.sort_unstable();
-                near
+            .map(|b| {
+                let rows = b * BLOCK..((b + 1) * BLOCK).min(pos.len());
+                let mut lengths = Vec::with_capacity(rows.len());
+                let mut near: Vec<u32> = Vec::new();
+                for i in rows {
+                    let row = near.len();
+                    let ri = pos[i];
+                    cells.for_each_run(ri, |js, rs| {
+                        for (&j, &rj) in js.iter().zip(rs) {
+                            let wanted = if half { j > i } else { j != i };
+                            if wanted && image.apply(rj - ri).length_squared() < reach2 {
+                                near.push(j as u32);
+                            }
+                        }
+                    });
+                    near[row..].sort_unstable();
+                    lengths.push((near.len() - row) as u32);
+                }
+                (lengths, near)
             })
             .collect();
         self.start.clear();
         self.neighbors.clear();
         self.start.push(0);
-        for near in &lists {
+        for (lengths, near) in &blocks {
+            let mut end = self.neighbors.len() as u32;
+            self.start.extend(lengths.iter().map(|l| {
+                end += l;
+                end
+            }));
             self.neighbors.extend_from_slice(near);
-            self.start.push(self.neighbors.len() as u32);
         }
         self.reference.clear();
         self.reference.extend_from_slice(pos);
@@ -123,6 +143,8 @@ pub struct CellGrid {
     /// Particle indices sorted by cell; `first[c]..first[c + 1]` is cell c.
     order: Vec<usize>,
     first: Vec<usize>,
+    /// The positions in that order, so that a scan reads them in a row.
+    sorted: Vec<DVec3>,
 }
 
 impl CellGrid {
@@ -170,6 +192,7 @@ impl CellGrid {
             periodic: boundary.periodic,
             order: Vec::new(),
             first: Vec::new(),
+            sorted: Vec::new(),
         };
         let ncell = dims[0] * dims[1] * dims[2];
         let cell_of: Vec<usize> = pos
@@ -189,6 +212,7 @@ impl CellGrid {
             order[fill[c]] = i;
             fill[c] += 1;
         }
+        grid.sorted = order.iter().map(|&i| pos[i]).collect();
         grid.order = order;
         grid.first = count;
         grid
@@ -215,6 +239,15 @@ impl CellGrid {
 
     /// Calls `f(j)` for every particle in the cells around position r.
     pub fn for_each_candidate(&self, r: DVec3, mut f: impl FnMut(usize)) {
+        self.for_each_run(r, |js, _| js.iter().for_each(|&j| f(j)));
+    }
+
+    /// Calls `f(js, rs)` for runs of the particles in the cells around
+    /// position r: their indices and positions, side by side in memory.
+    /// The cells along x of one row (y, z) are neighbours in memory, so
+    /// where the row does not wrap around a periodic face its cells are
+    /// one run.
+    pub fn for_each_run(&self, r: DVec3, mut f: impl FnMut(&[usize], &[DVec3])) {
         let c = self.coords(r);
         // The (at most three) distinct cells along each axis, without
         // allocating: a periodic axis of one cell visits it once.
@@ -233,12 +266,24 @@ impl CellGrid {
             }
         };
         let (xs, ys, zs) = (range(0), range(1), range(2));
+        let xs = &xs.0[..xs.1];
+        // x-cells in increasing order without a wrap: one run of memory.
+        let run = xs.windows(2).all(|w| w[1] == w[0] + 1);
+        let mut visit = |from: usize, to: usize| {
+            if to > from {
+                f(&self.order[from..to], &self.sorted[from..to]);
+            }
+        };
         for &z in &zs.0[..zs.1] {
             for &y in &ys.0[..ys.1] {
-                for &x in &xs.0[..xs.1] {
-                    let cell = self.cell_index([x, y, z]);
-                    for &j in &self.order[self.first[cell]..self.first[cell + 1]] {
-                        f(j);
+                if run {
+                    let first = self.cell_index([xs[0], y, z]);
+                    let last = self.cell_index([xs[xs.len() - 1], y, z]);
+                    visit(self.first[first], self.first[last + 1]);
+                } else {
+                    for &x in xs {
+                        let cell = self.cell_index([x, y, z]);
+                        visit(self.first[cell], self.first[cell + 1]);
                     }
                 }
             }
