@@ -57,35 +57,18 @@ pub(super) fn add_law(
     Ok(())
 }
 
-/// Refuses `[coulomb]` where a rigid table already sums the charges'
-/// forces: `[rigid.fields] coulomb`, or the conducting planes' sum with
-/// the charges' images.
-pub(super) fn refuse_charges_twice(
+/// Refuses `[coulomb]` between conducting planes, whose own sum
+/// (`[rigid.planes] coulomb`) takes the charges' images. (`[rigid.fields]
+/// coulomb`, the other rigid sum, is refused by its table.)
+pub(super) fn refuse_coulomb_between_planes(
     scene: &RigidScene,
     b: &RigidBuild<'_>,
 ) -> Result<(), ParseError> {
-    let Some(coulomb) = &scene.coulomb else {
-        return Ok(());
-    };
-    let rigid = scene.settings();
-    if let Some(f) = rigid
-        .fields
-        .as_ref()
-        .filter(|f| f.get_ref().coulomb.is_some())
-    {
-        return Err(b.error(
-            coulomb.span(),
-            format!(
-                "[coulomb] beside [rigid.fields] coulomb (line {}): give the charges' forces once",
-                b.src.line_of(f.span().start)
-            ),
-        ));
-    }
-    if rigid.planes.is_some() {
-        return Err(b.error(
+    match &scene.coulomb {
+        Some(coulomb) if scene.settings().planes.is_some() => Err(b.error(
             coulomb.span(),
             "[coulomb] between conducting planes is [rigid.planes] coulomb (with the planes' images)".into(),
-        ));
+        )),
+        _ => Ok(()),
     }
-    Ok(())
 }

@@ -391,7 +391,7 @@ impl RigidScene {
             ));
         }
         add(&rigid.fields, self, &mut b)?;
-        centres::refuse_charges_twice(self, &b)?;
+        centres::refuse_coulomb_between_planes(self, &b)?;
         for (law, span) in self.centre_laws() {
             centres::add_law(law, span, &mut b)?;
         }
