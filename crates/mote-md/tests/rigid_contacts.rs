@@ -277,3 +277,77 @@ fn the_contact_virial_is_the_volume_derivative_of_the_energy() {
         "virial {from_virial:e} against -dU/dV {from_energy:e}"
     );
 }
+
+/// 800 trimers (2400 spheres: two blocks of pairs, three of spheres
+/// against the floor) falling onto a floor in a box periodic in x and y
+/// (bodies crossing its sides, contacts between bodies and with the
+/// floor): the contact section's blocks run on any number of threads and
+/// the wrenches are summed in pair order, so 1, 2 and 3 threads give the
+/// same bits.
+#[test]
+fn clumps_on_a_floor_give_the_same_bits_on_any_number_of_threads() {
+    use mote_md::rigid::run::RigidDynamics;
+    use mote_md::rigid::scene::RigidScene;
+    use mote_run::Propagator;
+    let text = r#"
+seed = 7
+[rigid]
+[[rigid.template]]
+name = "trimer"
+generator = "trimer"
+radius = 0.5
+distance = 0.5
+mass = 1.5
+[[rigid.lattice]]
+template = "trimer"
+n = 800
+lo = [0.0, 0.0, 0.6]
+hi = [19.0, 19.0, 12.0]
+spacing = 1.9
+random_orientation = true
+[rigid.fields]
+gravity = [0.0, 0.0, -10.0]
+[rigid.contacts]
+young = 136500.0
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+[[rigid.wall]]
+kind = "plane"
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[box]
+hi = [19.0, 19.0, 30.0]
+periodic = [true, true, false]
+[run]
+dt = 5e-4
+steps = 300
+"#;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let built = RigidScene::parse(text, "floor.toml")
+                .unwrap()
+                .build(text, "floor.toml", None)
+                .unwrap();
+            let mut run = RigidDynamics::new(built);
+            run.prime(&mut |_| {}).unwrap();
+            for _ in 0..300 {
+                run.advance().unwrap();
+            }
+            let (pairs, walls) = run.contacts().unwrap().contact_counts();
+            assert!(
+                pairs > 100 && walls > 10,
+                "{pairs} pairs, {walls} on the floor"
+            );
+            (run.bodies.position.clone(), run.bodies.velocity.clone())
+        })
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(3));
+}

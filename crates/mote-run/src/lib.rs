@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::xyz::Frame;
 
+pub mod parallel;
 pub mod scene;
 mod steer;
 mod trajectory;
@@ -308,6 +309,7 @@ impl<P: Propagator> Driver<P> {
     ) -> Result<Option<P::Sample>, P::Error> {
         let mut last = None;
         while state.step() < last_step && !state.finished() {
+            parallel::keep_warm();
             state.advance()?;
             let step = state.step();
             if let Some((particle, what)) = state.unstable() {

@@ -83,6 +83,56 @@ impl VerletList {
         stale
     }
 
+    /// Rebuilds if needed, for positions never wrapped into the box (the
+    /// spheres of rigid bodies, carried with their bodies): `search` gets
+    /// each position plus the lattice vector `shift` that wrapped it at the
+    /// last build — one addition per particle and step where wrapping costs
+    /// a division and a floor per periodic axis — and the list is searched
+    /// there; a rebuild wraps them anew. Returns whether it rebuilt.
+    pub fn update_unwrapped(
+        &mut self,
+        pos: &[DVec3],
+        boundary: &Boundary,
+        shift: &mut Vec<DVec3>,
+        search: &mut Vec<DVec3>,
+    ) -> bool {
+        const CHUNK: usize = 4096;
+        self.since_build += 1;
+        let n = pos.len();
+        let mut stale = self.reference.len() != n
+            || shift.len() != n
+            || (self.every > 0 && self.since_build >= self.every);
+        if !stale {
+            // Since the build each search position moved as its particle
+            // did: no image is needed.
+            let limit = 0.25 * self.skin * self.skin;
+            search.resize(n, DVec3::ZERO);
+            stale = search
+                .par_chunks_mut(CHUNK)
+                .zip(pos.par_chunks(CHUNK))
+                .zip(shift.par_chunks(CHUNK))
+                .zip(self.reference.par_chunks(CHUNK))
+                .map(|(((out, r), by), r0)| {
+                    let mut moved = false;
+                    for k in 0..out.len() {
+                        out[k] = r[k] + by[k];
+                        moved |= (out[k] - r0[k]).length_squared() > limit;
+                    }
+                    moved
+                })
+                .reduce(|| false, |a, b| a || b);
+        }
+        if stale {
+            pos.par_iter()
+                .map(|r| boundary.wrap(*r))
+                .collect_into_vec(search);
+            shift.clear();
+            shift.extend(search.iter().zip(pos).map(|(w, r)| *w - *r));
+            self.build(search, boundary);
+        }
+        stale
+    }
+
     /// Builds the list from scratch: blocks of particles in parallel, each
     /// filling its rows into one buffer (no allocation per particle),
     /// every row's partners sorted, the blocks joined in order.

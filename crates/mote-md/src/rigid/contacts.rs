@@ -26,13 +26,16 @@
 //!   mean of two steps), and the tangential history advances by the time
 //!   since the previous evaluation, which is stored.
 
+use std::ops::Range;
+
 use glam::DVec3;
 use mote_geom::DE;
+use mote_run::parallel::for_each_block;
 
 use super::interaction::{BodyInteraction, BodyView};
 use crate::boundary::Boundary;
 use crate::boundary::MinimumImage;
-use crate::force::granular::history::{history_of, PAIR_ROW};
+use crate::force::granular::history::{block_firsts, history_of, split_blocks, PAIR_ROW};
 use crate::force::granular::{ContactForce, ContactLaw, History, PairHistories, Wall, WallShape};
 use crate::neighbor::VerletList;
 
@@ -57,8 +60,11 @@ pub struct RigidContacts {
 struct ContactState {
     list: VerletList,
     skin: f64,
-    /// Wrapped sphere centres (periodic boundaries only).
+    /// Sphere centres for the search on periodic axes: each centre plus
+    /// the lattice vector `shift` that wrapped it into the box at the last
+    /// build (within half a skin of the box between builds).
     wrapped: Vec<DVec3>,
+    shift: Vec<DVec3>,
     /// Pairs of spheres of different bodies, with their histories.
     pairs: PairHistories,
     /// history[s · walls + w]: sphere s against wall w.
@@ -69,12 +75,46 @@ struct ContactState {
     wall_contacts: usize,
     /// Sphere–wall histories of a resumed run, put in place at the next evaluation.
     pending_walls: Vec<(usize, History)>,
+    /// The touching pairs' wrenches of each block of rows, in pair order.
+    pair_wrenches: Vec<Vec<PairWrench>>,
+    /// The sphere–wall contacts' wrenches of each block of spheres.
+    wall_wrenches: Vec<Vec<WallWrench>>,
 }
+
+/// One touching pair's wrenches on its two bodies: the contact force at
+/// each sphere's centre plus the law's torque about it.
+#[derive(Debug, Clone, Copy)]
+struct PairWrench {
+    a: u32,
+    b: u32,
+    on_a: DE,
+    on_b: DE,
+}
+
+/// One sphere–wall contact's wrench on the body, and its force on the sphere.
+#[derive(Debug, Clone, Copy)]
+struct WallWrench {
+    body: u32,
+    wall: u32,
+    on_body: DE,
+    force: DVec3,
+}
+
+/// Spheres per block of the parallel wall loop.
+const WALL_BLOCK: usize = 1024;
 
 /// Numbers per carried sphere–wall row: slot, ξ (3), ψ (3).
 const WALL_ROW: usize = 7;
 
 impl RigidContacts {
+    /// Blocks of sphere rows of the parallel pair loop: one per 1024
+    /// spheres, each holding an equal share of the listed pairs. The
+    /// wrenches are summed in pair order whatever the blocks, so their
+    /// number only sets how the work spreads over threads.
+    fn blocks(n: usize) -> usize {
+        (n / 1024).clamp(1, 256)
+    }
+
     /// Contacts with law `law` between bodies and `wall_law` against
     /// `walls`; `skin` is the Verlet skin of the sphere search.
     pub fn new(law: ContactLaw, wall_law: ContactLaw, walls: Vec<Wall>, skin: f64) -> Self {
@@ -134,15 +174,12 @@ impl ContactState {
             let skin = self.skin;
             self.list = VerletList::half(cutoff, skin);
         }
-        let pos: &[DVec3] = if boundary.is_periodic() {
-            self.wrapped.clear();
-            self.wrapped
-                .extend(centres.iter().map(|c| boundary.wrap(*c)));
-            &self.wrapped
+        let rebuilt = if boundary.is_periodic() {
+            let (shift, search) = (&mut self.shift, &mut self.wrapped);
+            self.list.update_unwrapped(centres, boundary, shift, search)
         } else {
-            centres
+            self.list.update(centres, boundary)
         };
-        let rebuilt = self.list.update(pos, boundary);
         if !rebuilt && self.pairs.rows() == centres.len() {
             return;
         }
@@ -222,128 +259,267 @@ impl SpherePairs<'_> {
     }
 }
 
+impl SpherePairs<'_> {
+    /// The pairs of sphere rows `rows` (entries from `base` on in
+    /// `history` and `touching`): advances their histories and writes the
+    /// touching pairs' wrenches, in pair order, into `out`.
+    fn block(
+        &self,
+        list: &PairHistories,
+        rows: Range<usize>,
+        history: &mut [History],
+        touching: &mut [bool],
+        out: &mut Vec<PairWrench>,
+    ) {
+        let world = self.view.world;
+        let (centres, body) = (&world.sphere_centre, &world.sphere_body);
+        let dt = self.view.step.dt;
+        out.clear();
+        let base = list.starts()[rows.start] as usize;
+        for s in rows {
+            let a = body[s];
+            for k in list.range(s) {
+                let (o, kb) = (list.partner(k) as usize, k - base);
+                let Some(c) = self.contact(s, o, dt, &mut history[kb]) else {
+                    if touching[kb] {
+                        touching[kb] = false;
+                        history[kb] = History::default();
+                    }
+                    continue;
+                };
+                touching[kb] = true;
+                let b = body[o];
+                let on_a = self.view.wrench_at(a as usize, centres[s], c.force);
+                let on_b = self.view.wrench_at(b as usize, centres[o], -c.force);
+                out.push(PairWrench {
+                    a,
+                    b,
+                    on_a: DE::new(on_a.omega + c.torque_i, on_a.v),
+                    on_b: DE::new(on_b.omega + c.torque_j, on_b.v),
+                });
+            }
+        }
+    }
+}
+
+/// The sphere–wall contacts of one evaluation.
+struct WallContacts<'a> {
+    view: &'a BodyView<'a>,
+    law: &'a ContactLaw,
+    walls: &'a [Wall],
+    /// Each plane wall's normal and offset n·p at the evaluation's time
+    /// (`None` for a cylinder).
+    planes: Vec<Option<(DVec3, f64)>>,
+}
+
+impl WallContacts<'_> {
+    /// The spheres from `first` on against every wall (history slot
+    /// s·walls + w, from the first sphere's on in `history` and
+    /// `touching`): advances their histories and writes the contacts'
+    /// wrenches, in sphere order, into `out`.
+    fn block(
+        &self,
+        first: usize,
+        history: &mut [History],
+        touching: &mut [bool],
+        out: &mut Vec<WallWrench>,
+    ) {
+        out.clear();
+        let n_walls = self.walls.len();
+        let (view, t, dt) = (self.view, self.view.step.time, self.view.step.dt);
+        let (world, bodies) = (view.world, view.bodies);
+        let (centres, radius, body) = (
+            &world.sphere_centre,
+            &world.sphere_radius,
+            &world.sphere_body,
+        );
+        for (slot, (h, touch)) in history.iter_mut().zip(touching).enumerate() {
+            let (s, w) = (first + slot / n_walls, slot % n_walls);
+            let (x, rs, wall) = (centres[s], radius[s], &self.walls[w]);
+            let (gap, nrm) = match self.planes[w] {
+                Some((normal, offset)) => (x.dot(normal) - offset, normal),
+                None => wall.gap(x, t),
+            };
+            if gap >= rs || gap <= -rs {
+                if *touch {
+                    *touch = false;
+                    *h = History::default();
+                }
+                continue;
+            }
+            *touch = true;
+            let a = body[s] as usize;
+            let delta = rs - gap;
+            let arm = rs - 0.5 * delta;
+            let p = x - nrm * arm;
+            let v_rel = view.point_velocity(a, p) - wall.surface_velocity(x, gap, nrm, t);
+            let c = self.law.force(
+                delta,
+                nrm,
+                v_rel,
+                bodies.omega[a],
+                arm,
+                0.0,
+                rs,
+                bodies.template(a).mass(),
+                dt,
+                h,
+            );
+            let on_a = view.wrench_at(a, x, c.force);
+            out.push(WallWrench {
+                body: a as u32,
+                wall: w as u32,
+                on_body: DE::new(on_a.omega + c.torque_i, on_a.v),
+                force: c.force,
+            });
+        }
+    }
+}
+
+/// A block of one evaluation's parallel section: rows of sphere pairs, or
+/// spheres against the walls, with the histories it advances and the
+/// buffer its wrenches go to.
+enum ContactBlock<'h> {
+    Pairs {
+        rows: Range<usize>,
+        history: &'h mut [History],
+        touching: &'h mut [bool],
+        out: &'h mut Vec<PairWrench>,
+    },
+    Walls {
+        first: usize,
+        history: &'h mut [History],
+        touching: &'h mut [bool],
+        out: &'h mut Vec<WallWrench>,
+    },
+}
+
 impl BodyInteraction for RigidContacts {
     fn name(&self) -> &str {
         "contacts"
     }
 
+    /// Sphere pairs and sphere–wall contacts advance in one parallel
+    /// section of blocks (rows of pairs with equal numbers of pairs, runs
+    /// of spheres against the walls), each writing its contacts' wrenches
+    /// in order; the wrenches are then summed in pair order, then sphere–
+    /// wall order, so the bits are those of one serial loop on any number
+    /// of threads.
     fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
-        let t = view.step.time;
         let world = view.world;
-        let bodies = view.bodies;
-        let centres = &world.sphere_centre;
-        let radius = &world.sphere_radius;
-        let body = &world.sphere_body;
+        let (centres, radius) = (&world.sphere_centre, &world.sphere_radius);
         let n = centres.len();
         let r_max = radius.iter().cloned().fold(0.0, f64::max);
         let st = &mut self.state;
-        st.refresh(centres, body, r_max, &self.boundary);
-        let dt = view.step.dt;
+        st.refresh(centres, &world.sphere_body, r_max, &self.boundary);
         let image = self.boundary.image();
         let periodic = self.boundary.is_periodic();
-        let pos: &[DVec3] = if periodic { &st.wrapped } else { centres };
-        let law = &self.law;
-        let mut contacts = 0usize;
-
-        // Sphere–sphere.
         let pairs = SpherePairs {
             view,
-            law,
-            pos,
+            law: &self.law,
+            pos: if periodic { &st.wrapped } else { centres },
             image: periodic.then_some(&image),
         };
-        for s in 0..n {
-            let (a, range) = (body[s] as usize, st.pairs.range(s));
-            for k in range {
-                let o = st.pairs.partner(k) as usize;
-                let Some(c) = pairs.contact(s, o, dt, &mut st.pairs.history[k]) else {
-                    if st.pairs.touching[k] {
-                        st.pairs.touching[k] = false;
-                        st.pairs.history[k] = History::default();
+        let t = view.step.time;
+        let walls = WallContacts {
+            view,
+            law: &self.wall_law,
+            walls: &self.walls,
+            planes: self
+                .walls
+                .iter()
+                .map(|w| match w.shape {
+                    WallShape::Plane { point, normal } => {
+                        Some((normal, (point + w.velocity * t).dot(normal)))
                     }
-                    continue;
-                };
-                st.pairs.touching[k] = true;
-                let b = body[o] as usize;
-                let wa_ = view.wrench_at(a, centres[s], c.force);
-                wrench[a].omega += wa_.omega + c.torque_i;
-                wrench[a].v += wa_.v;
-                let wb_ = view.wrench_at(b, centres[o], -c.force);
-                wrench[b].omega += wb_.omega + c.torque_j;
-                wrench[b].v += wb_.v;
-                contacts += 1;
-            }
-        }
-        st.contacts = contacts;
-
-        // Sphere–wall.
+                    WallShape::Cylinder { .. } => None,
+                })
+                .collect(),
+        };
         let n_walls = self.walls.len();
-        st.wall_force.clear();
-        st.wall_force.resize(n_walls, DVec3::ZERO);
-        st.wall_contacts = 0;
-        if n_walls == 0 {
-            return;
-        }
         if st.wall_history.len() != n * n_walls {
             st.wall_history = vec![History::default(); n * n_walls];
             st.wall_touching = vec![false; n * n_walls];
         }
-        for (slot, h) in std::mem::take(&mut st.pending_walls) {
+        for (slot, h) in st.pending_walls.drain(..) {
             if slot < st.wall_history.len() {
                 st.wall_history[slot] = h;
                 st.wall_touching[slot] = true;
             }
         }
-        let planes: Vec<Option<(DVec3, f64)>> = self
-            .walls
-            .iter()
-            .map(|w| match w.shape {
-                WallShape::Plane { point, normal } => {
-                    Some((normal, (point + w.velocity * t).dot(normal)))
-                }
-                WallShape::Cylinder { .. } => None,
+
+        let firsts = block_firsts(st.pairs.starts(), Self::blocks(n));
+        let mut history = std::mem::take(&mut st.pairs.history);
+        let mut touching = std::mem::take(&mut st.pairs.touching);
+        let pair_blocks = split_blocks(&mut history, &mut touching, st.pairs.starts(), &firsts);
+        st.pair_wrenches
+            .resize_with(pair_blocks.len(), Default::default);
+        let wall_chunk = (WALL_BLOCK * n_walls).max(1);
+        let wall_blocks = if n_walls == 0 {
+            0
+        } else {
+            n.div_ceil(WALL_BLOCK)
+        };
+        st.wall_wrenches.resize_with(wall_blocks, Default::default);
+        let mut blocks: Vec<ContactBlock> = pair_blocks
+            .into_iter()
+            .zip(st.pair_wrenches.iter_mut())
+            .enumerate()
+            .map(|(b, ((history, touching), out))| ContactBlock::Pairs {
+                rows: firsts[b]..firsts[b + 1],
+                history,
+                touching,
+                out,
             })
             .collect();
-        let wl = &self.wall_law;
-        for s in 0..n {
-            let (x, rs) = (centres[s], radius[s]);
-            let a = body[s] as usize;
-            for (w, wall) in self.walls.iter().enumerate() {
-                let slot = s * n_walls + w;
-                let (gap, nrm) = match planes[w] {
-                    Some((normal, offset)) => (x.dot(normal) - offset, normal),
-                    None => wall.gap(x, t),
-                };
-                if gap >= rs || gap <= -rs {
-                    if st.wall_touching[slot] {
-                        st.wall_touching[slot] = false;
-                        st.wall_history[slot] = History::default();
-                    }
-                    continue;
-                }
-                st.wall_touching[slot] = true;
-                let delta = rs - gap;
-                let arm = rs - 0.5 * delta;
-                let p = x - nrm * arm;
-                let v_rel = view.point_velocity(a, p) - wall.surface_velocity(x, gap, nrm, t);
-                let c = wl.force(
-                    delta,
-                    nrm,
-                    v_rel,
-                    bodies.omega[a],
-                    arm,
-                    0.0,
-                    rs,
-                    bodies.template(a).mass(),
-                    dt,
-                    &mut st.wall_history[slot],
-                );
-                let wr = view.wrench_at(a, x, c.force);
-                wrench[a].omega += wr.omega + c.torque_i;
-                wrench[a].v += wr.v;
-                st.wall_force[w] -= c.force;
-                st.wall_contacts += 1;
-            }
+        blocks.extend(
+            (st.wall_history.chunks_mut(wall_chunk))
+                .zip(st.wall_touching.chunks_mut(wall_chunk))
+                .zip(st.wall_wrenches.iter_mut())
+                .enumerate()
+                .map(|(b, ((history, touching), out))| ContactBlock::Walls {
+                    first: b * WALL_BLOCK,
+                    history,
+                    touching,
+                    out,
+                }),
+        );
+        let list = &st.pairs;
+        for_each_block(&mut blocks, |_, block| match block {
+            ContactBlock::Pairs {
+                rows,
+                history,
+                touching,
+                out,
+            } => pairs.block(list, rows.clone(), history, touching, out),
+            ContactBlock::Walls {
+                first,
+                history,
+                touching,
+                out,
+            } => walls.block(*first, history, touching, out),
+        });
+        drop(blocks);
+        st.pairs.history = history;
+        st.pairs.touching = touching;
+        st.contacts = 0;
+        for w in st.pair_wrenches.iter().flatten() {
+            let (a, b) = (w.a as usize, w.b as usize);
+            wrench[a].omega += w.on_a.omega;
+            wrench[a].v += w.on_a.v;
+            wrench[b].omega += w.on_b.omega;
+            wrench[b].v += w.on_b.v;
+            st.contacts += 1;
+        }
+        st.wall_force.clear();
+        st.wall_force.resize(self.walls.len(), DVec3::ZERO);
+        st.wall_contacts = 0;
+        for w in st.wall_wrenches.iter().flatten() {
+            let a = w.body as usize;
+            wrench[a].omega += w.on_body.omega;
+            wrench[a].v += w.on_body.v;
+            st.wall_force[w.wall as usize] -= w.force;
+            st.wall_contacts += 1;
         }
     }
 

@@ -6,7 +6,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::history::PairHistories;
+use super::history::{block_firsts, split_blocks, PairHistories};
 use super::law::{ContactLaw, History};
 use crate::force::{add_block_buffers, BlockBuffers, Interaction, Spin, State, Virial};
 use crate::neighbor::VerletList;
@@ -84,29 +84,14 @@ impl GranularContacts {
         let dt = state.step.dt;
 
         let blocks = Self::blocks(n);
-        let firsts = Self::block_firsts(&list.start, blocks);
+        let firsts = block_firsts(&list.start, blocks);
         self.buffers
             .resize_with(blocks.saturating_sub(1), Default::default);
         let mut buffers = std::mem::take(&mut self.buffers);
         let mut history = std::mem::take(&mut self.pairs.history);
         let mut touching = std::mem::take(&mut self.pairs.touching);
 
-        // Split the history into the slices owned by each block of i.
-        let mut history_blocks: Vec<(&mut [History], &mut [bool])> = Vec::with_capacity(blocks);
-        {
-            let mut rest: &mut [History] = &mut history;
-            let mut rest_touch: &mut [bool] = &mut touching;
-            let mut taken = 0usize;
-            for b in 0..blocks {
-                let end = list.start[firsts[b + 1]] as usize;
-                let (head, tail) = rest.split_at_mut(end - taken);
-                let (head_touch, tail_touch) = rest_touch.split_at_mut(end - taken);
-                history_blocks.push((head, head_touch));
-                rest = tail;
-                rest_touch = tail_touch;
-                taken = end;
-            }
-        }
+        let history_blocks = split_blocks(&mut history, &mut touching, &list.start, &firsts);
         // Block 0 adds into the output, block b > 0 into a buffer over the
         // particles from its first one to the end (pairs have j > i).
         let mut targets: Vec<(&mut [DVec3], &mut [DVec3])> = Vec::with_capacity(blocks);
@@ -156,27 +141,6 @@ impl GranularContacts {
     /// torques.
     fn blocks(n: usize) -> usize {
         (n / 4096).clamp(1, 16)
-    }
-
-    /// The first particle of each of `blocks` blocks, and n: blocks of
-    /// equal numbers of listed pairs. A half list lists pair (i, j) at the
-    /// lower index, so rows shrink along the particles: blocks of equal
-    /// numbers of particles left the first of two blocks three quarters of
-    /// the pairs (and two threads 1.26 times as fast as one). Like the
-    /// block count, the split depends on the list alone, never on the
-    /// thread count.
-    fn block_firsts(start: &[u32], blocks: usize) -> Vec<usize> {
-        let n = start.len() - 1;
-        let pairs = start[n] as usize;
-        let mut firsts: Vec<usize> = (0..blocks)
-            .map(|b| {
-                start
-                    .partition_point(|&s| (s as usize) < b * pairs / blocks)
-                    .min(n)
-            })
-            .collect();
-        firsts.push(n);
-        firsts
     }
 
     /// The pairs of particles `range` (and their partners j > i), adding
@@ -336,41 +300,5 @@ impl Interaction for GranularContacts {
 
     fn neighbour_reach(&self) -> Option<(f64, f64)> {
         Some((self.list.cutoff, self.list.skin))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::GranularContacts;
-
-    /// Blocks of a half list's rows split its pairs evenly, not its
-    /// particles: rows shrinking along the particles (row i of n holding
-    /// n − 1 − i pairs) give the first of two blocks ~29 % of the
-    /// particles; the bounds run from 0 to n in order, and an empty list
-    /// puts every block at 0.
-    #[test]
-    fn blocks_hold_equal_numbers_of_pairs() {
-        let n = 1000usize;
-        let mut start = vec![0u32];
-        for i in 0..n {
-            start.push(start[i] + (n - 1 - i) as u32);
-        }
-        let pairs = start[n] as usize;
-        for blocks in 1..6 {
-            let firsts = GranularContacts::block_firsts(&start, blocks);
-            assert_eq!((firsts[0], firsts[blocks]), (0, n));
-            assert!(firsts.windows(2).all(|w| w[0] <= w[1]), "{firsts:?}");
-            for b in 0..blocks {
-                let held = (start[firsts[b + 1]] - start[firsts[b]]) as usize;
-                let share = held as f64 * blocks as f64 / pairs as f64;
-                assert!((share - 1.0).abs() < 0.01, "block {b} of {blocks}: {share}");
-            }
-        }
-        let two = GranularContacts::block_firsts(&start, 2);
-        assert!((two[1] as f64 / n as f64 - (1.0 - 0.5f64.sqrt())).abs() < 0.01);
-        assert_eq!(
-            GranularContacts::block_firsts(&[0; 11], 3),
-            vec![0, 0, 0, 10]
-        );
     }
 }
