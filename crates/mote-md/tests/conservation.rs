@@ -59,11 +59,7 @@ fn isolated_cluster_conserves_momentum_and_angular_momentum() {
 #[test]
 fn thread_count_does_not_change_results() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        mote_testkit::on_threads(threads, || {
             let mut sim = build(CLUSTER).simulation;
             steps(&mut sim, 50, |_| {});
             sim.system.particles.position.clone()

@@ -185,11 +185,7 @@ fn brownian_runs_are_independent_of_the_thread_count() {
         System::new(p)
     };
     let run = |threads: usize, seed: u64| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        mote_testkit::on_threads(threads, || {
             let mut sys = build();
             let mut ff = ForceField::new()
                 .with(

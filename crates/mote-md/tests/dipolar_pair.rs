@@ -328,11 +328,7 @@ fn zeeman_torque_energy_and_gradient_forces() {
 fn all_pairs_is_bit_identical_for_every_thread_count() {
     let (pos, m) = cluster(300, 21);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        mote_testkit::on_threads(threads, || {
             let mut dd = DipoleDipole::all_pairs(4.0 * PI)
                 .with_repulsion(PairRepulsion::wca(1.0, 1.0))
                 .unwrap();

@@ -79,11 +79,7 @@ fn cpu_seconds() -> f64 {
 /// 100 steps of the 32000-atom fluid on `threads` threads (after one
 /// step that builds the list): CPU and wall µs per atom-step.
 fn lj_dipole_fluid_32000(threads: usize) {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    mote_testkit::on_threads(threads, || {
         let (mut sys, mut ff) = lj_dipole_fluid(20);
         let mut stepper = Stepper::new(Integrator::LeapFrog);
         stepper.step(&mut sys, &mut ff, 0.005);

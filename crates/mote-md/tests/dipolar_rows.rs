@@ -239,13 +239,8 @@ fn one_and_two_threads_give_the_same_bits() {
         .with_repulsion(PairRepulsion::lennard_jones(1.0, 1.0, LJ_RC))
         .unwrap();
     for kernel in [Rows::Fastest, Rows::Lanes] {
-        let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| rows(&dd, &pos, &dip, kernel))
-        };
+        let run =
+            |threads: usize| mote_testkit::on_threads(threads, || rows(&dd, &pos, &dip, kernel));
         let (one, two) = (run(1), run(2));
         assert!(pos.len() > 2000, "more rows than one block");
         assert_eq!(one.force, two.force, "{kernel:?}");

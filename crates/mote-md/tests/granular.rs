@@ -431,11 +431,7 @@ fn contacts_are_thread_count_independent() {
     let law = ContactLaw::new(glass(), glass(), 0.5, 0.4, Damping::Exact, false);
     let start = System::new(p);
     let on = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        mote_testkit::on_threads(threads, || {
             let mut sys = start.clone();
             let mut ff = ForceField::new().with(GranularContacts::new(
                 law,

@@ -295,11 +295,7 @@ fn lj_rows_agree_across_kernels_and_threads() {
     let pos = jittered(9, l, &mut rng);
     use mote_md::force::lennard_jones::Rows;
     let run = |rows: Rows, threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        mote_testkit::on_threads(threads, || {
             let mut lj = mote_md::force::LennardJones::new(1.0, 1.0, 2.5, true, 0.3);
             lj.set_rows(rows);
             lj_through_list(&mut lj, &pos, &b)

@@ -325,11 +325,7 @@ dt = 5e-4
 steps = 300
 "#;
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        mote_testkit::on_threads(threads, || {
             let built = RigidScene::parse(text, "floor.toml")
                 .unwrap()
                 .build(text, "floor.toml", None)

@@ -95,11 +95,7 @@ fn potential_energy_matches_direct_sum_and_model() {
 fn forces_do_not_depend_on_the_thread_count() {
     let (pos, vel, mass) = plummer(30_000, 5);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        mote_testkit::on_threads(threads, || {
             let s = state(&pos, &vel, &mass);
             let mut tree = TreeGravity::new(1.0, 0.01, 0.5);
             let mut f = vec![DVec3::ZERO; pos.len()];

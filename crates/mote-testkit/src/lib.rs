@@ -1,7 +1,9 @@
 //! Test support shared by mote's crates, a dev-dependency only: the
 //! numbers a careless or hostile user writes into a scene, for the
 //! property tests over scene values (every value in range runs or is
-//! refused, never panics; every value out of range is refused at its line).
+//! refused, never panics; every value out of range is refused at its line);
+//! a closure run on a pool of a given number of threads, for the tests that
+//! results do not depend on it.
 #![forbid(unsafe_code)]
 
 use std::ops::Range;
@@ -32,6 +34,15 @@ pub fn with_hostile(valid: Vec<Range<f64>>) -> impl Strategy<Value = Vec<f64>> {
         }
         v
     })
+}
+
+/// `f` run on a pool of its own with `threads` threads.
+pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
 }
 
 #[cfg(test)]

@@ -85,49 +85,42 @@ impl VerletList {
 
     /// Rebuilds if needed, for positions never wrapped into the box (the
     /// spheres of rigid bodies, carried with their bodies): `search` gets
-    /// each position plus the lattice vector `shift` that wrapped it at the
-    /// last build — one addition per particle and step where wrapping costs
-    /// a division and a floor per periodic axis — and the list is searched
-    /// there; a rebuild wraps them anew. Returns whether it rebuilt.
-    pub fn update_unwrapped(
+    /// each position wrapped into the box ([`Boundary::wrap`], a function
+    /// of the position alone, so a resumed run searches where the
+    /// uninterrupted one did), in parallel chunks that check the
+    /// displacement since the last build in the same pass. Returns whether
+    /// it rebuilt.
+    pub fn update_wrapping(
         &mut self,
         pos: &[DVec3],
         boundary: &Boundary,
-        shift: &mut Vec<DVec3>,
         search: &mut Vec<DVec3>,
     ) -> bool {
         const CHUNK: usize = 4096;
         self.since_build += 1;
         let n = pos.len();
-        let mut stale = self.reference.len() != n
-            || shift.len() != n
-            || (self.every > 0 && self.since_build >= self.every);
-        if !stale {
-            // Since the build each search position moved as its particle
-            // did: no image is needed.
-            let limit = 0.25 * self.skin * self.skin;
-            search.resize(n, DVec3::ZERO);
-            stale = search
-                .par_chunks_mut(CHUNK)
-                .zip(pos.par_chunks(CHUNK))
-                .zip(shift.par_chunks(CHUNK))
-                .zip(self.reference.par_chunks(CHUNK))
-                .map(|(((out, r), by), r0)| {
-                    let mut moved = false;
-                    for k in 0..out.len() {
-                        out[k] = r[k] + by[k];
-                        moved |= (out[k] - r0[k]).length_squared() > limit;
+        search.resize(n, DVec3::ZERO);
+        let limit = 0.25 * self.skin * self.skin;
+        let image = boundary.image();
+        let fresh = self.reference.len() == n;
+        let reference: &[DVec3] = if fresh { &self.reference } else { &[] };
+        let moved = search
+            .par_chunks_mut(CHUNK)
+            .zip(pos.par_chunks(CHUNK))
+            .enumerate()
+            .map(|(c, (out, r))| {
+                let mut moved = false;
+                for (k, (w, &r)) in out.iter_mut().zip(r).enumerate() {
+                    *w = boundary.wrap(r);
+                    if let Some(r0) = reference.get(c * CHUNK + k) {
+                        moved |= image.apply(*w - *r0).length_squared() > limit;
                     }
-                    moved
-                })
-                .reduce(|| false, |a, b| a || b);
-        }
+                }
+                moved
+            })
+            .reduce(|| false, |a, b| a || b);
+        let stale = !fresh || moved || (self.every > 0 && self.since_build >= self.every);
         if stale {
-            pos.par_iter()
-                .map(|r| boundary.wrap(*r))
-                .collect_into_vec(search);
-            shift.clear();
-            shift.extend(search.iter().zip(pos).map(|(w, r)| *w - *r));
             self.build(search, boundary);
         }
         stale

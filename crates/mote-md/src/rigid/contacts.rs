@@ -60,11 +60,8 @@ pub struct RigidContacts {
 struct ContactState {
     list: VerletList,
     skin: f64,
-    /// Sphere centres for the search on periodic axes: each centre plus
-    /// the lattice vector `shift` that wrapped it into the box at the last
-    /// build (within half a skin of the box between builds).
+    /// Sphere centres wrapped into the box (periodic boundaries only).
     wrapped: Vec<DVec3>,
-    shift: Vec<DVec3>,
     /// Pairs of spheres of different bodies, with their histories.
     pairs: PairHistories,
     /// history[s · walls + w]: sphere s against wall w.
@@ -175,8 +172,8 @@ impl ContactState {
             self.list = VerletList::half(cutoff, skin);
         }
         let rebuilt = if boundary.is_periodic() {
-            let (shift, search) = (&mut self.shift, &mut self.wrapped);
-            self.list.update_unwrapped(centres, boundary, shift, search)
+            self.list
+                .update_wrapping(centres, boundary, &mut self.wrapped)
         } else {
             self.list.update(centres, boundary)
         };
