@@ -37,6 +37,9 @@ pub struct VerletList {
     since_build: u64,
     /// Number of builds so far.
     pub builds: u64,
+    /// The group of each particle, or empty: pairs within one group (the
+    /// spheres of one rigid body) are not listed ([`VerletList::set_groups`]).
+    groups: Vec<u32>,
 }
 
 impl VerletList {
@@ -60,6 +63,17 @@ impl VerletList {
     #[inline]
     pub fn of(&self, i: usize) -> &[u32] {
         &self.neighbors[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// Lists no pair of particles of one group from the next build on
+    /// (`groups[i]`, the group of particle i; empty: every pair); a change
+    /// of groups makes the next update rebuild.
+    pub fn set_groups(&mut self, groups: &[u32]) {
+        if self.groups != groups {
+            self.groups.clear();
+            self.groups.extend_from_slice(groups);
+            self.reference.clear();
+        }
     }
 
     /// Rebuilds the list if needed; returns whether it did.
@@ -136,6 +150,8 @@ impl VerletList {
         let cells = CellGrid::new(pos, boundary, reach);
         let image = boundary.image();
         let half = self.half;
+        let groups = &self.groups;
+        let grouped = !groups.is_empty();
         let blocks: Vec<(Vec<u32>, Vec<u32>)> = (0..pos.len().div_ceil(BLOCK))
             .into_par_iter()
             .map(|b| {
@@ -147,7 +163,8 @@ impl VerletList {
                     let ri = pos[i];
                     cells.for_each_run(ri, |js, rs| {
                         for (&j, &rj) in js.iter().zip(rs) {
-                            let wanted = if half { j > i } else { j != i };
+                            let wanted = (if half { j > i } else { j != i })
+                                && !(grouped && groups[i] == groups[j]);
                             if wanted && image.apply(rj - ri).length_squared() < reach2 {
                                 near.push(j as u32);
                             }
@@ -331,5 +348,45 @@ impl CellGrid {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A list grouped by body lists exactly the pairs of the plain list
+    /// whose particles are of different groups (across a periodic side
+    /// too), and a change of groups rebuilds it.
+    #[test]
+    fn grouped_lists_leave_out_pairs_within_a_group() {
+        let boundary = Boundary::periodic(DVec3::ZERO, DVec3::splat(6.0));
+        let pos: Vec<DVec3> = (0..300)
+            .map(|i| {
+                let t = i as f64;
+                DVec3::new((t * 0.37) % 6.0, (t * 0.71) % 6.0, (t * 1.13) % 6.0)
+            })
+            .collect();
+        let groups: Vec<u32> = (0..300).map(|i| i % 7).collect();
+        let mut plain = VerletList::half(1.0, 0.2);
+        plain.update(&pos, &boundary);
+        let mut grouped = VerletList::half(1.0, 0.2);
+        grouped.set_groups(&groups);
+        grouped.update(&pos, &boundary);
+        let mut kept = 0;
+        for i in 0..pos.len() {
+            let want: Vec<u32> = (plain.of(i).iter())
+                .filter(|&&j| groups[j as usize] != groups[i])
+                .copied()
+                .collect();
+            assert_eq!(grouped.of(i), want.as_slice(), "row {i}");
+            kept += want.len();
+        }
+        assert!(kept > 0 && kept < plain.neighbors.len());
+        let builds = grouped.builds;
+        assert!(!grouped.update(&pos, &boundary));
+        grouped.set_groups(&vec![0; 300]);
+        assert!(grouped.update(&pos, &boundary));
+        assert_eq!((grouped.builds, grouped.neighbors.len()), (builds + 1, 0));
     }
 }

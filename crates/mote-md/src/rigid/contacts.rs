@@ -4,9 +4,8 @@
 //! through their spheres; the short-range issue's contact law).
 //!
 //! - Neighbour search: a half Verlet list over all world-frame sphere
-//!   centres ([`crate::neighbor::VerletList`]); after each rebuild the pairs
-//!   of one body are dropped, so the loop sees only pairs of different
-//!   bodies. Every listed pair carries its contact history (tangential and
+//!   centres ([`crate::neighbor::VerletList`]) grouped by body, so that it
+//!   lists only pairs of spheres of different bodies. Every listed pair carries its contact history (tangential and
 //!   rolling elongations) beside the list; a rebuild carries the histories
 //!   of pairs still listed over by merging the sorted partner lists.
 //! - Walls: the granular [`Wall`]s, with one history per (sphere, wall).
@@ -97,6 +96,34 @@ struct WallWrench {
     force: DVec3,
 }
 
+/// Where one evaluation's wrenches go, in the order they come: the bodies'
+/// wrenches and the walls' forces, with the contacts counted.
+struct Totals<'a> {
+    wrench: &'a mut [DE],
+    wall_force: &'a mut [DVec3],
+    contacts: usize,
+    wall_contacts: usize,
+}
+
+impl Totals<'_> {
+    fn pair(&mut self, w: &PairWrench) {
+        let (a, b) = (w.a as usize, w.b as usize);
+        self.wrench[a].omega += w.on_a.omega;
+        self.wrench[a].v += w.on_a.v;
+        self.wrench[b].omega += w.on_b.omega;
+        self.wrench[b].v += w.on_b.v;
+        self.contacts += 1;
+    }
+
+    fn wall(&mut self, w: &WallWrench) {
+        let a = w.body as usize;
+        self.wrench[a].omega += w.on_body.omega;
+        self.wrench[a].v += w.on_body.v;
+        self.wall_force[w.wall as usize] -= w.force;
+        self.wall_contacts += 1;
+    }
+}
+
 /// Spheres per block of the parallel wall loop.
 const WALL_BLOCK: usize = 1024;
 
@@ -163,32 +190,24 @@ impl RigidContacts {
 }
 
 impl ContactState {
-    /// Refreshes the list; after a rebuild drops same-body pairs and carries
-    /// the histories of pairs still listed.
+    /// Refreshes the list (which lists no two spheres of one body); after
+    /// a rebuild carries the histories of pairs still listed.
     fn refresh(&mut self, centres: &[DVec3], body: &[u32], r_max: f64, boundary: &Boundary) {
         let cutoff = 2.0 * r_max;
         if self.list.cutoff != cutoff || !self.list.half {
             let skin = self.skin;
             self.list = VerletList::half(cutoff, skin);
         }
+        self.list.set_groups(body);
         let rebuilt = if boundary.is_periodic() {
             self.list
                 .update_wrapping(centres, boundary, &mut self.wrapped)
         } else {
             self.list.update(centres, boundary)
         };
-        if !rebuilt && self.pairs.rows() == centres.len() {
-            return;
+        if rebuilt || self.pairs.rows() != centres.len() {
+            self.pairs.carry_to(&self.list.start, &self.list.neighbors);
         }
-        let n = centres.len();
-        let mut start = Vec::with_capacity(n + 1);
-        let mut partner = Vec::with_capacity(self.list.neighbors.len());
-        start.push(0u32);
-        for (s, &bs) in body.iter().enumerate().take(n) {
-            partner.extend(self.list.of(s).iter().filter(|&&j| body[j as usize] != bs));
-            start.push(partner.len() as u32);
-        }
-        self.pairs.carry_to(&start, &partner);
     }
 }
 
@@ -259,19 +278,18 @@ impl SpherePairs<'_> {
 impl SpherePairs<'_> {
     /// The pairs of sphere rows `rows` (entries from `base` on in
     /// `history` and `touching`): advances their histories and writes the
-    /// touching pairs' wrenches, in pair order, into `out`.
+    /// touching pairs' wrenches to `out` in pair order.
     fn block(
         &self,
         list: &PairHistories,
         rows: Range<usize>,
         history: &mut [History],
         touching: &mut [bool],
-        out: &mut Vec<PairWrench>,
+        out: &mut impl FnMut(PairWrench),
     ) {
         let world = self.view.world;
         let (centres, body) = (&world.sphere_centre, &world.sphere_body);
         let dt = self.view.step.dt;
-        out.clear();
         let base = list.starts()[rows.start] as usize;
         for s in rows {
             let a = body[s];
@@ -288,7 +306,7 @@ impl SpherePairs<'_> {
                 let b = body[o];
                 let on_a = self.view.wrench_at(a as usize, centres[s], c.force);
                 let on_b = self.view.wrench_at(b as usize, centres[o], -c.force);
-                out.push(PairWrench {
+                out(PairWrench {
                     a,
                     b,
                     on_a: DE::new(on_a.omega + c.torque_i, on_a.v),
@@ -313,15 +331,14 @@ impl WallContacts<'_> {
     /// The spheres from `first` on against every wall (history slot
     /// s·walls + w, from the first sphere's on in `history` and
     /// `touching`): advances their histories and writes the contacts'
-    /// wrenches, in sphere order, into `out`.
+    /// wrenches to `out` in sphere order.
     fn block(
         &self,
         first: usize,
         history: &mut [History],
         touching: &mut [bool],
-        out: &mut Vec<WallWrench>,
+        out: &mut impl FnMut(WallWrench),
     ) {
-        out.clear();
         let n_walls = self.walls.len();
         let (view, t, dt) = (self.view, self.view.step.time, self.view.step.dt);
         let (world, bodies) = (view.world, view.bodies);
@@ -363,7 +380,7 @@ impl WallContacts<'_> {
                 h,
             );
             let on_a = view.wrench_at(a, x, c.force);
-            out.push(WallWrench {
+            out(WallWrench {
                 body: a as u32,
                 wall: w as u32,
                 on_body: DE::new(on_a.omega + c.torque_i, on_a.v),
@@ -401,7 +418,8 @@ impl BodyInteraction for RigidContacts {
     /// of spheres against the walls), each writing its contacts' wrenches
     /// in order; the wrenches are then summed in pair order, then sphere–
     /// wall order, so the bits are those of one serial loop on any number
-    /// of threads.
+    /// of threads. One thread adds them as they come, in the same order,
+    /// without the buffers.
     fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
         let world = view.world;
         let (centres, radius) = (&world.sphere_centre, &world.sphere_radius);
@@ -482,42 +500,69 @@ impl BodyInteraction for RigidContacts {
                 }),
         );
         let list = &st.pairs;
-        for_each_block(&mut blocks, |_, block| match block {
-            ContactBlock::Pairs {
-                rows,
-                history,
-                touching,
-                out,
-            } => pairs.block(list, rows.clone(), history, touching, out),
-            ContactBlock::Walls {
-                first,
-                history,
-                touching,
-                out,
-            } => walls.block(*first, history, touching, out),
-        });
-        drop(blocks);
-        st.pairs.history = history;
-        st.pairs.touching = touching;
-        st.contacts = 0;
-        for w in st.pair_wrenches.iter().flatten() {
-            let (a, b) = (w.a as usize, w.b as usize);
-            wrench[a].omega += w.on_a.omega;
-            wrench[a].v += w.on_a.v;
-            wrench[b].omega += w.on_b.omega;
-            wrench[b].v += w.on_b.v;
-            st.contacts += 1;
-        }
         st.wall_force.clear();
         st.wall_force.resize(self.walls.len(), DVec3::ZERO);
-        st.wall_contacts = 0;
-        for w in st.wall_wrenches.iter().flatten() {
-            let a = w.body as usize;
-            wrench[a].omega += w.on_body.omega;
-            wrench[a].v += w.on_body.v;
-            st.wall_force[w.wall as usize] -= w.force;
-            st.wall_contacts += 1;
+        let mut totals = Totals {
+            wrench,
+            wall_force: &mut st.wall_force,
+            contacts: 0,
+            wall_contacts: 0,
+        };
+        if rayon::current_num_threads() < 2 {
+            // One thread: the blocks in order, each contact's wrenches
+            // added as they come — the order of the sums below.
+            for block in &mut blocks {
+                match block {
+                    ContactBlock::Pairs {
+                        rows,
+                        history,
+                        touching,
+                        ..
+                    } => pairs.block(list, rows.clone(), history, touching, &mut |w| {
+                        totals.pair(&w)
+                    }),
+                    ContactBlock::Walls {
+                        first,
+                        history,
+                        touching,
+                        ..
+                    } => walls.block(*first, history, touching, &mut |w| totals.wall(&w)),
+                }
+            }
+        } else {
+            for_each_block(&mut blocks, |_, block| match block {
+                ContactBlock::Pairs {
+                    rows,
+                    history,
+                    touching,
+                    out,
+                } => {
+                    out.clear();
+                    pairs.block(list, rows.clone(), history, touching, &mut |w| out.push(w))
+                }
+                ContactBlock::Walls {
+                    first,
+                    history,
+                    touching,
+                    out,
+                } => {
+                    out.clear();
+                    walls.block(*first, history, touching, &mut |w| out.push(w))
+                }
+            });
+            drop(blocks);
+            st.pair_wrenches
+                .iter()
+                .flatten()
+                .for_each(|w| totals.pair(w));
+            st.wall_wrenches
+                .iter()
+                .flatten()
+                .for_each(|w| totals.wall(w));
         }
+        (st.contacts, st.wall_contacts) = (totals.contacts, totals.wall_contacts);
+        st.pairs.history = history;
+        st.pairs.touching = touching;
     }
 
     /// [NaN (the time of the last evaluation before dt came with the view;

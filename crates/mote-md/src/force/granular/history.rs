@@ -77,27 +77,41 @@ impl PairHistories {
     }
 
     /// Moves onto a freshly built list, carrying the histories of the pairs
-    /// still listed, then placing restored ones.
+    /// still listed, then placing restored ones. Rows are independent:
+    /// blocks of rows merge in parallel.
     pub fn carry_to(&mut self, start: &[u32], partner: &[u32]) {
+        use rayon::prelude::*;
+        const ROWS: usize = 2048;
         let mut history = vec![History::default(); partner.len()];
         let mut touching = vec![false; partner.len()];
-        let rows = (start.len().saturating_sub(1)).min(self.rows());
-        for i in 0..rows {
-            let (mut a, a_end) = (self.start[i] as usize, self.start[i + 1] as usize);
-            let (mut b, b_end) = (start[i] as usize, start[i + 1] as usize);
-            while a < a_end && b < b_end {
-                match self.partner[a].cmp(&partner[b]) {
-                    std::cmp::Ordering::Less => a += 1,
-                    std::cmp::Ordering::Greater => b += 1,
-                    std::cmp::Ordering::Equal => {
-                        history[b] = self.history[a];
-                        touching[b] = self.touching[a];
-                        a += 1;
-                        b += 1;
+        let rows = start.len().saturating_sub(1);
+        let firsts: Vec<usize> = (0..=rows.div_ceil(ROWS))
+            .map(|b| (b * ROWS).min(rows))
+            .collect();
+        let blocks = split_blocks(&mut history, &mut touching, start, &firsts);
+        let old = &*self;
+        blocks
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(block, (history, touching))| {
+                let base = start[firsts[block]] as usize;
+                for i in firsts[block]..firsts[block + 1].min(old.rows()) {
+                    let (mut a, a_end) = (old.start[i] as usize, old.start[i + 1] as usize);
+                    let (mut b, b_end) = (start[i] as usize, start[i + 1] as usize);
+                    while a < a_end && b < b_end {
+                        match old.partner[a].cmp(&partner[b]) {
+                            std::cmp::Ordering::Less => a += 1,
+                            std::cmp::Ordering::Greater => b += 1,
+                            std::cmp::Ordering::Equal => {
+                                history[b - base] = old.history[a];
+                                touching[b - base] = old.touching[a];
+                                a += 1;
+                                b += 1;
+                            }
+                        }
                     }
                 }
-            }
-        }
+            });
         self.start.clear();
         self.start.extend_from_slice(start);
         self.partner.clear();
