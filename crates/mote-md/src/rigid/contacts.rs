@@ -273,9 +273,7 @@ impl SpherePairs<'_> {
             history,
         ))
     }
-}
 
-impl SpherePairs<'_> {
     /// The pairs of sphere rows `rows` (entries from `base` on in
     /// `history` and `touching`): advances their histories and writes the
     /// touching pairs' wrenches to `out` in pair order.
