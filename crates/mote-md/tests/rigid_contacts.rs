@@ -335,10 +335,18 @@ steps = 300
             for _ in 0..300 {
                 run.advance().unwrap();
             }
-            let (pairs, walls) = run.contacts().unwrap().contact_counts();
+            let contacts = run.contacts().unwrap();
+            let (pairs, walls) = contacts.contact_counts();
             assert!(
                 pairs > 100 && walls > 10,
                 "{pairs} pairs, {walls} on the floor"
+            );
+            // The summary names the contacts' list builds beside their share.
+            let builds = contacts.list_builds();
+            let summary = run.frbi.breakdown(run.stepping, run.stepping).sentence();
+            assert!(
+                builds > 1 && summary.contains(&format!("contacts (list: {builds} builds) ")),
+                "{summary}"
             );
             (run.bodies.position.clone(), run.bodies.velocity.clone())
         })

@@ -37,6 +37,15 @@ pub struct Breakdown {
     pub wall: f64,
 }
 
+/// "1 build", "N builds": a list's builds as the summary names them.
+pub fn builds(n: u64) -> String {
+    if n == 1 {
+        "1 build".into()
+    } else {
+        format!("{n} builds")
+    }
+}
+
 impl Breakdown {
     /// The parts of a run of `wall` seconds whose steps took `stepping`:
     /// the interactions by name (those of one name together), the shared
@@ -56,7 +65,7 @@ impl Breakdown {
         let neighbours = timing.neighbours.as_secs_f64();
         if neighbours > 0.0 {
             parts.push((
-                format!("neighbour list ({} builds)", timing.builds),
+                format!("neighbour list ({})", builds(timing.builds)),
                 neighbours,
             ));
         }
@@ -138,6 +147,10 @@ mod tests {
         assert_eq!(
             b.sentence(),
             "Wall time: granular 50.0 %, walls 10.0 %, neighbour list (7 builds) 5.0 %, integration and the rest of the steps 25.0 %, measuring and writing 10.0 %."
+        );
+        assert_eq!(
+            (builds(1), builds(0)),
+            ("1 build".into(), "0 builds".into())
         );
     }
 }

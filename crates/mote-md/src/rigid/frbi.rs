@@ -12,8 +12,10 @@ use mote_geom::{compose_rotations, rotation_matrix, DMat3, Inertia, DE};
 use rayon::prelude::*;
 
 use super::bodies::RigidBodies;
+use super::contacts::RigidContacts;
 use super::free8::{free_step8, react8, Group, LANES};
 use super::interaction::{BodyInteraction, BodyView, WorldFrame};
+use crate::force::timing::builds;
 use crate::force::StepParameters;
 
 /// How the centre of mass moves in a free step.
@@ -303,7 +305,15 @@ impl Frbi {
         stepping: std::time::Duration,
         wall: std::time::Duration,
     ) -> crate::force::timing::Breakdown {
-        let names: Vec<&str> = self.interactions.iter().map(|i| i.name()).collect();
+        // The contacts search with a list of their own: its builds are
+        // named beside their share, as the shared list's are.
+        let names: Vec<String> = (self.interactions.iter())
+            .map(|i| match i.as_any().downcast_ref::<RigidContacts>() {
+                Some(c) => format!("{} (list: {})", i.name(), builds(c.list_builds())),
+                None => i.name().to_string(),
+            })
+            .collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
         crate::force::timing::Breakdown::new(&names, &self.timing, stepping, wall)
     }
 
