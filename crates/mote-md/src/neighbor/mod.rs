@@ -101,43 +101,19 @@ impl VerletList {
     /// spheres of rigid bodies, carried with their bodies): `search` gets
     /// each position wrapped into the box ([`Boundary::wrap`], a function
     /// of the position alone, so a resumed run searches where the
-    /// uninterrupted one did), in parallel chunks that check the
-    /// displacement since the last build in the same pass. Returns whether
-    /// it rebuilt.
+    /// uninterrupted one did), in parallel, and the list is kept there by
+    /// [`VerletList::update`]. Returns whether it rebuilt.
     pub fn update_wrapping(
         &mut self,
         pos: &[DVec3],
         boundary: &Boundary,
         search: &mut Vec<DVec3>,
     ) -> bool {
-        const CHUNK: usize = 4096;
-        self.since_build += 1;
-        let n = pos.len();
-        search.resize(n, DVec3::ZERO);
-        let limit = 0.25 * self.skin * self.skin;
-        let image = boundary.image();
-        let fresh = self.reference.len() == n;
-        let reference: &[DVec3] = if fresh { &self.reference } else { &[] };
-        let moved = search
-            .par_chunks_mut(CHUNK)
-            .zip(pos.par_chunks(CHUNK))
-            .enumerate()
-            .map(|(c, (out, r))| {
-                let mut moved = false;
-                for (k, (w, &r)) in out.iter_mut().zip(r).enumerate() {
-                    *w = boundary.wrap(r);
-                    if let Some(r0) = reference.get(c * CHUNK + k) {
-                        moved |= image.apply(*w - *r0).length_squared() > limit;
-                    }
-                }
-                moved
-            })
-            .reduce(|| false, |a, b| a || b);
-        let stale = !fresh || moved || (self.every > 0 && self.since_build >= self.every);
-        if stale {
-            self.build(search, boundary);
-        }
-        stale
+        pos.par_iter()
+            .with_min_len(4096)
+            .map(|r| boundary.wrap(*r))
+            .collect_into_vec(search);
+        self.update(search, boundary)
     }
 
     /// Builds the list from scratch: blocks of particles in parallel, each
