@@ -216,6 +216,7 @@ impl Stepper {
             Self::eval_rotating(ff, sys, t, 0.0, &mut acc, &mut alpha);
             sys.carried_angular_acceleration = alpha;
         } else {
+            ff.before_forces(sys);
             Self::eval(
                 ff,
                 sys,
@@ -261,6 +262,7 @@ impl Stepper {
                 // (and in checkpoints), so it is evaluated once per step.
                 let mut acc = std::mem::take(&mut sys.carried_acceleration);
                 if acc.len() != sys.particles.len() {
+                    ff.before_forces(sys);
                     Self::eval(
                         ff,
                         sys,
@@ -283,6 +285,9 @@ impl Stepper {
                             *x += *v * h;
                         });
                 }
+                // A decomposed run's particles may migrate here: `acc` is
+                // overwritten whole by the evaluation.
+                ff.before_forces(sys);
                 Self::eval(
                     ff,
                     sys,

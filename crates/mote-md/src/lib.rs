@@ -10,6 +10,7 @@
 
 pub mod boundary;
 pub mod brownian;
+pub mod domain;
 pub mod eos;
 pub mod error;
 pub mod force;

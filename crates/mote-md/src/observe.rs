@@ -34,6 +34,26 @@ pub struct Observables {
     pub magnetisation: DVec3,
 }
 
+/// The sums over the particles (and the ranks) observables are made of.
+struct Sums {
+    /// Σ ½ m v² (translation only) and Σ ½ I ω².
+    kinetic: f64,
+    rotational: f64,
+    potential: f64,
+    momentum: DVec3,
+    angular_momentum: DVec3,
+    magnetisation: DVec3,
+    /// The virial W, where the box is periodic on every axis and every
+    /// interaction gives its part.
+    virial: Option<f64>,
+    /// Σ m v ⊗ v + W_αβ, when measured.
+    tensor: Option<Virial>,
+    /// Free translational axes and particles.
+    free: f64,
+    count: f64,
+    wall_forces: Vec<(String, DVec3)>,
+}
+
 impl Observables {
     pub fn total_energy(&self) -> f64 {
         self.kinetic + self.potential
@@ -57,43 +77,108 @@ impl Observables {
             rotational += 0.5 * iw.dot(p.angular_velocity[i]);
             angular_momentum += iw;
         }
-        let translational = kinetic;
-        kinetic += rotational;
         let state = State::of(sys, &p.position, &p.velocity, sys.time, 0.0);
-        let (potential, _) = ff.potential_energy(&state);
-        let nf = sys.degrees_of_freedom();
-        let volume = sys.boundary.volume();
-        let pressure = match ff.virial() {
-            Some(w) if sys.boundary.periodic.iter().all(|p| *p) && volume.is_finite() => {
-                (2.0 * translational + w) / (3.0 * volume)
-            }
-            _ => f64::NAN,
-        };
-        let mut pressure_tensor = [f64::NAN; 6];
-        if ff.pressure_tensor && pressure.is_finite() {
+        let (mut potential, _) = ff.potential_energy(&state);
+        let periodic =
+            sys.boundary.periodic.iter().all(|p| *p) && sys.boundary.volume().is_finite();
+        let mut virial = ff.virial().filter(|_| periodic);
+        let mut tensor = None;
+        if ff.pressure_tensor && virial.is_some_and(f64::is_finite) {
             if let Some(w) = ff.virial_tensor(&state) {
                 let mut kinetic = Virial::default();
                 for (m, v) in p.mass.iter().zip(&p.velocity) {
                     kinetic += Virial::pair(*v, *v * *m);
                 }
-                pressure_tensor = (kinetic + w).scaled(1.0 / volume).0;
+                tensor = Some(kinetic + w);
             }
         }
+        let mut magnetisation: DVec3 = p.dipole.iter().sum();
+        let free: f64 = p.mobility.iter().map(|m| m.x + m.y + m.z).sum();
+        let mut count = p.len() as f64;
+        if let Some(domain) = &ff.domain {
+            // A decomposed run: every rank's sums, added in rank order.
+            let mut local = vec![kinetic, rotational, potential, free, count];
+            local.extend(momentum.to_array());
+            local.extend(angular_momentum.to_array());
+            local.extend(magnetisation.to_array());
+            local.push(virial.unwrap_or(f64::NAN));
+            local.extend(tensor.map_or([f64::NAN; 6], |t| t.0));
+            let total = domain.comm().sum(&local);
+            [kinetic, rotational, potential, count] = [total[0], total[1], total[2], total[4]];
+            let free_total = total[3];
+            momentum = DVec3::from_slice(&total[5..8]);
+            angular_momentum = DVec3::from_slice(&total[8..11]);
+            magnetisation = DVec3::from_slice(&total[11..14]);
+            virial = virial.map(|_| total[14]);
+            tensor = tensor.map(|_| Virial(total[15..21].try_into().expect("six")));
+            return Self::from_sums(
+                sys,
+                Sums {
+                    kinetic,
+                    rotational,
+                    potential,
+                    momentum,
+                    angular_momentum,
+                    magnetisation,
+                    virial,
+                    tensor,
+                    free: free_total,
+                    count,
+                    wall_forces: Vec::new(),
+                },
+            );
+        }
+        Self::from_sums(
+            sys,
+            Sums {
+                kinetic,
+                rotational,
+                potential,
+                momentum,
+                angular_momentum,
+                magnetisation,
+                virial,
+                tensor,
+                free,
+                count,
+                wall_forces: ff
+                    .interactions
+                    .iter()
+                    .filter_map(|i| i.viewer())
+                    .flat_map(|v| v.wall_forces())
+                    .collect(),
+            },
+        )
+    }
+
+    /// The observables of the whole system's sums.
+    fn from_sums(sys: &System, s: Sums) -> Self {
+        let translational = s.kinetic;
+        // Translation's degrees of freedom: the free axes, less the three
+        // of total momentum when nothing is fixed.
+        let nf = if s.free == 3.0 * s.count && s.count > 1.0 {
+            s.free - 3.0
+        } else {
+            s.free
+        };
+        let volume = sys.boundary.volume();
+        let pressure = s
+            .virial
+            .map_or(f64::NAN, |w| (2.0 * translational + w) / (3.0 * volume));
+        let pressure_tensor = match s.tensor {
+            Some(t) if pressure.is_finite() => t.scaled(1.0 / volume).0,
+            _ => [f64::NAN; 6],
+        };
         Self {
             time: sys.time,
             pressure_tensor,
-            kinetic,
-            rotational,
-            potential,
-            momentum,
-            angular_momentum,
-            magnetisation: p.dipole.iter().sum(),
-            wall_forces: ff
-                .interactions
-                .iter()
-                .filter_map(|i| i.viewer())
-                .flat_map(|v| v.wall_forces())
-                .collect(),
+            kinetic: s.kinetic + s.rotational,
+            rotational: s.rotational,
+            potential: s.potential,
+            momentum: s.momentum,
+            angular_momentum: s.angular_momentum,
+            magnetisation: s.magnetisation,
+            wall_forces: s.wall_forces,
             kt: if nf > 0.0 {
                 2.0 * translational / nf
             } else {

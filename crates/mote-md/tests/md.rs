@@ -10,6 +10,7 @@ mod dipolar_mmf;
 mod dipolar_pair;
 mod dipolar_perf;
 mod dipolar_rows;
+mod domain;
 mod electric_scenes;
 mod ewald;
 mod from_file;

@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 use mote_io::checkpoint::{self, Checkpoint};
 use mote_io::xyz::Frame;
 
+pub mod comm;
 pub mod parallel;
 pub mod scene;
 mod steer;

@@ -34,6 +34,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::boundary::Boundary;
+use crate::domain::{Domain, Halo};
 use crate::neighbor::VerletList;
 use crate::particles::System;
 pub use crate::viewer::ViewerHooks;
@@ -79,6 +80,10 @@ pub struct State<'a> {
     /// `position` ([`ForceField`] sets it; `None` from the constructors:
     /// an interaction then uses a list of its own).
     pub neighbours: Option<&'a VerletList>,
+    /// In a decomposed run, this rank's particles and the ghosts near its
+    /// brick, up to date for `position` ([`ForceField`] sets it): an
+    /// interaction that decomposes lists its pairs over them.
+    pub halo: Option<&'a Halo>,
 }
 
 /// The box of a state given without one.
@@ -102,6 +107,7 @@ impl<'a> State<'a> {
             dipole: &[],
             boundary: &OPEN_SPACE,
             neighbours: None,
+            halo: None,
         }
     }
 
@@ -126,6 +132,7 @@ impl<'a> State<'a> {
             dipole: &p.dipole,
             boundary: &sys.boundary,
             neighbours: None,
+            halo: None,
         }
     }
 
@@ -182,6 +189,11 @@ pub trait Interaction: Send + Sync {
     fn name(&self) -> &'static str;
     /// Adds this interaction's force on each particle to `force`.
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]);
+    /// Whether it runs decomposed: its forces on a rank's particles come
+    /// from those particles and the ghosts of [`State::halo`] alone.
+    fn decomposes(&self) -> bool {
+        false
+    }
     /// Whether this interaction exerts torques (frictional contacts,
     /// dipoles); then the integrator rotates the particles and calls
     /// [`Interaction::add_forces_and_torques`].
@@ -329,9 +341,14 @@ pub(crate) fn add_block_buffers(force: &mut [DVec3], torque: &mut [DVec3], buffe
 }
 
 /// `state` with the shared list.
-fn sharing<'a>(state: &State<'a>, neighbours: &'a Option<(VerletList, usize)>) -> State<'a> {
+fn sharing<'a>(
+    state: &State<'a>,
+    neighbours: &'a Option<(VerletList, usize)>,
+    domain: &'a Option<Domain>,
+) -> State<'a> {
     State {
         neighbours: neighbours.as_ref().map(|n| &n.0),
+        halo: domain.as_ref().map(|d| d.halo()),
         ..*state
     }
 }
@@ -350,6 +367,8 @@ pub struct ForceField {
     neighbours: Option<(VerletList, usize)>,
     /// Wall time of the force passes, by interaction, and of the list.
     pub timing: timing::Timing,
+    /// This rank's part of a decomposed run (`None`: one process).
+    pub domain: Option<Domain>,
 }
 
 impl ForceField {
@@ -411,6 +430,37 @@ impl ForceField {
         }
     }
 
+    /// Readies a decomposed run's halo for a force evaluation at the
+    /// system's positions (particles migrate at a rebuild, so the system
+    /// may change); nothing in one process. Integrators call it before
+    /// every evaluation.
+    pub fn before_forces(&mut self, sys: &mut System) {
+        if let Some(domain) = &mut self.domain {
+            let since = std::time::Instant::now();
+            if domain.prepare(sys) {
+                self.timing.builds += 1;
+            }
+            self.timing.neighbours += since.elapsed();
+        }
+    }
+
+    /// Brings a decomposed run's ghosts to `state` for a measurement.
+    fn refresh_halo(&mut self, state: &State) {
+        if let Some(domain) = &mut self.domain {
+            domain.refresh(state.position, state.boundary);
+        }
+    }
+
+    /// The interactions that cannot run decomposed (a decomposed run
+    /// refuses them).
+    pub fn not_decomposing(&self) -> Vec<&'static str> {
+        self.interactions
+            .iter()
+            .filter(|i| !i.decomposes())
+            .map(|i| i.name())
+            .collect()
+    }
+
     /// The shared neighbour list as of the last evaluation, if any.
     pub fn neighbours(&self) -> Option<&VerletList> {
         self.neighbours.as_ref().map(|n| &n.0)
@@ -420,7 +470,7 @@ impl ForceField {
     pub fn accelerations(&mut self, state: &State, mobility: &[DVec3], acc: &mut [DVec3]) {
         let n = state.position.len();
         self.refresh_neighbours(state);
-        let state = &sharing(state, &self.neighbours);
+        let state = &sharing(state, &self.neighbours, &self.domain);
         self.force.clear();
         self.force.resize(n, DVec3::ZERO);
         for (k, interaction) in self.interactions.iter_mut().enumerate() {
@@ -488,7 +538,7 @@ impl ForceField {
         torque: &mut [DVec3],
     ) {
         self.refresh_neighbours(state);
-        let state = &sharing(state, &self.neighbours);
+        let state = &sharing(state, &self.neighbours, &self.domain);
         for (k, interaction) in self.interactions.iter_mut().enumerate() {
             let since = std::time::Instant::now();
             interaction.add_forces_and_torques(state, spin, force, torque);
@@ -505,8 +555,9 @@ impl ForceField {
     /// The virial tensor at `state`, summed over the interactions; `None`
     /// if one does not compute its part ([`ForceField::without_virial_tensor`]).
     pub fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        self.refresh_halo(state);
         self.refresh_neighbours(state);
-        let state = &sharing(state, &self.neighbours);
+        let state = &sharing(state, &self.neighbours, &self.domain);
         self.interactions
             .iter_mut()
             .map(|i| i.virial_tensor(state))
@@ -515,8 +566,9 @@ impl ForceField {
 
     /// The interactions that do not compute their virial tensor.
     pub fn without_virial_tensor(&mut self, state: &State) -> Vec<&'static str> {
+        self.refresh_halo(state);
         self.refresh_neighbours(state);
-        let state = &sharing(state, &self.neighbours);
+        let state = &sharing(state, &self.neighbours, &self.domain);
         self.interactions
             .iter_mut()
             .filter_map(|i| i.virial_tensor(state).is_none().then(|| i.name()))
@@ -535,8 +587,9 @@ impl ForceField {
 
     /// Total potential energy, and its parts by interaction name.
     pub fn potential_energy(&mut self, state: &State) -> (f64, Vec<(&'static str, f64)>) {
+        self.refresh_halo(state);
         self.refresh_neighbours(state);
-        let state = &sharing(state, &self.neighbours);
+        let state = &sharing(state, &self.neighbours, &self.domain);
         let parts: Vec<(&'static str, f64)> = self
             .interactions
             .iter_mut()

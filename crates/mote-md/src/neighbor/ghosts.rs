@@ -22,6 +22,7 @@ use mote_geom::lanes::{self, Lanes, LANES};
 use rayon::prelude::*;
 
 use crate::boundary::Boundary;
+use crate::domain::Halo;
 
 /// Particles per parallel block of a build or refresh.
 const BLOCK: usize = 512;
@@ -78,6 +79,8 @@ pub struct GhostList {
     /// A restored build (updates since it, wrapped positions), made at the
     /// next update, when the box is at hand.
     pending: Option<(u64, Vec<DVec3>)>,
+    /// The halo generation the list was built for (decomposed runs).
+    generation: u64,
 }
 
 impl GhostList {
@@ -215,18 +218,9 @@ impl GhostList {
             self.build(pos, boundary);
             return true;
         }
-        let (particle, displacement) = (&self.particle, &self.displacement);
-        let [bx, by, bz] = &self.base;
-        self.position
-            .par_chunks_mut(BLOCK)
-            .enumerate()
-            .for_each(|(b, chunk)| {
-                for (c, p) in chunk.iter_mut().enumerate() {
-                    let k = b * BLOCK + c;
-                    let d = displacement[particle[k] as usize];
-                    *p = Copy4([bx[k] + d.x, by[k] + d.y, bz[k] + d.z, 0.0]);
-                }
-            });
+        let displacement = std::mem::take(&mut self.displacement);
+        self.move_copies(&displacement);
+        self.displacement = displacement;
         false
     }
 
@@ -298,30 +292,120 @@ impl GhostList {
         let at = |&(i, s): &(u32, DVec3)| wrapped[i as usize] + s;
         let unsorted_cells: Vec<u32> = copies.par_iter().map(|c| grid.cell(at(c))).collect();
         let order = grid.counting_sort(&unsorted_cells);
-        let first = grid.first(&unsorted_cells);
-        let copies: Vec<(u32, DVec3)> = order.iter().map(|&c| copies[c as usize]).collect();
-        let cell: Vec<u32> = order.iter().map(|&c| unsorted_cells[c as usize]).collect();
-        self.particle = copies.iter().map(|c| c.0).collect();
+        let sorted: Vec<Copy> = order
+            .iter()
+            .map(|&c| {
+                let copy = copies[c as usize];
+                Copy {
+                    particle: copy.0,
+                    at: at(&copy),
+                    row: copy.1 == DVec3::ZERO,
+                    cell: unsorted_cells[c as usize],
+                }
+            })
+            .collect();
+        self.fill(&grid, &sorted, n);
+        self.reference = wrapped;
+        self.displacement = vec![DVec3::ZERO; n];
+        self.since_build = 0;
+    }
+
+    /// Brings the list to the halo of a decomposed run: rebuilt when the
+    /// halo was built anew since the list was, else each copy moved by its
+    /// particle's displacement. Returns whether it rebuilt.
+    pub fn follow_halo(&mut self, halo: &Halo, boundary: &Boundary) -> bool {
+        if self.generation != halo.generation {
+            self.build_halo(halo, boundary);
+            return true;
+        }
+        self.move_copies(&halo.displacement);
+        false
+    }
+
+    /// Builds the list over a rank's particles and ghosts. The copies are
+    /// sorted by the cell of one process's grid over the whole box, then
+    /// within a cell in the order one process makes them (particles by
+    /// id, then the images along x, then along y, along z, each by the
+    /// copy it was made from and its image), so every row lists the
+    /// neighbours one process's row lists, in its order.
+    fn build_halo(&mut self, halo: &Halo, boundary: &Boundary) {
+        let n = halo.reference.len();
+        assert!(
+            n + halo.ghosts.len() < u32::MAX as usize / 2,
+            "too many particles for u32 lists"
+        );
+        let reach = self.cutoff + self.skin;
+        let grid = Grid::spanning(boundary, reach, halo.extent, halo.total);
+        let own = halo
+            .reference
+            .iter()
+            .zip(&halo.id)
+            .map(|(r, id)| (*id, [0; 3], *r));
+        let ghosts = halo.ghosts.iter().map(|g| (g.id, g.image, g.base));
+        let copies: Vec<(u64, [i32; 3], DVec3)> = own.chain(ghosts).collect();
+        let cells: Vec<u32> = copies.par_iter().map(|c| grid.cell(c.2)).collect();
+        let mut order: Vec<u32> = (0..copies.len() as u32).collect();
+        order.par_sort_unstable_by_key(|&c| {
+            let (id, [mx, my, mz], _) = copies[c as usize];
+            (cells[c as usize], mz != 0, my != 0, mx != 0, id, mx, my, mz)
+        });
+        let sorted: Vec<Copy> = order
+            .iter()
+            .map(|&c| Copy {
+                particle: c,
+                at: copies[c as usize].2,
+                row: (c as usize) < n,
+                cell: cells[c as usize],
+            })
+            .collect();
+        self.fill(&grid, &sorted, n);
+        self.generation = halo.generation;
+    }
+
+    /// Moves copy k to its place at the build plus `displacement` of its
+    /// particle.
+    fn move_copies(&mut self, displacement: &[DVec3]) {
+        let particle = &self.particle;
+        let [bx, by, bz] = &self.base;
+        self.position
+            .par_chunks_mut(BLOCK)
+            .enumerate()
+            .for_each(|(b, chunk)| {
+                for (c, p) in chunk.iter_mut().enumerate() {
+                    let k = b * BLOCK + c;
+                    let d = displacement[particle[k] as usize];
+                    *p = Copy4([bx[k] + d.x, by[k] + d.y, bz[k] + d.z, 0.0]);
+                }
+            });
+    }
+
+    /// Takes `copies`, sorted by cell, as the list's copies, with a row for
+    /// each of the `rows` copies marked as one, filled from the 3 × 3 runs
+    /// of three cells around it without branches on the distance.
+    fn fill(&mut self, grid: &Grid, copies: &[Copy], rows: usize) {
+        let cell: Vec<u32> = copies.iter().map(|c| c.cell).collect();
+        let first = grid.first(&cell);
+        self.particle = copies.iter().map(|c| c.particle).collect();
         self.owner.clear();
-        self.slot = vec![0; n];
+        self.slot = vec![0; rows];
         for (k, c) in copies.iter().enumerate() {
-            if c.1 == DVec3::ZERO {
-                self.slot[c.0 as usize] = self.owner.len() as u32;
+            if c.row {
+                self.slot[c.particle as usize] = self.owner.len() as u32;
                 self.owner.push(k as u32);
             }
         }
         for axis in 0..3 {
-            self.base[axis] = copies.par_iter().map(|c| at(c)[axis]).collect();
+            self.base[axis] = copies.par_iter().map(|c| c.at[axis]).collect();
         }
         let [bx, by, bz] = &self.base;
         self.position = (0..copies.len())
             .map(|k| Copy4([bx[k], by[k], bz[k], 0.0]))
             .collect();
 
-        // Each particle's row from the 3 × 3 runs of three cells around it,
-        // without branches on the distance.
         let (x, y, z, owner) = (bx, by, bz, &self.owner);
+        let reach = self.cutoff + self.skin;
         let reach2 = reach * reach;
+        let n = rows;
         let rows: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(BLOCK))
             .into_par_iter()
             .map(|b| {
@@ -360,11 +444,18 @@ impl GhostList {
                 self.start.push(last + l);
             }
         }
-        self.reference = wrapped;
-        self.displacement = vec![DVec3::ZERO; n];
-        self.since_build = 0;
         self.builds += 1;
     }
+}
+
+/// A copy at a build: its particle (index into the positions the list was
+/// built from, a rank's particles then its ghosts), its place, whether it
+/// has a row (a particle itself, not an image or a ghost) and its cell.
+struct Copy {
+    particle: u32,
+    at: DVec3,
+    row: bool,
+    cell: u32,
 }
 
 /// Writes to the front of `out` the indices `first + m` of the points
@@ -499,6 +590,14 @@ struct Grid {
 
 impl Grid {
     fn new(wrapped: &[DVec3], boundary: &Boundary, reach: f64) -> Self {
+        let lo = wrapped.iter().fold(DVec3::INFINITY, |a, r| a.min(*r));
+        let hi = wrapped.iter().fold(DVec3::NEG_INFINITY, |a, r| a.max(*r));
+        Self::spanning(boundary, reach, (lo, hi), wrapped.len())
+    }
+
+    /// The grid of `particles` particles whose wrapped coordinates lie
+    /// within `extent` (the grid of an open axis spans them).
+    fn spanning(boundary: &Boundary, reach: f64, extent: (DVec3, DVec3), particles: usize) -> Self {
         let mut lo = DVec3::ZERO;
         let mut inverse_edge = DVec3::ZERO;
         let mut dims = [1usize; 3];
@@ -506,23 +605,16 @@ impl Grid {
         for k in 0..3 {
             let (a, b) = if boundary.periodic[k] {
                 (boundary.lo[k] - reach, boundary.hi[k] + reach)
+            } else if extent.0[k].is_finite() {
+                (extent.0[k], extent.1[k])
             } else {
-                let a = wrapped.iter().map(|r| r[k]).fold(f64::INFINITY, f64::min);
-                let b = wrapped
-                    .iter()
-                    .map(|r| r[k])
-                    .fold(f64::NEG_INFINITY, f64::max);
-                if a.is_finite() {
-                    (a, b)
-                } else {
-                    (0.0, 1.0)
-                }
+                (0.0, 1.0)
             };
             len[k] = (b - a).max(reach);
             dims[k] = ((len[k] / reach).floor() as usize).clamp(1, 1 << 10);
             lo[k] = a;
         }
-        mote_geom::grids::cap_cells(&mut dims, 8 * wrapped.len().max(8));
+        mote_geom::grids::cap_cells(&mut dims, 8 * particles.max(8));
         for k in 0..3 {
             inverse_edge[k] = dims[k] as f64 / len[k];
         }

@@ -148,6 +148,22 @@ impl LennardJones {
         }
     }
 
+    /// Brings the list to `state`: over the halo in a decomposed run, else
+    /// over the particles and their images (counting a step when `step`).
+    fn follow(&mut self, state: &State, step: bool) {
+        match state.halo {
+            Some(halo) => {
+                self.list.follow_halo(halo, state.boundary);
+            }
+            None if step => {
+                self.list.update(state.position, state.boundary);
+            }
+            None => {
+                self.list.refresh(state.position, state.boundary);
+            }
+        }
+    }
+
     /// Runs every row into `sorted_force` and returns the halved sums of
     /// the virial and the energy (both zero unless `energy`).
     fn rows(&self, sorted_force: &mut [DVec3], energy: bool) -> (f64, f64) {
@@ -263,9 +279,13 @@ impl Interaction for LennardJones {
         "lennard_jones"
     }
 
+    fn decomposes(&self) -> bool {
+        true
+    }
+
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let pos = state.position;
-        self.list.update(pos, state.boundary);
+        self.follow(state, true);
         let mut sorted = std::mem::take(&mut self.sorted_force);
         sorted.resize(pos.len(), DVec3::ZERO);
         self.rows(&mut sorted, false);
@@ -279,7 +299,7 @@ impl Interaction for LennardJones {
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
-        self.list.refresh(state.position, state.boundary);
+        self.follow(state, false);
         // The virial comes with the energy, so a pressure measured before
         // the first step (no force evaluation yet) is right too.
         let mut sorted = std::mem::take(&mut self.sorted_force);
@@ -299,7 +319,7 @@ impl Interaction for LennardJones {
     /// W_αβ = ½ Σ_rows Σ_j (F/r) r_α r_β over the full list, by the
     /// portable pair law (a measurement, not a step: no SIMD kernel).
     fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
-        self.list.refresh(state.position, state.boundary);
+        self.follow(state, false);
         let (list, c) = (&self.list, self.coefficients());
         let mut rows = vec![(); list.len()];
         let w = list.sum_rows(&mut rows, |r| {

@@ -1,0 +1,443 @@
+//! Spatial domain decomposition (Plimpton 1995, J. Comput. Phys. 117, 1;
+//! LAMMPS's `comm`): the box cut into bricks, one per rank; each rank owns
+//! the particles in its brick and holds copies ("ghosts") of every particle
+//! within the cut-off and skin of its brick.
+//!
+//! At a list build the particles that left their brick migrate to the
+//! rank that now holds them, with all their state, and the ghosts are sent
+//! in three stages, x then y then z, each to the two face neighbours, a
+//! stage forwarding what the earlier ones brought (so the edges and
+//! corners arrive without diagonal messages); a copy that crosses a
+//! periodic face takes the image ±L there. Between builds, every force
+//! evaluation forwards along the same paths how far each particle has
+//! moved since the build, and a copy stands at its place at the build
+//! plus that displacement.
+//!
+//! The ghosts are exactly the periodic images one process makes
+//! ([`GhostList`](crate::neighbor::GhostList)) and the neighbours a brick
+//! needs; the list over them orders each row as one process would (by
+//! cell, then by particle id and image), and the rebuild rule is the one
+//! process's, reduced over the ranks: a decomposed run's forces, hence its
+//! trajectory, are the same bits on any number of ranks.
+
+pub mod bricks;
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use mote_run::comm::Comm;
+
+use crate::boundary::Boundary;
+use crate::particles::System;
+pub use bricks::Bricks;
+
+/// A copy of a particle near this rank's brick: another rank's particle,
+/// or this rank's own across a periodic face.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ghost {
+    /// The particle's id (its index in the undivided system).
+    pub id: u64,
+    /// The periodic image: the copy stands `image · L` from the particle.
+    pub image: [i32; 3],
+    /// The copy's place at the build: the particle's wrapped position
+    /// there plus the image.
+    pub base: DVec3,
+}
+
+/// What a rank's pair lists read: its particles and the ghosts near its
+/// brick as of the last build, and how far each has moved since.
+#[derive(Debug, Clone, Default)]
+pub struct Halo {
+    /// Counts the builds: a list built for another generation is rebuilt.
+    pub generation: u64,
+    /// The id of each of this rank's particles.
+    pub id: Vec<u64>,
+    /// The wrapped positions of this rank's particles at the build.
+    pub reference: Vec<DVec3>,
+    pub ghosts: Vec<Ghost>,
+    /// The minimum-image displacement since the build of this rank's
+    /// particles, then of the ghosts (each its particle's).
+    pub displacement: Vec<DVec3>,
+    /// The number of particles on all ranks.
+    pub total: usize,
+    /// The smallest and largest wrapped coordinates of all particles at the
+    /// build: the cell grid of an open axis spans them.
+    pub extent: (DVec3, DVec3),
+}
+
+/// One of the six messages of a ghost exchange: what goes to one face
+/// neighbour and comes from the opposite one.
+#[derive(Debug, Clone, Default)]
+struct Stage {
+    to: Option<usize>,
+    from: Option<usize>,
+    /// The copies sent, as indices into this rank's particles then ghosts.
+    send: Vec<u32>,
+}
+
+/// This rank's part of a decomposed run.
+pub struct Domain {
+    comm: Arc<dyn Comm>,
+    pub bricks: Bricks,
+    /// Pairs within cutoff + skin are listed.
+    pub cutoff: f64,
+    pub skin: f64,
+    /// Rebuild at least every this many evaluations (0: on displacement).
+    pub every: u64,
+    halo: Halo,
+    stages: Vec<Stage>,
+    since_build: u64,
+    /// The builds so far (the run summary's count).
+    pub builds: u64,
+    /// The particles this rank has sent to another so far.
+    pub migrated: u64,
+    /// The species names of the undivided system; a particle carries its
+    /// species as an index into them.
+    species: Vec<String>,
+}
+
+/// The numbers a migrating particle carries, [`pack`]'s layout.
+const CARRIED: usize = 25;
+
+impl Domain {
+    /// This rank's part of a run over `boundary` on `comm`'s ranks, for
+    /// pair lists of `cutoff` + `skin`; `grid` forces the bricks.
+    pub fn new(
+        comm: Arc<dyn Comm>,
+        boundary: &Boundary,
+        cutoff: f64,
+        skin: f64,
+        grid: Option<[usize; 3]>,
+    ) -> Result<Self, String> {
+        let dims = Bricks::choose(comm.size(), boundary, cutoff + skin, grid)?;
+        let bricks = Bricks::new(dims, comm.rank(), boundary);
+        Ok(Self {
+            comm,
+            bricks,
+            cutoff,
+            skin,
+            every: 0,
+            halo: Halo::default(),
+            stages: Vec::new(),
+            since_build: 0,
+            builds: 0,
+            migrated: 0,
+            species: Vec::new(),
+        })
+    }
+
+    pub fn comm(&self) -> &dyn Comm {
+        &*self.comm
+    }
+
+    /// The particles and ghosts as of the last build and evaluation.
+    pub fn halo(&self) -> &Halo {
+        &self.halo
+    }
+
+    /// This rank's particles of the undivided system `whole` (which every
+    /// rank holds at the start): those its brick holds, in id order.
+    pub fn scatter(&mut self, whole: &System) -> System {
+        self.species = distinct(&whole.species);
+        let b = &whole.boundary;
+        let mine: Vec<usize> = (0..whole.particles.len())
+            .filter(|&i| self.bricks.owner(b.wrap(whole.particles.position[i])) == self.comm.rank())
+            .collect();
+        let mut part = System {
+            particles: Default::default(),
+            carried_acceleration: Vec::new(),
+            carried_angular_acceleration: Vec::new(),
+            species: Vec::new(),
+            ..whole.clone()
+        };
+        self.halo = Halo::default();
+        for &i in &mine {
+            let row = pack(whole, i, i as u64, &self.species);
+            self.halo.id.push(unpack(&mut part, &row, &self.species));
+        }
+        part
+    }
+
+    /// The undivided system at rank 0, particles in id order (`None` on
+    /// the other ranks): what output and checkpoints write.
+    pub fn gather(&self, part: &System) -> Option<System> {
+        let rows: Vec<f64> = (0..part.particles.len())
+            .flat_map(|i| pack(part, i, self.halo.id[i], &self.species))
+            .collect();
+        let all = self.comm.gather(&rows);
+        if self.comm.rank() != 0 {
+            return None;
+        }
+        let mut rows: Vec<&[f64]> = all.iter().flat_map(|v| v.chunks(CARRIED)).collect();
+        rows.sort_by_key(|r| r[0] as u64);
+        let mut whole = System {
+            particles: Default::default(),
+            carried_acceleration: Vec::new(),
+            carried_angular_acceleration: Vec::new(),
+            species: Vec::new(),
+            ..part.clone()
+        };
+        for r in rows {
+            unpack(&mut whole, r, &self.species);
+        }
+        Some(whole)
+    }
+
+    /// Readies the halo for a force evaluation at the system's positions,
+    /// counting one evaluation: the rank's particles' displacements since
+    /// the build, and a rebuild when the largest over all ranks exceeds
+    /// half the skin, a rebuild is due, or none was made (the one-process
+    /// rule of [`GhostList`](crate::neighbor::GhostList)); else the
+    /// displacements forwarded to the ghosts. Returns whether it rebuilt.
+    pub fn prepare(&mut self, sys: &mut System) -> bool {
+        self.since_build += 1;
+        let due = self.every > 0 && self.since_build >= self.every;
+        let farthest = self.displace(&sys.particles.position, &sys.boundary);
+        let farthest = self.comm.max(farthest);
+        if self.builds == 0 || due || farthest > 0.25 * self.skin * self.skin {
+            self.build(sys);
+            return true;
+        }
+        self.forward();
+        false
+    }
+
+    /// Brings the ghosts to positions `position` of this rank's particles
+    /// without counting an evaluation or rebuilding (measurements between
+    /// steps, at the positions of the last evaluation).
+    pub fn refresh(&mut self, position: &[DVec3], boundary: &Boundary) {
+        if self.builds > 0 {
+            self.displace(position, boundary);
+            self.forward();
+        }
+    }
+
+    /// Sets this rank's displacements; returns the largest |d|².
+    fn displace(&mut self, position: &[DVec3], boundary: &Boundary) -> f64 {
+        let h = &mut self.halo;
+        if h.reference.len() != position.len() {
+            return f64::INFINITY;
+        }
+        h.displacement.truncate(position.len());
+        let mut farthest = 0.0f64;
+        for (i, d) in h.displacement.iter_mut().enumerate() {
+            *d = boundary.minimum_image(position[i] - h.reference[i]);
+            farthest = farthest.max(d.length_squared());
+        }
+        farthest
+    }
+
+    /// Forwards the displacements along the build's six messages.
+    fn forward(&mut self) {
+        let h = &mut self.halo;
+        for stage in &self.stages {
+            let out: Vec<f64> = stage
+                .send
+                .iter()
+                .flat_map(|&s| h.displacement[s as usize].to_array())
+                .collect();
+            let got = self.comm.exchange(stage.to, &out, stage.from);
+            h.displacement.extend(got.chunks(3).map(DVec3::from_slice));
+        }
+    }
+
+    /// Migrates the particles that left the brick, then sends the ghosts.
+    fn build(&mut self, sys: &mut System) {
+        for k in 0..3 {
+            self.migrate(sys, k);
+        }
+        let b = sys.boundary;
+        let h = &mut self.halo;
+        h.reference = sys.particles.position.iter().map(|r| b.wrap(*r)).collect();
+        h.displacement = vec![DVec3::ZERO; h.reference.len()];
+        h.ghosts.clear();
+        h.total = self.comm.sum(&[h.id.len() as f64])[0] as usize;
+        let lo = h.reference.iter().fold(DVec3::INFINITY, |a, r| a.min(*r));
+        let hi = h
+            .reference
+            .iter()
+            .fold(DVec3::NEG_INFINITY, |a, r| a.max(*r));
+        let lo = -DVec3::from_array(self.comm_max3(-lo));
+        let hi = DVec3::from_array(self.comm_max3(hi));
+        self.halo.extent = (lo, hi);
+        self.send_ghosts(&b);
+        self.since_build = 0;
+        self.builds += 1;
+        self.halo.generation += 1;
+    }
+
+    fn comm_max3(&self, v: DVec3) -> [f64; 3] {
+        [self.comm.max(v.x), self.comm.max(v.y), self.comm.max(v.z)]
+    }
+
+    /// Sends along axis k the particles whose brick index along k is no
+    /// longer this rank's, to the face neighbour on their side (a particle
+    /// moves less than a brick between builds), and takes in the others'.
+    fn migrate(&mut self, sys: &mut System, k: usize) {
+        if self.bricks.dims[k] == 1 {
+            return;
+        }
+        let (b, at, p) = (sys.boundary, self.bricks.at[k], self.bricks.dims[k]);
+        let mut going = [Vec::new(), Vec::new()];
+        let mut stay = Vec::new();
+        for i in 0..sys.particles.len() {
+            let c = self.bricks.index(k, b.wrap(sys.particles.position[i])[k]);
+            if c == at {
+                stay.push(i);
+            } else {
+                // Below or above, the shorter way round a periodic axis.
+                let down = (at + p - c) % p;
+                let up = (c + p - at) % p;
+                let side = if b.periodic[k] {
+                    usize::from(up <= down)
+                } else {
+                    usize::from(c > at)
+                };
+                going[side].extend(pack(sys, i, self.halo.id[i], &self.species));
+                self.migrated += 1;
+            }
+        }
+        let ids = std::mem::take(&mut self.halo.id);
+        let mut kept = System {
+            particles: Default::default(),
+            carried_acceleration: Vec::new(),
+            carried_angular_acceleration: Vec::new(),
+            species: Vec::new(),
+            ..sys.clone()
+        };
+        for &i in &stay {
+            let row = pack(sys, i, ids[i], &self.species);
+            self.halo.id.push(unpack(&mut kept, &row, &self.species));
+        }
+        for (side, out) in going.iter().enumerate() {
+            let to = self.bricks.neighbour(k, side == 1).map(|n| n.0);
+            let from = self.bricks.neighbour(k, side == 0).map(|n| n.0);
+            let got = self.comm.exchange(to, out, from);
+            for row in got.chunks(CARRIED) {
+                self.halo.id.push(unpack(&mut kept, row, &self.species));
+            }
+        }
+        *sys = kept;
+    }
+
+    /// The staged ghost exchange at a build (see the module's text).
+    fn send_ghosts(&mut self, boundary: &Boundary) {
+        let reach = self.cutoff + self.skin;
+        let l = boundary.lengths();
+        self.stages.clear();
+        let h = &mut self.halo;
+        let n = h.reference.len();
+        for k in 0..3 {
+            // The copies at the start of the stage: a stage forwards what
+            // the earlier axes brought, not its own.
+            let count = n + h.ghosts.len();
+            let place = |s: usize, h: &Halo| {
+                if s < n {
+                    (h.id[s], [0; 3], h.reference[s])
+                } else {
+                    let g = h.ghosts[s - n];
+                    (g.id, g.image, g.base)
+                }
+            };
+            let (lower, upper) = self.bricks.faces(k);
+            // A little beyond the reach: a copy too many is never in a row,
+            // one too few would be a missing pair. (An axis without a
+            // length has no neighbours.)
+            let slack = 1e-9 * (reach + if l[k].is_finite() { l[k] } else { 0.0 });
+            for up in [false, true] {
+                let neighbour = self.bricks.neighbour(k, up);
+                let from = self.bricks.neighbour(k, !up).map(|n| n.0);
+                let mut send = Vec::new();
+                let mut out = Vec::new();
+                if let Some((_, image)) = neighbour {
+                    for s in 0..count {
+                        let (id, mut m, mut at) = place(s, h);
+                        let near = if up {
+                            at[k] >= upper - reach - slack
+                        } else {
+                            at[k] < lower + reach + slack
+                        };
+                        if !near {
+                            continue;
+                        }
+                        m[k] += image;
+                        at[k] += image as f64 * l[k];
+                        send.push(s as u32);
+                        out.extend([id as f64, m[0] as f64, m[1] as f64, m[2] as f64]);
+                        out.extend(at.to_array());
+                    }
+                }
+                let got = self.comm.exchange(neighbour.map(|n| n.0), &out, from);
+                for g in got.chunks(7) {
+                    h.ghosts.push(Ghost {
+                        id: g[0] as u64,
+                        image: [g[1] as i32, g[2] as i32, g[3] as i32],
+                        base: DVec3::new(g[4], g[5], g[6]),
+                    });
+                    h.displacement.push(DVec3::ZERO);
+                }
+                self.stages.push(Stage {
+                    to: neighbour.map(|n| n.0),
+                    from,
+                    send,
+                });
+            }
+        }
+    }
+}
+
+/// The distinct names in `names`, in order of first appearance.
+fn distinct(names: &[String]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for n in names {
+        if !out.contains(n) {
+            out.push(n.clone());
+        }
+    }
+    out
+}
+
+/// Particle i of `sys` as [`CARRIED`] numbers: id, species, x, v, mass,
+/// charge, radius, colour, mobility, ω, inertia, dipole moment.
+fn pack(sys: &System, i: usize, id: u64, species: &[String]) -> [f64; CARRIED] {
+    let p = &sys.particles;
+    let kind = sys
+        .species
+        .get(i)
+        .and_then(|s| species.iter().position(|n| n == s))
+        .map_or(-1.0, |k| k as f64);
+    let mut row = [0.0; CARRIED];
+    row[0] = id as f64;
+    row[1] = kind;
+    row[2..5].copy_from_slice(&p.position[i].to_array());
+    row[5..8].copy_from_slice(&p.velocity[i].to_array());
+    row[8] = p.mass[i];
+    row[9] = p.charge[i];
+    row[10] = p.radius[i];
+    row[11..14].copy_from_slice(&p.color[i]);
+    row[14..17].copy_from_slice(&p.mobility[i].to_array());
+    row[17..20].copy_from_slice(&p.angular_velocity[i].to_array());
+    row[20] = p.inertia[i];
+    row[21..24].copy_from_slice(&p.dipole[i].to_array());
+    row[24] = 0.0;
+    row
+}
+
+/// Appends the particle [`pack`] wrote to `sys`; returns its id.
+fn unpack(sys: &mut System, row: &[f64], species: &[String]) -> u64 {
+    let p = &mut sys.particles;
+    p.position.push(DVec3::from_slice(&row[2..5]));
+    p.velocity.push(DVec3::from_slice(&row[5..8]));
+    p.mass.push(row[8]);
+    p.charge.push(row[9]);
+    p.radius.push(row[10]);
+    p.color.push([row[11], row[12], row[13]]);
+    p.mobility.push(DVec3::from_slice(&row[14..17]));
+    p.angular_velocity.push(DVec3::from_slice(&row[17..20]));
+    p.inertia.push(row[20]);
+    p.dipole.push(DVec3::from_slice(&row[21..24]));
+    if row[1] >= 0.0 {
+        sys.species.push(species[row[1] as usize].clone());
+    }
+    row[0] as u64
+}

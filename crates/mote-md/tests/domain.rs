@@ -1,0 +1,120 @@
+//! Domain decomposition: a Lennard-Jones liquid stepped on 2, 3, 4 and 6
+//! ranks (threads of one process, `mote_run::comm::in_process`, which run
+//! the very code `mpirun` runs) gives the same bits as one process.
+
+use std::sync::Arc;
+
+use mote_md::domain::Domain;
+use mote_md::force::LennardJones;
+use mote_md::init::fcc;
+use mote_md::particles::ParticleInit;
+use mote_md::{DVec3, ForceField, Integrator, Observables, Particles, Simulation, Stepper, System};
+use mote_run::comm::{in_process, Comm};
+use mote_run::Propagator;
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+const CUTOFF: f64 = 2.5;
+const SKIN: f64 = 0.3;
+const STEPS: usize = 300;
+
+/// A hot fcc crystal in a box 8 × 6 × 5 cells (960 atoms, ρ = 0.8442,
+/// kT = 3: it melts, so particles cross bricks and the list is rebuilt
+/// many times).
+fn crystal() -> System {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+    let (atoms, boundary) = fcc(
+        [8, 6, 5],
+        0.8442,
+        DVec3::ZERO,
+        3.0,
+        &ParticleInit::default(),
+        &mut rng,
+    );
+    let mut particles = Particles::default();
+    for a in atoms {
+        particles.push(a);
+    }
+    let mut sys = System::new(particles);
+    sys.boundary = boundary;
+    sys
+}
+
+fn simulation(system: System, domain: Option<Domain>) -> Simulation {
+    let mut forces = ForceField::new().with(LennardJones::new(1.0, 1.0, CUTOFF, true, SKIN));
+    forces.domain = domain;
+    Simulation::new(system, forces, Stepper::new(Integrator::LeapFrog), 0.005, 1)
+}
+
+/// Steps `sim` STEPS times; returns the observables at the start and end.
+fn run(sim: &mut Simulation) -> (Observables, Observables) {
+    sim.prime(&mut |_| {}).unwrap();
+    let first = sim.measure();
+    for _ in 0..STEPS {
+        sim.advance().unwrap();
+    }
+    (first, sim.measure())
+}
+
+/// What one rank of a decomposed run ends with: the whole system (at rank
+/// 0), the observables, and the list builds.
+fn decomposed(
+    comm: Arc<dyn Comm>,
+    grid: Option<[usize; 3]>,
+) -> (Option<System>, Observables, Observables, u64) {
+    let whole = crystal();
+    let mut domain = Domain::new(comm, &whole.boundary, CUTOFF, SKIN, grid).unwrap();
+    let part = domain.scatter(&whole);
+    let mut sim = simulation(part, Some(domain));
+    let (first, last) = run(&mut sim);
+    let domain = sim.forces.domain.as_ref().unwrap();
+    let migrated = domain.comm().sum(&[domain.migrated as f64])[0];
+    assert!(migrated > 0.0, "no particle changed brick");
+    (domain.gather(&sim.system), first, last, domain.builds)
+}
+
+#[test]
+fn a_decomposed_liquid_steps_as_one_process_does() {
+    let mut one = simulation(crystal(), None);
+    let (first, last) = run(&mut one);
+    let p = &one.system.particles;
+    let mut builds = None;
+    for (ranks, grid) in [
+        (2, None),
+        (3, None),
+        (4, None),
+        (4, Some([1, 2, 2])),
+        (6, None),
+    ] {
+        let out = in_process(ranks, |comm| decomposed(comm, grid));
+        let (whole, f, l, b) = &out[0];
+        let whole = whole.as_ref().expect("rank 0 gathers");
+        let q = &whole.particles;
+        assert_eq!(q.len(), p.len(), "{ranks} ranks, grid {grid:?}");
+        // The same bits, particle by particle.
+        assert_eq!(q.position, p.position, "{ranks} ranks, grid {grid:?}");
+        assert_eq!(q.velocity, p.velocity, "{ranks} ranks, grid {grid:?}");
+        assert_eq!(
+            *b,
+            *builds.get_or_insert(*b),
+            "list builds on {ranks} ranks"
+        );
+        // Sums over the ranks: the same to round-off.
+        for (a, e) in [(f, &first), (l, &last)] {
+            assert!((a.potential - e.potential).abs() < 1e-11 * e.potential.abs());
+            assert!((a.kinetic - e.kinetic).abs() < 1e-11 * e.kinetic);
+            assert!((a.pressure - e.pressure).abs() < 1e-11 * e.pressure.abs());
+            assert!((a.momentum - e.momentum).length() < 1e-10);
+            assert_eq!(a.kt.to_bits() != 0, e.kt.to_bits() != 0);
+        }
+        // Every rank agrees on the sums, to the bit (NaN pressures too).
+        for (_, f2, l2, _) in &out[1..] {
+            assert_eq!(format!("{f2:?}"), format!("{f:?}"));
+            assert_eq!(format!("{l2:?}"), format!("{l:?}"));
+        }
+    }
+    // The run did what the test needs: the liquid moved through many
+    // builds.
+    let builds = builds.unwrap();
+    assert!(builds > 10, "{builds} builds");
+}
