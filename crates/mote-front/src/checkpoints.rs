@@ -116,6 +116,7 @@ pub(crate) fn restore(
         threads: given.threads,
         force: given.force,
         live: given.live.clone(),
+        ranks: given.ranks.clone(),
     };
     Ok((input, options))
 }

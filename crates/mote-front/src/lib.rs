@@ -67,6 +67,25 @@ pub struct RunOptions {
     /// The live viewer's tap (`mote view SCENE`): sees every step, hands
     /// back changes, may pause the run.
     pub live: mote_run::LiveSlot,
+    /// The ranks of a run `mpirun` started on several (None: one process).
+    pub ranks: Option<Ranks>,
+}
+
+/// The ranks of a decomposed run, seen from one of them.
+#[derive(Clone)]
+pub struct Ranks(pub std::sync::Arc<dyn mote_run::comm::Comm>);
+
+impl Ranks {
+    /// Whether this is rank 0, which writes the files and prints.
+    pub fn is_root(&self) -> bool {
+        self.0.rank() == 0
+    }
+}
+
+impl std::fmt::Debug for Ranks {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "rank {} of {}", self.0.rank(), self.0.size())
+    }
 }
 
 impl RunOptions {
@@ -206,6 +225,7 @@ pub struct Outcome {
 
 /// Runs what `options` describe with the engine its scene asks for.
 pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, FrontError> {
+    check_ranks(options, None)?;
     if let Some(path) = &options.resume {
         // Checkpoints name their engine (point particles' older ones do not).
         let cp = mote_io::checkpoint::read(path)?;
@@ -236,6 +256,38 @@ pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, F
     run_input(&input, options, monitor)
 }
 
+/// Refuses on several ranks what does not run decomposed yet: resuming,
+/// checkpoints, the live viewer, and every engine but point particles.
+fn check_ranks(options: &RunOptions, engine: Option<Engine>) -> Result<(), FrontError> {
+    let Some(ranks) = options.ranks.as_ref().filter(|r| r.0.size() > 1) else {
+        return Ok(());
+    };
+    let input = options.input.as_deref().unwrap_or("the run");
+    let n = ranks.0.size();
+    let why = if options.resume.is_some() {
+        Some("--resume (checkpoints of a decomposed run come next)".to_string())
+    } else if options.checkpoint_every.is_some() {
+        Some("--checkpoint-every (checkpoints of a decomposed run come next)".to_string())
+    } else if options.live.is_set() {
+        Some("the live viewer".to_string())
+    } else {
+        match engine {
+            Some(Engine::Rigid) => Some("a scene of rigid clumps ([rigid])".to_string()),
+            Some(Engine::EventDriven) => Some(
+                "an event-driven scene (docs/parallel.md says how it would decompose)".to_string(),
+            ),
+            Some(Engine::Packing) => Some("a packing".to_string()),
+            _ => None,
+        }
+    };
+    match why {
+        Some(what) => {
+            error::refuse!("{input}: {what} does not run on {n} ranks yet: run it on one")
+        }
+        None => Ok(()),
+    }
+}
+
 /// Runs an input already read (a scene text from Python, say).
 pub fn run_input(
     input: &Input,
@@ -243,7 +295,9 @@ pub fn run_input(
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
     options.check_values()?;
-    let result = match input.engine()? {
+    let engine = input.engine()?;
+    check_ranks(options, Some(engine))?;
+    let result = match engine {
         Engine::Particles => particles::run(Some(input.clone()), options, monitor),
         Engine::Rigid => rigid::run(input, options, monitor),
         Engine::EventDriven => event_driven::run(input, options, monitor),
@@ -267,8 +321,6 @@ pub fn check_simd_request() -> Result<(), FrontError> {
         .map_err(FrontError::Request)
 }
 
-/// "1 thread, AVX-512" / "2 threads, AVX2 + FMA (portable kernels)": the
-/// threads and the SIMD level the kernels run at (`MOTE_SIMD` forces one).
 /// What a run's summary says when a periodic box has no pressure column:
 /// the interactions `without` a virial, named.
 fn no_pressure_column<S: AsRef<str>>(without: &[S]) -> String {
@@ -285,6 +337,8 @@ fn no_pressure_column<S: AsRef<str>>(without: &[S]) -> String {
     )
 }
 
+/// "1 thread, AVX-512" / "2 threads, AVX2 + FMA (portable kernels)": the
+/// threads and the SIMD level the kernels run at (`MOTE_SIMD` forces one).
 fn threads_phrase() -> String {
     let n = rayon::current_num_threads();
     format!(

@@ -188,6 +188,16 @@ impl EngineRun for PointsRun {
         if let Some(cp) = resumed {
             resume_state(cp, &mut sim, label)?;
         }
+        if let Some(ranks) = args.ranks.as_ref().filter(|r| r.0.size() > 1) {
+            if !built.probes.is_empty() {
+                refuse!(
+                    "{label}: the particle inspector ([output] inspect) does not run on {} ranks yet: run it on one",
+                    ranks.0.size()
+                );
+            }
+            sim.decompose(ranks.0.clone(), None)
+                .map_err(|m| FrontError::request(format!("{label}: {m}: run it on one")))?;
+        }
         let done = resumed.map_or(0, |cp| cp.step.min(self.total_steps));
         self.last_step = sim.system.step + (self.total_steps - done);
         self.probes = built.probes;
@@ -199,7 +209,7 @@ impl EngineRun for PointsRun {
             dir,
             &self.scene.output,
             self.total_steps,
-            sim.system.particles.len(),
+            sim.particle_count(),
         )
         .map_err(|m| FrontError::request(format!("{}: {m}", self.input.label)))
     }
@@ -210,6 +220,11 @@ impl EngineRun for PointsRun {
         files: &RunFiles,
     ) -> Result<Vec<Box<dyn Observer<Simulation>>>, FrontError> {
         table_observers(&self.scene, sim, &self.probes, files)
+    }
+
+    fn table_every(&self) -> Vec<u64> {
+        let every = self.scene.output.observables_every();
+        (every > 0).then_some(every).into_iter().collect()
     }
 
     fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError> {
@@ -244,9 +259,13 @@ impl EngineRun for PointsRun {
         } else {
             sim.stepper.scheme.name().to_string()
         };
+        let ranks = sim.forces.domain.as_ref().map_or(String::new(), |d| {
+            let [x, y, z] = d.bricks.dims;
+            format!(", on {} ranks ({x} × {y} × {z} bricks)", d.comm().size())
+        });
         format!(
-            "{} particles, {} with dt = {}, {} steps",
-            sim.system.particles.len(),
+            "{} particles, {} with dt = {}, {} steps{ranks}",
+            sim.particle_count(),
             propagator,
             mote_io::system::human_number(sim.dt),
             self.last_step - sim.system.step,

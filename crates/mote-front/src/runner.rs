@@ -15,7 +15,7 @@ use mote_io::Provenance;
 use mote_run::{Driver, Observer, Propagator, Report};
 
 use crate::checkpoints::trim_outputs;
-use crate::error::FrontError;
+use crate::error::{self, FrontError};
 use crate::{Ending, Engine, Input, Monitor, Outcome, RunOptions};
 
 /// Where a run writes its files.
@@ -71,6 +71,11 @@ pub(crate) trait EngineRun {
         state: &Self::State,
         files: &RunFiles,
     ) -> Result<Vec<Box<dyn Observer<Self::State>>>, FrontError>;
+    /// The steps between the samples of each table [`EngineRun::observers`]
+    /// writes: what the other ranks of a decomposed run follow.
+    fn table_every(&self) -> Vec<u64> {
+        Vec::new()
+    }
     /// The trajectory's file name in the run folder, its format and the
     /// steps between frames; `None` writes none.
     fn trajectory(&self) -> Result<Option<(String, Format, u64)>, FrontError>;
@@ -148,6 +153,44 @@ pub(crate) fn trajectory_observer(
     )?)
 }
 
+/// The observers of an engine's run (its tables and trajectory).
+type Observers<E> = Vec<Box<dyn Observer<<E as EngineRun>::State>>>;
+
+/// Claims the run's folder (checked against the disk first, trimmed back
+/// to a resumed checkpoint) and opens its tables and trajectory.
+fn take_folder<E: EngineRun>(
+    engine: &E,
+    state: &E::State,
+    input: &Input,
+    options: &RunOptions,
+    resumed: Option<&Checkpoint>,
+    files: &RunFiles,
+    trajectory: &Option<(String, Format, u64)>,
+) -> Result<(Option<crate::lock::RunFolder>, Observers<E>), FrontError> {
+    if resumed.is_none() && !options.force {
+        engine.check_folder(state, &files.dir)?;
+    }
+    let folder = if engine.writes_files() || options.checkpoint_every.is_some() || resumed.is_some()
+    {
+        Some(crate::lock::RunFolder::claim(
+            &files.dir,
+            &input.label,
+            &input.text,
+            resumed.zip(options.resume.as_deref()),
+        )?)
+    } else {
+        None
+    };
+    if let Some(cp) = resumed {
+        trim_outputs(&files.dir, cp.step, cp.time)?;
+    }
+    let mut observers = engine.observers(state, files)?;
+    if let Some(spec) = trajectory {
+        observers.push(Box::new(trajectory_observer(spec, files)?));
+    }
+    Ok((folder, observers))
+}
+
 /// Runs `engine`'s scene, or continues it from `resumed`.
 pub(crate) fn run_engine<E: EngineRun>(
     mut engine: E,
@@ -160,38 +203,58 @@ pub(crate) fn run_engine<E: EngineRun>(
     let chosen = chosen || engine.seed_chosen();
     let dir = input.output_dir(options.output.as_ref(), engine.scene_dir());
     let mut state = engine.build(seed, resumed)?;
-    if resumed.is_none() && !options.force {
-        engine.check_folder(&state, &dir)?;
-    }
-    let folder = if engine.writes_files() || options.checkpoint_every.is_some() || resumed.is_some()
-    {
-        Some(crate::lock::RunFolder::claim(
-            &dir,
-            &input.label,
-            &input.text,
-            resumed.zip(options.resume.as_deref()),
-        )?)
-    } else {
-        None
-    };
+    // On several ranks rank 0 alone takes the folder and writes; the
+    // others follow its observers' schedule (their measurements and
+    // frames are collective) and write nothing.
+    let ranks = options.ranks.as_ref().filter(|r| r.0.size() > 1);
+    let root = ranks.is_none_or(|r| r.is_root());
     let files = RunFiles {
         dir,
         provenance: crate::provenance(&input.label, seed),
         append: resumed.is_some(),
     };
-    if let Some(cp) = resumed {
-        trim_outputs(&files.dir, cp.step, cp.time)?;
-    }
     let trajectory = engine.trajectory()?;
     let mut driver = Driver::new();
     driver.sample_at_start = !files.append;
     driver.live = options.live.clone().take();
-    driver.observers = engine.observers(&state, &files)?;
-    if let Some(spec) = &trajectory {
-        driver
-            .observers
-            .push(Box::new(trajectory_observer(spec, &files)?));
-    }
+    let folder = if root {
+        let setup = take_folder(
+            &engine,
+            &state,
+            input,
+            options,
+            resumed,
+            &files,
+            &trajectory,
+        );
+        if let Some(r) = ranks {
+            // Every rank learns whether rank 0 could start, so none waits
+            // for it in a measurement it never takes.
+            r.0.max(if setup.is_ok() { 0.0 } else { 1.0 });
+        }
+        let (folder, observers) = setup?;
+        driver.observers = observers;
+        folder
+    } else {
+        let failed = ranks.is_some_and(|r| r.0.max(0.0) > 0.0);
+        if failed {
+            error::refuse!("rank 0 could not start the run (its message says why)");
+        }
+        driver.observers = engine
+            .table_every()
+            .into_iter()
+            .map(|every| mote_run::Follower {
+                every,
+                frames: false,
+            })
+            .chain(trajectory.iter().map(|t| mote_run::Follower {
+                every: t.2,
+                frames: true,
+            }))
+            .map(|f| Box::new(f) as Box<dyn Observer<E::State>>)
+            .collect();
+        None
+    };
     if let Some(every) = options.checkpoint_every {
         let format = trajectory.as_ref().map_or(Format::Xyz, |t| t.1);
         let options = [

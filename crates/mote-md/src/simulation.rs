@@ -78,6 +78,53 @@ impl Simulation {
         mote_run::Driver::new().run(self, |_| last, |s| progress(&s.system))
     }
 
+    /// Splits the run over `comm`'s ranks by spatial domain decomposition
+    /// ([`crate::domain`]): this rank keeps the particles of its brick (of
+    /// `grid` bricks, or the grid chosen from the box's shape). Refuses,
+    /// naming it, what does not run decomposed yet.
+    pub fn decompose(
+        &mut self,
+        comm: std::sync::Arc<dyn mote_run::comm::Comm>,
+        grid: Option<[usize; 3]>,
+    ) -> Result<(), String> {
+        let ranks = comm.size();
+        let not_yet = |what: &str| Err(format!("{what} does not run on {ranks} ranks yet"));
+        if self.brownian.is_some() {
+            return not_yet("Brownian dynamics");
+        }
+        if self.thermostat.is_some() {
+            return not_yet("a thermostat");
+        }
+        if self.stepper.scheme != crate::Integrator::LeapFrog {
+            return not_yet(&format!(
+                "the {} integrator (leap-frog does)",
+                self.stepper.scheme.name()
+            ));
+        }
+        let reach = match self.forces.halo_reach() {
+            Ok(reach) => reach,
+            Err(names) => {
+                return not_yet(&format!(
+                    "{} (Lennard-Jones/WCA, uniform fields and damping do)",
+                    names.join(", ")
+                ))
+            }
+        };
+        let mut domain = crate::domain::Domain::new(comm, &self.system.boundary, reach, grid)?;
+        self.system = domain.scatter(&self.system);
+        self.forces.domain = Some(domain);
+        Ok(())
+    }
+
+    /// The number of particles of the run, on every rank of a decomposed
+    /// one.
+    pub fn particle_count(&self) -> usize {
+        self.forces
+            .domain
+            .as_ref()
+            .map_or(self.system.particles.len(), |d| d.total())
+    }
+
     /// max |E(t) − E(0)| / |E(0)| over the instants measured in the
     /// current run (|E(t) − E(0)| when E(0) = 0).
     pub fn max_energy_error(&self) -> f64 {
@@ -140,11 +187,35 @@ impl mote_run::Propagator for Simulation {
         Ok(())
     }
 
+    /// In a decomposed run, the particle of least id among those found on
+    /// every rank (its id: its index in the undivided system).
     fn unstable(&self) -> Option<(usize, String)> {
         let p = &self.system.particles;
-        let (column, i) = first_non_finite(&[&p.position, &p.velocity])?;
-        let what = ["a non-finite position", "a non-finite velocity"][column];
-        Some((i, format!("{what} ({} / {})", p.position[i], p.velocity[i])))
+        let found = first_non_finite(&[&p.position, &p.velocity]).map(|(column, i)| {
+            let what = ["a non-finite position", "a non-finite velocity"][column];
+            (i, format!("{what} ({} / {})", p.position[i], p.velocity[i]))
+        });
+        let Some(domain) = &self.forces.domain else {
+            return found;
+        };
+        let found = found.map(|(i, what)| (domain.halo().id[i] as usize, what));
+        let least = -domain
+            .comm()
+            .max(found.as_ref().map_or(f64::NEG_INFINITY, |f| -(f.0 as f64)));
+        if least == f64::INFINITY {
+            return None;
+        }
+        let id = least as usize;
+        Some(found.filter(|f| f.0 == id).unwrap_or_else(|| {
+            (
+                id,
+                "a non-finite position or velocity (on another rank)".into(),
+            )
+        }))
+    }
+
+    fn most(&self, x: f64) -> f64 {
+        self.forces.domain.as_ref().map_or(x, |d| d.comm().max(x))
     }
 
     fn measure(&mut self) -> Observables {
@@ -160,14 +231,26 @@ impl mote_run::Propagator for Simulation {
         obs
     }
 
+    /// In a decomposed run, the whole system gathered at rank 0 in id
+    /// order (`None` on the other ranks, which must call it alike).
     fn frame(&self) -> Option<mote_io::xyz::Frame> {
-        Some(crate::output::frame_of(&self.system))
+        match &self.forces.domain {
+            Some(domain) => domain
+                .gather(&self.system)
+                .map(|whole| crate::output::frame_of(&whole)),
+            None => Some(crate::output::frame_of(&self.system)),
+        }
     }
 
     /// F = m a from the accelerations leap-frog carries (the integrators
     /// that carry none give none).
     fn forces(&self) -> Vec<[f64; 3]> {
         let sys = &self.system;
+        if self.forces.domain.is_some() {
+            // A rank's own, not the frame's (the live viewer, which reads
+            // them, does not run decomposed).
+            return Vec::new();
+        }
         sys.carried_acceleration
             .iter()
             .zip(&sys.particles.mass)

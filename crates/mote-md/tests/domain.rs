@@ -4,7 +4,6 @@
 
 use std::sync::Arc;
 
-use mote_md::domain::Domain;
 use mote_md::force::LennardJones;
 use mote_md::init::fcc;
 use mote_md::particles::ParticleInit;
@@ -40,9 +39,8 @@ fn crystal() -> System {
     sys
 }
 
-fn simulation(system: System, domain: Option<Domain>) -> Simulation {
-    let mut forces = ForceField::new().with(LennardJones::new(1.0, 1.0, CUTOFF, true, SKIN));
-    forces.domain = domain;
+fn simulation(system: System) -> Simulation {
+    let forces = ForceField::new().with(LennardJones::new(1.0, 1.0, CUTOFF, true, SKIN));
     Simulation::new(system, forces, Stepper::new(Integrator::LeapFrog), 0.005, 1)
 }
 
@@ -63,9 +61,8 @@ fn decomposed(
     grid: Option<[usize; 3]>,
 ) -> (Option<System>, Observables, Observables, u64) {
     let whole = crystal();
-    let mut domain = Domain::new(comm, &whole.boundary, CUTOFF, SKIN, grid).unwrap();
-    let part = domain.scatter(&whole);
-    let mut sim = simulation(part, Some(domain));
+    let mut sim = simulation(whole);
+    sim.decompose(comm, grid).unwrap();
     let (first, last) = run(&mut sim);
     let domain = sim.forces.domain.as_ref().unwrap();
     let migrated = domain.comm().sum(&[domain.migrated as f64])[0];
@@ -75,7 +72,7 @@ fn decomposed(
 
 #[test]
 fn a_decomposed_liquid_steps_as_one_process_does() {
-    let mut one = simulation(crystal(), None);
+    let mut one = simulation(crystal());
     let (first, last) = run(&mut one);
     let p = &one.system.particles;
     let mut builds = None;

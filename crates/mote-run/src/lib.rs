@@ -98,8 +98,15 @@ pub trait Propagator {
         false
     }
     /// The first particle (index, what is wrong) whose state is not a
-    /// finite number, if any.
+    /// finite number, if any (on any rank of a decomposed run: every rank
+    /// answers alike).
     fn unstable(&self) -> Option<(usize, String)>;
+    /// The largest `x` over the ranks of a decomposed run, at every rank;
+    /// `x` itself in one process. The ranks agree through it to stop
+    /// together on a signal only some of them have seen.
+    fn most(&self, x: f64) -> f64 {
+        x
+    }
     /// Measures the observables of now.
     fn measure(&mut self) -> Self::Sample;
     /// Puts the state (time, step, tables, what interactions carry) into a
@@ -158,6 +165,30 @@ pub trait Observer<P: Propagator>: Send {
     /// `# event:` comment line.
     fn event(&mut self, state: &P, text: &str) -> Result<(), P::Error> {
         let _ = (state, text);
+        Ok(())
+    }
+}
+
+/// What the other ranks of a decomposed run do where rank 0's observer
+/// samples and writes: they take part in the measurement (the Driver's)
+/// and, for a trajectory, in gathering the frame, and write nothing.
+#[derive(Debug, Clone, Copy)]
+pub struct Follower {
+    /// The steps between the samples of the observer followed.
+    pub every: u64,
+    /// Whether that observer takes a frame ([`Propagator::frame`]).
+    pub frames: bool,
+}
+
+impl<P: Propagator> Observer<P> for Follower {
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, state: &P, _: &P::Sample) -> Result<(), P::Error> {
+        if self.frames {
+            state.frame();
+        }
         Ok(())
     }
 }
@@ -342,18 +373,18 @@ impl<P: Propagator> Driver<P> {
             };
             progress(state);
             self.tap(state)?;
-            if let Some(signal) = mote_io::system::stop_requested() {
-                if !end {
-                    if let Some(c) = self.checkpoints.as_ref().filter(|_| !saved) {
-                        Self::save(c, state)?;
-                    }
-                    return Err(Stopped::Interrupted {
-                        signal,
-                        step,
-                        time: state.time(),
-                    }
-                    .into());
+            let asked = mote_io::system::stop_requested().unwrap_or(0);
+            let signal = state.most(asked as f64) as i32;
+            if signal != 0 && !end {
+                if let Some(c) = self.checkpoints.as_ref().filter(|_| !saved) {
+                    Self::save(c, state)?;
                 }
+                return Err(Stopped::Interrupted {
+                    signal,
+                    step,
+                    time: state.time(),
+                }
+                .into());
             }
         }
         Ok(last)

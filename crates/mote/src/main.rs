@@ -7,6 +7,8 @@ use clap::{Parser, Subcommand};
 #[macro_use]
 mod out;
 mod cmd;
+#[cfg(feature = "mpi")]
+mod ranks;
 
 /// mote — many-particle simulation toolkit.
 #[derive(Parser, Debug)]

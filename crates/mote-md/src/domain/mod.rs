@@ -28,6 +28,7 @@ use glam::DVec3;
 use mote_run::comm::Comm;
 
 use crate::boundary::Boundary;
+use crate::force::HaloReach;
 use crate::particles::System;
 pub use bricks::Bricks;
 
@@ -101,14 +102,21 @@ const CARRIED: usize = 25;
 
 impl Domain {
     /// This rank's part of a run over `boundary` on `comm`'s ranks, for
-    /// pair lists of `cutoff` + `skin`; `grid` forces the bricks.
+    /// pair lists of `reach` ([`ForceField::halo_reach`]); `grid` forces
+    /// the bricks. A run without pairs rebuilds (migrates) every step.
+    ///
+    /// [`ForceField::halo_reach`]: crate::ForceField::halo_reach
     pub fn new(
         comm: Arc<dyn Comm>,
         boundary: &Boundary,
-        cutoff: f64,
-        skin: f64,
+        reach: HaloReach,
         grid: Option<[usize; 3]>,
     ) -> Result<Self, String> {
+        let (cutoff, skin) = if reach == HaloReach::NONE {
+            (0.0, 0.0)
+        } else {
+            (reach.cutoff, reach.skin)
+        };
         let dims = Bricks::choose(comm.size(), boundary, cutoff + skin, grid)?;
         let bricks = Bricks::new(dims, comm.rank(), boundary);
         Ok(Self {
@@ -116,7 +124,7 @@ impl Domain {
             bricks,
             cutoff,
             skin,
-            every: 0,
+            every: reach.every,
             halo: Halo::default(),
             stages: Vec::new(),
             since_build: 0,
@@ -124,6 +132,11 @@ impl Domain {
             migrated: 0,
             species: Vec::new(),
         })
+    }
+
+    /// The number of particles on all ranks.
+    pub fn total(&self) -> usize {
+        self.halo.total
     }
 
     pub fn comm(&self) -> &dyn Comm {
@@ -150,7 +163,10 @@ impl Domain {
             species: Vec::new(),
             ..whole.clone()
         };
-        self.halo = Halo::default();
+        self.halo = Halo {
+            total: whole.particles.len(),
+            ..Halo::default()
+        };
         for &i in &mine {
             let row = pack(whole, i, i as u64, &self.species);
             self.halo.id.push(unpack(&mut part, &row, &self.species));

@@ -86,6 +86,48 @@ pub struct State<'a> {
     pub halo: Option<&'a Halo>,
 }
 
+/// The pairs an interaction lists over a decomposed run's halo: those
+/// within `cutoff` + `skin`, its list rebuilt when a particle has moved
+/// half the skin or, if `every` > 0, after that many evaluations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HaloReach {
+    pub cutoff: f64,
+    pub skin: f64,
+    pub every: u64,
+}
+
+impl HaloReach {
+    /// A force on each particle alone: no pairs.
+    pub const NONE: HaloReach = HaloReach {
+        cutoff: 0.0,
+        skin: f64::INFINITY,
+        every: 0,
+    };
+
+    /// One halo for both: the widest cut-off and skin together, rebuilt
+    /// when either list must be (the smaller skin, the more frequent
+    /// forced rebuild).
+    pub fn and(self, other: HaloReach) -> HaloReach {
+        if self == Self::NONE {
+            return other;
+        }
+        if other == Self::NONE {
+            return self;
+        }
+        let reach = (self.cutoff + self.skin).max(other.cutoff + other.skin);
+        let skin = self.skin.min(other.skin);
+        let every = match (self.every, other.every) {
+            (0, e) | (e, 0) => e,
+            (a, b) => a.min(b),
+        };
+        HaloReach {
+            cutoff: reach - skin,
+            skin,
+            every,
+        }
+    }
+}
+
 /// The box of a state given without one.
 static OPEN_SPACE: Boundary = Boundary {
     lo: DVec3::NEG_INFINITY,
@@ -189,10 +231,12 @@ pub trait Interaction: Send + Sync {
     fn name(&self) -> &'static str;
     /// Adds this interaction's force on each particle to `force`.
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]);
-    /// Whether it runs decomposed: its forces on a rank's particles come
-    /// from those particles and the ghosts of [`State::halo`] alone.
-    fn decomposes(&self) -> bool {
-        false
+    /// What it needs to run decomposed, where it can: its forces on a
+    /// rank's particles come from those particles and the ghosts of
+    /// [`State::halo`] within the reach it names (none for a force on
+    /// each particle alone). `None`: it cannot run decomposed.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        None
     }
     /// Whether this interaction exerts torques (frictional contacts,
     /// dipoles); then the integrator rotates the particles and calls
@@ -273,6 +317,9 @@ impl Interaction for Box<dyn Interaction> {
     }
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         (**self).add_forces(state, force)
+    }
+    fn halo_reach(&self) -> Option<HaloReach> {
+        (**self).halo_reach()
     }
     fn exerts_torques(&self) -> bool {
         (**self).exerts_torques()
@@ -451,14 +498,23 @@ impl ForceField {
         }
     }
 
-    /// The interactions that cannot run decomposed (a decomposed run
-    /// refuses them).
-    pub fn not_decomposing(&self) -> Vec<&'static str> {
-        self.interactions
-            .iter()
-            .filter(|i| !i.decomposes())
-            .map(|i| i.name())
-            .collect()
+    /// The halo the interactions need to run decomposed: the widest
+    /// reach, the smallest skin, the most frequent forced rebuild; `Err`
+    /// with the names of those that cannot.
+    pub fn halo_reach(&self) -> Result<HaloReach, Vec<&'static str>> {
+        let mut refused = Vec::new();
+        let mut need = HaloReach::NONE;
+        for i in &self.interactions {
+            match i.halo_reach() {
+                Some(r) => need = need.and(r),
+                None => refused.push(i.name()),
+            }
+        }
+        if refused.is_empty() {
+            Ok(need)
+        } else {
+            Err(refused)
+        }
     }
 
     /// The shared neighbour list as of the last evaluation, if any.

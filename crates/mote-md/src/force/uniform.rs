@@ -28,6 +28,11 @@ impl Interaction for UniformField {
         Some(Virial::default())
     }
 
+    /// A force on each particle alone.
+    fn halo_reach(&self) -> Option<super::HaloReach> {
+        Some(super::HaloReach::NONE)
+    }
+
     fn name(&self) -> &'static str {
         "uniform_field"
     }

@@ -50,7 +50,7 @@ impl GlobalOpts {
     /// context switches per loop, thousands per second in a stepped run).
     pub fn threads(&self) -> anyhow::Result<rayon::ThreadPool> {
         let mut builder = rayon::ThreadPoolBuilder::new();
-        if let Some(n) = self.threads {
+        if let Some(n) = self.threads.or_else(threads_per_rank) {
             builder = builder.num_threads(n.max(1));
         }
         builder.build().map_err(|e| {
@@ -58,4 +58,18 @@ impl GlobalOpts {
             anyhow::anyhow!("cannot set up {n} threads: {e}")
         })
     }
+}
+
+/// Under `mpirun` with several ranks on this machine, the cores shared
+/// out among them (OpenMPI's `OMPI_COMM_WORLD_LOCAL_SIZE`, MPICH's
+/// `MPI_LOCALNRANKS`): each rank's threads would otherwise take every core.
+fn threads_per_rank() -> Option<usize> {
+    if !cfg!(feature = "mpi") {
+        return None;
+    }
+    let local: usize = ["OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok()?.parse().ok())?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    (local > 1).then(|| (cores / local).max(1))
 }

@@ -68,15 +68,46 @@ impl RunArgs {
             threads: global.threads,
             force: self.force,
             live: Default::default(),
+            ranks: None,
         }
     }
 }
 
 pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode> {
-    let options = args.options(global);
-    let mut terminal = Terminal::new(global.quiet);
-    let outcome = mote_front::run(&options, &mut terminal)?;
-    Ok(report(&outcome, global.quiet))
+    #[cfg(feature = "mpi")]
+    let mpi = crate::ranks::Mpi::start()?;
+    #[allow(unused_mut)]
+    let mut options = args.options(global);
+    #[cfg(feature = "mpi")]
+    {
+        options.ranks = mpi.ranks.clone().map(mote_front::Ranks);
+    }
+    // Rank 0 of several prints; the others keep quiet and exit alike.
+    let root = options.ranks.as_ref().is_none_or(|r| r.is_root());
+    let mut terminal = Terminal::new(global.quiet || !root);
+    match mote_front::run(&options, &mut terminal) {
+        Ok(outcome) if root => Ok(report(&outcome, global.quiet)),
+        Ok(outcome) => Ok(exit_code(&outcome.ending)),
+        Err(e) if options.ranks.is_none() => Err(e.into()),
+        Err(e) => {
+            if root {
+                tell!("error: {e}");
+                // The others may be waiting for rank 0 mid-run.
+                #[cfg(feature = "mpi")]
+                mpi.abort(1);
+            }
+            Ok(ExitCode::FAILURE)
+        }
+    }
+}
+
+/// The exit status of a run that ended so ([`report`]'s, unprinted).
+fn exit_code(ending: &Ending) -> ExitCode {
+    match ending {
+        Ending::Finished => ExitCode::SUCCESS,
+        Ending::Unstable(_) => ExitCode::from(3),
+        Ending::Interrupted { signal, .. } => ExitCode::from((128 + signal).clamp(0, 255) as u8),
+    }
 }
 
 /// Prints a run's summary (unless quiet) and gives its exit status: 3 for
@@ -90,7 +121,7 @@ pub fn report(outcome: &mote_front::Outcome, quiet: bool) -> ExitCode {
                     say!("{line}");
                 }
             }
-            ExitCode::SUCCESS
+            exit_code(&outcome.ending)
         }
         Ending::Unstable(message) => {
             tell!("error: {message}");
@@ -98,9 +129,9 @@ pub fn report(outcome: &mote_front::Outcome, quiet: bool) -> ExitCode {
                 "the files written up to that point are kept in {}",
                 outcome.dir.display()
             );
-            ExitCode::from(3)
+            exit_code(&outcome.ending)
         }
-        Ending::Interrupted { signal, message } => {
+        Ending::Interrupted { message, .. } => {
             tell!("{message}");
             tell!(
                 "the files are flushed in {}{}",
@@ -111,7 +142,7 @@ pub fn report(outcome: &mote_front::Outcome, quiet: bool) -> ExitCode {
                     ""
                 }
             );
-            ExitCode::from((128 + signal).clamp(0, 255) as u8)
+            exit_code(&outcome.ending)
         }
     }
 }

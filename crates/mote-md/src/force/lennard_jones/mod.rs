@@ -16,7 +16,7 @@
 //! both are tested against, to a few ulp. Rows are summed in fixed blocks,
 //! so every thread count gives the same bits.
 
-use super::{Interaction, State, Virial};
+use super::{HaloReach, Interaction, State, Virial};
 use crate::neighbor::{Copy4, GhostList};
 use glam::DVec3;
 use mote_geom::lanes::{self, Lanes};
@@ -279,8 +279,12 @@ impl Interaction for LennardJones {
         "lennard_jones"
     }
 
-    fn decomposes(&self) -> bool {
-        true
+    fn halo_reach(&self) -> Option<HaloReach> {
+        Some(HaloReach {
+            cutoff: self.cutoff,
+            skin: self.list.skin,
+            every: self.list.every,
+        })
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {

@@ -1,0 +1,150 @@
+//! `mote run` across the ranks of `mpirun` (built with the `mpi` feature:
+//! `cargo test -p mote --features mpi --test mpi`; `.ci/run` installs
+//! OpenMPI and runs it). A Lennard-Jones liquid decomposed over 2, 3 and 4
+//! ranks writes the trajectory of one process byte for byte; one rank
+//! writes exactly what the plain build writes; what does not decompose yet
+//! is refused, once, with its name.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// A liquid of 1920 atoms that melts from a hot crystal: particles cross
+/// bricks and the list is rebuilt dozens of times in 400 steps.
+const LIQUID: &str = r#"
+title = "LJ liquid on ranks"
+units = "lj"
+seed = 5
+
+[run]
+integrator = "leapfrog"
+dt = 0.005
+steps = 400
+
+[lennard_jones]
+cutoff = 2.5
+shifted = true
+skin = 0.3
+
+[[fcc]]
+cells = [10, 8, 6]
+density = 0.8442
+kt = 2.0
+
+[output]
+observables_every = 50
+trajectory_every = 100
+"#;
+
+fn mpirun(ranks: usize, args: &[&str], dir: &Path) -> Output {
+    Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-np"])
+        .arg(ranks.to_string())
+        .arg(env!("CARGO_BIN_EXE_mote"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("mpirun runs (OpenMPI: openmpi-bin)")
+}
+
+fn plain(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mote"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("mote runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// The numbers of observables.csv, row by row.
+fn table(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("time"))
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+#[test]
+fn a_liquid_on_two_three_and_four_ranks_writes_one_process_trajectory() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("lj.toml"), LIQUID).unwrap();
+    let one = plain(&["run", "lj.toml", "-o", "one"], dir.path());
+    assert!(one.status.success(), "{}", text(&one.stderr));
+    let read = |run: &str, file: &str| std::fs::read(dir.path().join(run).join(file)).unwrap();
+    // One rank is the plain build, every byte of every file.
+    let solo = mpirun(1, &["run", "lj.toml", "-o", "solo"], dir.path());
+    assert!(solo.status.success(), "{}", text(&solo.stderr));
+    for file in ["trajectory.xyz", "observables.csv"] {
+        assert!(
+            read("one", file) == read("solo", file),
+            "{file} on one rank"
+        );
+    }
+    let expected = table(&dir.path().join("one/observables.csv"));
+    for ranks in [2, 3, 4] {
+        let run = format!("np{ranks}");
+        let o = mpirun(ranks, &["run", "lj.toml", "-o", &run], dir.path());
+        let stdout = text(&o.stdout);
+        assert!(
+            o.status.success(),
+            "{ranks} ranks: {}{stdout}",
+            text(&o.stderr)
+        );
+        // Rank 0 alone opens (on stderr), prints and writes.
+        let opening = text(&o.stderr);
+        assert_eq!(
+            opening.matches(&format!("on {ranks} ranks")).count(),
+            1,
+            "{opening}"
+        );
+        assert_eq!(stdout.matches("Ran 400 steps").count(), 1, "{stdout}");
+        assert!(
+            read("one", "trajectory.xyz") == read(&run, "trajectory.xyz"),
+            "the trajectory on {ranks} ranks differs from one process's"
+        );
+        // Sums over the ranks: the same to round-off (added in another order).
+        let got = table(&dir.path().join(&run).join("observables.csv"));
+        assert_eq!(got.len(), expected.len());
+        for (g, e) in got.iter().zip(&expected) {
+            for (a, b) in g.iter().zip(e) {
+                assert!(
+                    (a - b).abs() <= 1e-9 * b.abs().max(1e-3),
+                    "{ranks} ranks: {a} against {b}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn what_does_not_decompose_yet_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let gravity = "title = \"g\"\nunits = \"lj\"\n[run]\ndt = 0.01\nsteps = 5\n\
+                   [gravity]\nsoftening = 0.1\n\
+                   [[particle]]\nposition = [0, 0, 0]\n[[particle]]\nposition = [1, 0, 0]\n";
+    std::fs::write(dir.path().join("g.toml"), gravity).unwrap();
+    let o = mpirun(2, &["run", "g.toml", "-o", "g"], dir.path());
+    let stderr = text(&o.stderr);
+    assert!(!o.status.success());
+    assert_eq!(
+        stderr.matches("does not run on 2 ranks yet").count(),
+        1,
+        "{stderr}"
+    );
+    assert!(stderr.contains("gravity"), "{stderr}");
+    let o = mpirun(
+        2,
+        &["run", "example:sun-earth", "--checkpoint-every", "5"],
+        dir.path(),
+    );
+    assert!(!o.status.success());
+    assert!(
+        text(&o.stderr).contains("--checkpoint-every"),
+        "{}",
+        text(&o.stderr)
+    );
+}
