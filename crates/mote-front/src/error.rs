@@ -18,11 +18,22 @@ pub enum FrontError {
     /// scene's engine does not have, a missing run length), said in words.
     #[error("{0}")]
     Request(String),
+    /// Rank 0 of a decomposed run failed while stepping (a file it could
+    /// not write): the other ranks wait for it in a measurement it will
+    /// never take, so the caller must end every rank (MPI_Abort).
+    #[error(transparent)]
+    Stranded(Box<FrontError>),
 }
 
 impl FrontError {
     pub fn request(message: impl Into<String>) -> Self {
         FrontError::Request(message.into())
+    }
+
+    /// Whether the other ranks of a decomposed run are left waiting
+    /// ([`FrontError::Stranded`]).
+    pub fn strands_ranks(&self) -> bool {
+        matches!(self, FrontError::Stranded(_))
     }
 
     /// Whether the run went unstable (a non-finite number: the message

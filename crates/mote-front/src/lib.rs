@@ -229,6 +229,13 @@ pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, F
     if let Some(path) = &options.resume {
         // Checkpoints name their engine (point particles' older ones do not).
         let cp = mote_io::checkpoint::read(path)?;
+        let engine = match cp.option("engine") {
+            Some("rigid") => Engine::Rigid,
+            Some("event-driven") => Engine::EventDriven,
+            Some("packing") => Engine::Packing,
+            _ => Engine::Particles,
+        };
+        check_ranks(options, Some(engine))?;
         let mut options = options.clone();
         let (dir, elsewhere) = lock::resume_folder(&cp, path);
         if elsewhere {
@@ -240,11 +247,11 @@ pub fn run(options: &RunOptions, monitor: &mut dyn Monitor) -> Result<Outcome, F
         }
         options.output = Some(dir);
         let options = &options;
-        let result = match cp.option("engine") {
-            Some("rigid") => rigid::resume(&cp, options, monitor),
-            Some("event-driven") => event_driven::resume(&cp, options, monitor),
-            Some("packing") => packing::resume(&cp, options, monitor),
-            _ => particles::run(None, options, monitor),
+        let result = match engine {
+            Engine::Rigid => rigid::resume(&cp, options, monitor),
+            Engine::EventDriven => event_driven::resume(&cp, options, monitor),
+            Engine::Packing => packing::resume(&cp, options, monitor),
+            Engine::Particles => particles::run(None, options, monitor),
         };
         monitor.finish();
         return result;
@@ -264,11 +271,7 @@ fn check_ranks(options: &RunOptions, engine: Option<Engine>) -> Result<(), Front
     };
     let input = options.input.as_deref().unwrap_or("the run");
     let n = ranks.0.size();
-    let why = if options.resume.is_some() {
-        Some("--resume (checkpoints of a decomposed run come next)".to_string())
-    } else if options.checkpoint_every.is_some() {
-        Some("--checkpoint-every (checkpoints of a decomposed run come next)".to_string())
-    } else if options.live.is_set() {
+    let why = if options.live.is_set() {
         Some("the live viewer".to_string())
     } else {
         match engine {

@@ -271,6 +271,7 @@ pub(crate) fn run_engine<E: EngineRun>(
         .chain(folder.iter().flat_map(|f| f.checkpoint_options()))
         .collect();
         driver.checkpoints = Some(mote_run::Checkpoints {
+            writes: root,
             every: every.max(1),
             path: files.dir.join("checkpoint.mote"),
             template: Checkpoint {
@@ -322,7 +323,17 @@ pub(crate) fn run_engine<E: EngineRun>(
                     .push(format!("Picture of the final state: {}.", png.display()));
             }
         }
-        Err(e) => outcome.ending = engine.ending(&mut state, e)?,
+        Err(e) => {
+            outcome.ending = engine.ending(&mut state, e).map_err(|e| {
+                // Every rank stops together on instability and signals;
+                // what else ends a run is rank 0's alone.
+                if ranks.is_some() {
+                    FrontError::Stranded(Box::new(e))
+                } else {
+                    e
+                }
+            })?
+        }
     }
     Ok(outcome)
 }

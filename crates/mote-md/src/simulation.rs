@@ -111,7 +111,15 @@ impl Simulation {
             }
         };
         let mut domain = crate::domain::Domain::new(comm, &self.system.boundary, reach, grid)?;
-        self.system = domain.scatter(&self.system);
+        // A resumed run's lists: one build for all (a decomposed run's
+        // lists are built together), the first restored.
+        let restored = self
+            .forces
+            .interactions
+            .iter_mut()
+            .filter_map(|i| i.take_restored_list())
+            .next();
+        self.system = domain.scatter(&self.system, restored);
         self.forces.domain = Some(domain);
         Ok(())
     }
@@ -309,32 +317,67 @@ impl mote_run::Propagator for Simulation {
     /// angular ones with ω when the particles turn), and what each
     /// interaction carries (contact histories, lists) under its name.
     fn save(&mut self, cp: &mut mote_io::checkpoint::Checkpoint) -> Result<(), MdError> {
+        if let Some(domain) = &self.forces.domain {
+            // The whole state at rank 0, in one process's form: a run
+            // resumes from it on any number of ranks, or on one process.
+            let whole = domain.gather(&self.system);
+            let lists = domain.carried_state();
+            let Some(whole) = whole else {
+                return Ok(());
+            };
+            let keys = self.forces.carried_keys();
+            let carried: Vec<(String, Vec<f64>)> = keys
+                .into_iter()
+                .zip(&self.forces.interactions)
+                .map(|(key, i)| match i.halo_reach() {
+                    Some(r) if r != crate::force::HaloReach::NONE => {
+                        (key, lists.clone().unwrap_or_default())
+                    }
+                    _ => (key, i.carried_state()),
+                })
+                .filter(|(_, v)| !v.is_empty())
+                .collect();
+            write_state(&whole, carried, cp);
+            return Ok(());
+        }
         let sys = &self.system;
-        let p = &sys.particles;
-        cp.angular = p
-            .angular_velocity
-            .iter()
-            .zip(&sys.carried_angular_acceleration)
-            .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
-            .collect();
         let keys = self.forces.carried_keys();
-        cp.carried = keys
+        let carried = keys
             .into_iter()
             .zip(&self.forces.interactions)
             .map(|(key, i)| (key, i.carried_state()))
             .filter(|(_, v)| !v.is_empty())
             .collect();
-        cp.time = sys.time;
-        cp.step = sys.step;
-        cp.positions = p.position.iter().map(|r| r.to_array()).collect();
-        cp.velocities = p.velocity.iter().map(|v| v.to_array()).collect();
-        cp.accelerations = sys
-            .carried_acceleration
-            .iter()
-            .map(|a| a.to_array())
-            .collect();
+        write_state(sys, carried, cp);
         Ok(())
     }
+}
+
+/// Puts `sys` and what its interactions carry into `cp`: positions,
+/// velocities, the accelerations leap-frog carries (and the angular ones
+/// with ω when the particles turn).
+fn write_state(
+    sys: &System,
+    carried: Vec<(String, Vec<f64>)>,
+    cp: &mut mote_io::checkpoint::Checkpoint,
+) {
+    let p = &sys.particles;
+    cp.angular = p
+        .angular_velocity
+        .iter()
+        .zip(&sys.carried_angular_acceleration)
+        .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
+        .collect();
+    cp.carried = carried;
+    cp.time = sys.time;
+    cp.step = sys.step;
+    cp.positions = p.position.iter().map(|r| r.to_array()).collect();
+    cp.velocities = p.velocity.iter().map(|v| v.to_array()).collect();
+    cp.accelerations = sys
+        .carried_acceleration
+        .iter()
+        .map(|a| a.to_array())
+        .collect();
 }
 
 /// The first (column, particle) whose vector is not finite. A branch-free

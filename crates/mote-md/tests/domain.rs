@@ -1,6 +1,7 @@
 //! Domain decomposition: a Lennard-Jones liquid stepped on 2, 3, 4 and 6
 //! ranks (threads of one process, `mote_run::comm::in_process`, which run
-//! the very code `mpirun` runs) gives the same bits as one process.
+//! the very code `mpirun` runs) gives the same bits as one process, and
+//! its checkpoints are one process's and resume on any number of ranks.
 
 use std::sync::Arc;
 
@@ -114,4 +115,93 @@ fn a_decomposed_liquid_steps_as_one_process_does() {
     // builds.
     let builds = builds.unwrap();
     assert!(builds > 10, "{builds} builds");
+}
+
+/// The state a checkpoint holds at `step`, taken by one process.
+fn checkpoint_at(sim: &mut Simulation, step: usize) -> mote_io::checkpoint::Checkpoint {
+    sim.prime(&mut |_| {}).unwrap();
+    for _ in 0..step {
+        sim.advance().unwrap();
+    }
+    let mut cp = mote_io::checkpoint::Checkpoint::default();
+    sim.save(&mut cp).unwrap();
+    cp
+}
+
+/// Puts a checkpoint's state into a freshly built simulation, as the
+/// front's resume does.
+fn resume(cp: &mote_io::checkpoint::Checkpoint) -> Simulation {
+    let mut sim = simulation(crystal());
+    let sys = &mut sim.system;
+    sys.time = cp.time;
+    sys.step = cp.step;
+    for (i, (r, v)) in cp.positions.iter().zip(&cp.velocities).enumerate() {
+        sys.particles.position[i] = DVec3::from(*r);
+        sys.particles.velocity[i] = DVec3::from(*v);
+    }
+    sys.carried_acceleration = cp.accelerations.iter().map(|a| DVec3::from(*a)).collect();
+    for (key, values) in &cp.carried {
+        assert_eq!(key, "lennard_jones");
+        sim.forces.interactions[0]
+            .restore_carried_state(values)
+            .unwrap();
+    }
+    sim
+}
+
+/// A decomposed run's checkpoint is one process's, number for number; a
+/// run resumed from it on another number of ranks ends where the
+/// uninterrupted run of one process ends, to the bit.
+#[test]
+fn checkpoints_of_a_decomposed_run_resume_on_any_number_of_ranks() {
+    const HALF: usize = STEPS / 2;
+    let mut one = simulation(crystal());
+    let plain = checkpoint_at(&mut one, HALF);
+    for _ in HALF..STEPS {
+        one.advance().unwrap();
+    }
+    let end = one.system.particles;
+    let taken = in_process(2, |comm| {
+        let mut sim = simulation(crystal());
+        sim.decompose(comm, None).unwrap();
+        checkpoint_at(&mut sim, HALF)
+    });
+    let cp = &taken[0];
+    assert_eq!(cp.positions, plain.positions);
+    assert_eq!(cp.velocities, plain.velocities);
+    assert_eq!(cp.accelerations, plain.accelerations);
+    assert_eq!(cp.carried, plain.carried);
+    assert_eq!((cp.step, cp.time), (plain.step, plain.time));
+    assert!(!cp.carried.is_empty(), "the list's build is carried");
+    // Resumed on three ranks and on one process.
+    for ranks in [1, 2, 3] {
+        let out = in_process(ranks, |comm| {
+            let mut sim = resume(cp);
+            if ranks > 1 {
+                sim.decompose(comm, None).unwrap();
+            }
+            sim.prime(&mut |_| {}).unwrap();
+            for _ in HALF..STEPS {
+                sim.advance().unwrap();
+            }
+            match &sim.forces.domain {
+                Some(d) => d.gather(&sim.system),
+                None => Some(sim.system.clone()),
+            }
+        });
+        let whole = out[0].as_ref().unwrap();
+        let differ = (0..end.len())
+            .filter(|&i| {
+                whole.particles.position[i] != end.position[i]
+                    || whole.particles.velocity[i] != end.velocity[i]
+            })
+            .count();
+        let worst = (0..end.len())
+            .map(|i| (whole.particles.position[i] - end.position[i]).length())
+            .fold(0.0, f64::max);
+        assert_eq!(
+            differ, 0,
+            "particles that differ, resumed on {ranks} ranks (by {worst} at most)"
+        );
+    }
 }

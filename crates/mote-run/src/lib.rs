@@ -202,6 +202,10 @@ pub struct Checkpoints {
     pub path: PathBuf,
     /// The run's input, seed and options; the propagator adds its state.
     pub template: Checkpoint,
+    /// Whether this process writes the file: false on the ranks of a
+    /// decomposed run but rank 0, which take part in gathering the state
+    /// at the same steps and write nothing.
+    pub writes: bool,
 }
 
 /// How a run ended before its last step.
@@ -424,7 +428,10 @@ impl<P: Propagator> Driver<P> {
     fn save(c: &Checkpoints, state: &mut P) -> Result<(), P::Error> {
         let mut cp = c.template.clone();
         state.save(&mut cp)?;
-        Ok(checkpoint::write(&c.path, &cp)?)
+        if c.writes {
+            checkpoint::write(&c.path, &cp)?;
+        }
+        Ok(())
     }
 }
 
@@ -722,6 +729,7 @@ mod tests {
         let path = dir.path().join("c.mote");
         let mut d = Driver::<Decay>::new();
         d.checkpoints = Some(Checkpoints {
+            writes: true,
             every: 3,
             path: path.clone(),
             template: Checkpoint {

@@ -56,6 +56,7 @@ fn a_signal_stops_after_the_step_with_a_checkpoint_of_it() {
     let path = dir.path().join("checkpoint.mote");
     let mut driver = Driver::new();
     driver.checkpoints = Some(Checkpoints {
+        writes: true,
         every: 100,
         path: path.clone(),
         template: Checkpoint::default(),

@@ -136,15 +136,69 @@ fn what_does_not_decompose_yet_is_refused_by_name() {
         "{stderr}"
     );
     assert!(stderr.contains("gravity"), "{stderr}");
-    let o = mpirun(
-        2,
-        &["run", "example:sun-earth", "--checkpoint-every", "5"],
-        dir.path(),
-    );
-    assert!(!o.status.success());
+    for (example, what) in [
+        ("example:cube", "an event-driven scene"),
+        ("example:clumps-settling", "rigid clumps"),
+        ("example:settling", "granular"),
+    ] {
+        let o = mpirun(2, &["run", example, "-o", "x"], dir.path());
+        let stderr = text(&o.stderr);
+        assert!(!o.status.success(), "{example} ran on 2 ranks");
+        assert!(stderr.contains(what), "{example}: {stderr}");
+        assert!(stderr.contains("does not run on 2 ranks yet"), "{stderr}");
+    }
+}
+
+/// A run on three ranks stopped by a signal (mpirun hands it to every
+/// rank) writes one checkpoint of the whole state; resumed on two ranks
+/// it ends in the one-process run's trajectory, byte for byte.
+#[test]
+fn a_run_stopped_on_three_ranks_resumes_on_two() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = LIQUID
+        .replace("steps = 400", "steps = 20000")
+        .replace("cells = [10, 8, 6]", "cells = [6, 6, 6]")
+        .replace("trajectory_every = 100", "trajectory_every = 500");
+    std::fs::write(dir.path().join("long.toml"), long).unwrap();
+    let whole = plain(&["run", "long.toml", "-o", "whole", "-q"], dir.path());
+    assert!(whole.status.success(), "{}", text(&whole.stderr));
+
+    let child = Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-np", "3"])
+        .arg(env!("CARGO_BIN_EXE_mote"))
+        .args(["run", "long.toml", "-o", "cut", "--checkpoint-every", "200"])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("mpirun runs");
+    let cp = dir.path().join("cut/checkpoint.mote");
+    let start = std::time::Instant::now();
+    while mote_io::checkpoint::read(&cp).map_or(true, |c| c.step < 400) {
+        assert!(start.elapsed().as_secs() < 120, "no checkpoint at step 400");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let term = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(term.success());
+    let stopped = child.wait_with_output().unwrap();
+    assert!(!stopped.status.success(), "it finished before the signal");
+    let at_stop = mote_io::checkpoint::read(&cp).unwrap();
+    assert!(at_stop.step < 20000, "it finished before the signal");
     assert!(
-        text(&o.stderr).contains("--checkpoint-every"),
+        text(&stopped.stderr).contains("interrupted by signal"),
         "{}",
-        text(&o.stderr)
+        text(&stopped.stderr)
+    );
+
+    let resumed = mpirun(2, &["run", "--resume", "cut/checkpoint.mote"], dir.path());
+    assert!(resumed.status.success(), "{}", text(&resumed.stderr));
+    let read = |run: &str| std::fs::read(dir.path().join(run).join("trajectory.xyz")).unwrap();
+    assert!(
+        read("whole") == read("cut"),
+        "the run stopped at step {} on 3 ranks and resumed on 2 is not the whole run",
+        at_stop.step
     );
 }

@@ -92,13 +92,16 @@ pub struct Domain {
     pub builds: u64,
     /// The particles this rank has sent to another so far.
     pub migrated: u64,
+    /// A checkpoint's build to remake at the first evaluation: its
+    /// evaluations since (the positions are the halo's reference).
+    restored: Option<u64>,
     /// The species names of the undivided system; a particle carries its
     /// species as an index into them.
     species: Vec<String>,
 }
 
 /// The numbers a migrating particle carries, [`pack`]'s layout.
-const CARRIED: usize = 25;
+const CARRIED: usize = 31;
 
 impl Domain {
     /// This rank's part of a run over `boundary` on `comm`'s ranks, for
@@ -130,6 +133,7 @@ impl Domain {
             since_build: 0,
             builds: 0,
             migrated: 0,
+            restored: None,
             species: Vec::new(),
         })
     }
@@ -149,12 +153,21 @@ impl Domain {
     }
 
     /// This rank's particles of the undivided system `whole` (which every
-    /// rank holds at the start): those its brick holds, in id order.
-    pub fn scatter(&mut self, whole: &System) -> System {
+    /// rank holds at the start): those its brick holds, in id order, with
+    /// what they carry. With `restored` (a checkpoint's list: evaluations
+    /// since its build and the particles' wrapped positions there, by id),
+    /// the bricks hold the particles where they stood at that build, which
+    /// is remade at the first evaluation, as one process remakes it.
+    pub fn scatter(&mut self, whole: &System, restored: Option<(u64, Vec<DVec3>)>) -> System {
         self.species = distinct(&whole.species);
         let b = &whole.boundary;
-        let mine: Vec<usize> = (0..whole.particles.len())
-            .filter(|&i| self.bricks.owner(b.wrap(whole.particles.position[i])) == self.comm.rank())
+        let n = whole.particles.len();
+        let at = |i: usize| match &restored {
+            Some((_, reference)) => reference[i],
+            None => b.wrap(whole.particles.position[i]),
+        };
+        let mine: Vec<usize> = (0..n)
+            .filter(|&i| self.bricks.owner(at(i)) == self.comm.rank())
             .collect();
         let mut part = System {
             particles: Default::default(),
@@ -164,14 +177,42 @@ impl Domain {
             ..whole.clone()
         };
         self.halo = Halo {
-            total: whole.particles.len(),
+            total: n,
             ..Halo::default()
         };
         for &i in &mine {
             let row = pack(whole, i, i as u64, &self.species);
             self.halo.id.push(unpack(&mut part, &row, &self.species));
         }
+        if let Some((since, _)) = restored {
+            self.halo.reference = mine.iter().map(|&i| at(i)).collect();
+            self.restored = Some(since);
+        }
         part
+    }
+
+    /// What a checkpoint holds of the lists over the halo, in one
+    /// process's form ([`GhostList::carried_state`]): evaluations since the
+    /// build, then the wrapped positions there in id order. At rank 0
+    /// (`None` elsewhere, and before the first build).
+    ///
+    /// [`GhostList::carried_state`]: crate::neighbor::GhostList::carried_state
+    pub fn carried_state(&self) -> Option<Vec<f64>> {
+        let h = &self.halo;
+        let rows: Vec<f64> =
+            h.id.iter()
+                .zip(&h.reference)
+                .flat_map(|(id, r)| [*id as f64, r.x, r.y, r.z])
+                .collect();
+        let all = self.comm.gather(&rows);
+        if self.comm.rank() != 0 || self.builds == 0 {
+            return None;
+        }
+        let mut rows: Vec<&[f64]> = all.iter().flat_map(|v| v.chunks(4)).collect();
+        rows.sort_by_key(|r| r[0] as u64);
+        let mut out = vec![self.since_build as f64];
+        out.extend(rows.iter().flat_map(|r| r[1..4].iter().copied()));
+        Some(out)
     }
 
     /// The undivided system at rank 0, particles in id order (`None` on
@@ -206,6 +247,7 @@ impl Domain {
     /// rule of [`GhostList`](crate::neighbor::GhostList)); else the
     /// displacements forwarded to the ghosts. Returns whether it rebuilt.
     pub fn prepare(&mut self, sys: &mut System) -> bool {
+        self.remake_restored(&sys.boundary);
         self.since_build += 1;
         let due = self.every > 0 && self.since_build >= self.every;
         let farthest = self.displace(&sys.particles.position, &sys.boundary);
@@ -222,9 +264,18 @@ impl Domain {
     /// without counting an evaluation or rebuilding (measurements between
     /// steps, at the positions of the last evaluation).
     pub fn refresh(&mut self, position: &[DVec3], boundary: &Boundary) {
+        self.remake_restored(boundary);
         if self.builds > 0 {
             self.displace(position, boundary);
             self.forward();
+        }
+    }
+
+    /// Makes the build a checkpoint restored ([`Domain::scatter`]), once.
+    fn remake_restored(&mut self, boundary: &Boundary) {
+        if let Some(since) = self.restored.take() {
+            self.share(boundary);
+            self.since_build = since;
         }
     }
 
@@ -263,8 +314,14 @@ impl Domain {
             self.migrate(sys, k);
         }
         let b = sys.boundary;
+        self.halo.reference = sys.particles.position.iter().map(|r| b.wrap(*r)).collect();
+        self.share(&b);
+    }
+
+    /// Makes the build at the halo's reference positions: the ghosts,
+    /// the particle count and extent every rank's grid needs.
+    fn share(&mut self, b: &Boundary) {
         let h = &mut self.halo;
-        h.reference = sys.particles.position.iter().map(|r| b.wrap(*r)).collect();
         h.displacement = vec![DVec3::ZERO; h.reference.len()];
         h.ghosts.clear();
         h.total = self.comm.sum(&[h.id.len() as f64])[0] as usize;
@@ -276,7 +333,7 @@ impl Domain {
         let lo = -DVec3::from_array(self.comm_max3(-lo));
         let hi = DVec3::from_array(self.comm_max3(hi));
         self.halo.extent = (lo, hi);
-        self.send_ghosts(&b);
+        self.send_ghosts(b);
         self.since_build = 0;
         self.builds += 1;
         self.halo.generation += 1;
@@ -414,7 +471,9 @@ fn distinct(names: &[String]) -> Vec<String> {
 }
 
 /// Particle i of `sys` as [`CARRIED`] numbers: id, species, x, v, mass,
-/// charge, radius, colour, mobility, ω, inertia, dipole moment.
+/// charge, radius, colour, mobility, ω, inertia, dipole moment, which of
+/// the carried accelerations the system holds (1: linear, 2: angular),
+/// and those.
 fn pack(sys: &System, i: usize, id: u64, species: &[String]) -> [f64; CARRIED] {
     let p = &sys.particles;
     let kind = sys
@@ -435,7 +494,14 @@ fn pack(sys: &System, i: usize, id: u64, species: &[String]) -> [f64; CARRIED] {
     row[17..20].copy_from_slice(&p.angular_velocity[i].to_array());
     row[20] = p.inertia[i];
     row[21..24].copy_from_slice(&p.dipole[i].to_array());
-    row[24] = 0.0;
+    let (acc, alpha) = (&sys.carried_acceleration, &sys.carried_angular_acceleration);
+    row[24] = f64::from(u8::from(!acc.is_empty()) + 2 * u8::from(!alpha.is_empty()));
+    if let Some(a) = acc.get(i) {
+        row[25..28].copy_from_slice(&a.to_array());
+    }
+    if let Some(a) = alpha.get(i) {
+        row[28..31].copy_from_slice(&a.to_array());
+    }
     row
 }
 
@@ -454,6 +520,15 @@ fn unpack(sys: &mut System, row: &[f64], species: &[String]) -> u64 {
     p.dipole.push(DVec3::from_slice(&row[21..24]));
     if row[1] >= 0.0 {
         sys.species.push(species[row[1] as usize].clone());
+    }
+    let carried = row[24] as u8;
+    if carried & 1 != 0 {
+        sys.carried_acceleration
+            .push(DVec3::from_slice(&row[25..28]));
+    }
+    if carried & 2 != 0 {
+        sys.carried_angular_acceleration
+            .push(DVec3::from_slice(&row[28..31]));
     }
     row[0] as u64
 }

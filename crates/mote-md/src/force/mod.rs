@@ -238,6 +238,12 @@ pub trait Interaction: Send + Sync {
     fn halo_reach(&self) -> Option<HaloReach> {
         None
     }
+    /// The build of its pair list a checkpoint restored and the list has
+    /// not made yet (evaluations since it, wrapped positions there): a
+    /// decomposed run remakes it over its halo.
+    fn take_restored_list(&mut self) -> Option<(u64, Vec<DVec3>)> {
+        None
+    }
     /// Whether this interaction exerts torques (frictional contacts,
     /// dipoles); then the integrator rotates the particles and calls
     /// [`Interaction::add_forces_and_torques`].
@@ -320,6 +326,9 @@ impl Interaction for Box<dyn Interaction> {
     }
     fn halo_reach(&self) -> Option<HaloReach> {
         (**self).halo_reach()
+    }
+    fn take_restored_list(&mut self) -> Option<(u64, Vec<DVec3>)> {
+        (**self).take_restored_list()
     }
     fn exerts_torques(&self) -> bool {
         (**self).exerts_torques()

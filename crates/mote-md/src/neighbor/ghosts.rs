@@ -254,6 +254,14 @@ impl GhostList {
         Ok(())
     }
 
+    /// Hands over a build a checkpoint described and the list has not
+    /// made yet ([`GhostList::restore`]): evaluations since it and the
+    /// wrapped positions there (a decomposed run remakes it over its
+    /// halo).
+    pub fn take_restored(&mut self) -> Option<(u64, Vec<DVec3>)> {
+        self.pending.take()
+    }
+
     /// Builds the list from scratch at positions `pos`.
     pub fn build(&mut self, pos: &[DVec3], boundary: &Boundary) {
         let n = pos.len();
@@ -314,12 +322,13 @@ impl GhostList {
     /// halo was built anew since the list was, else each copy moved by its
     /// particle's displacement. Returns whether it rebuilt.
     pub fn follow_halo(&mut self, halo: &Halo, boundary: &Boundary) -> bool {
-        if self.generation != halo.generation {
+        let rebuilt = self.generation != halo.generation;
+        if rebuilt {
             self.build_halo(halo, boundary);
-            return true;
         }
+        // Zero after a build, but not after one a checkpoint restored.
         self.move_copies(&halo.displacement);
-        false
+        rebuilt
     }
 
     /// Builds the list over a rank's particles and ghosts. The copies are

@@ -92,9 +92,11 @@ pub fn run(global: &super::GlobalOpts, args: RunArgs) -> anyhow::Result<ExitCode
         Err(e) => {
             if root {
                 tell!("error: {e}");
-                // The others may be waiting for rank 0 mid-run.
-                #[cfg(feature = "mpi")]
-                mpi.abort(1);
+                if e.strands_ranks() {
+                    // The others wait for rank 0 mid-run.
+                    #[cfg(feature = "mpi")]
+                    mpi.abort(1);
+                }
             }
             Ok(ExitCode::FAILURE)
         }

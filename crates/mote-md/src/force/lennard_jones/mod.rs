@@ -287,6 +287,10 @@ impl Interaction for LennardJones {
         })
     }
 
+    fn take_restored_list(&mut self) -> Option<(u64, Vec<DVec3>)> {
+        self.list.take_restored()
+    }
+
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let pos = state.position;
         self.follow(state, true);
