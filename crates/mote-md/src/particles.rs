@@ -129,6 +129,34 @@ impl System {
         }
     }
 
+    /// Keeps the particles where `keep` is true, in order, with all they
+    /// carry (a decomposed run's particles leaving this rank).
+    pub(crate) fn retain_particles(&mut self, keep: &[bool]) {
+        use crate::domain::retain;
+        let p = &mut self.particles;
+        retain(&mut p.position, keep);
+        retain(&mut p.velocity, keep);
+        retain(&mut p.mass, keep);
+        retain(&mut p.charge, keep);
+        retain(&mut p.radius, keep);
+        retain(&mut p.color, keep);
+        retain(&mut p.mobility, keep);
+        retain(&mut p.angular_velocity, keep);
+        retain(&mut p.inertia, keep);
+        retain(&mut p.dipole, keep);
+        for carried in [
+            &mut self.carried_acceleration,
+            &mut self.carried_angular_acceleration,
+        ] {
+            if !carried.is_empty() {
+                retain(carried, keep);
+            }
+        }
+        if !self.species.is_empty() {
+            retain(&mut self.species, keep);
+        }
+    }
+
     /// Maps positions back into the box on periodic axes.
     pub fn wrap_positions(&mut self) {
         if self.boundary.is_periodic() {

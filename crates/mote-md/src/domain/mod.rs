@@ -352,12 +352,10 @@ impl Domain {
         }
         let (b, at, p) = (sys.boundary, self.bricks.at[k], self.bricks.dims[k]);
         let mut going = [Vec::new(), Vec::new()];
-        let mut stay = Vec::new();
-        for i in 0..sys.particles.len() {
+        let mut stays = vec![true; sys.particles.len()];
+        for (i, stay) in stays.iter_mut().enumerate() {
             let c = self.bricks.index(k, b.wrap(sys.particles.position[i])[k]);
-            if c == at {
-                stay.push(i);
-            } else {
+            if c != at {
                 // Below or above, the shorter way round a periodic axis.
                 let down = (at + p - c) % p;
                 let up = (c + p - at) % p;
@@ -368,29 +366,19 @@ impl Domain {
                 };
                 going[side].extend(pack(sys, i, self.halo.id[i], &self.species));
                 self.migrated += 1;
+                *stay = false;
             }
         }
-        let ids = std::mem::take(&mut self.halo.id);
-        let mut kept = System {
-            particles: Default::default(),
-            carried_acceleration: Vec::new(),
-            carried_angular_acceleration: Vec::new(),
-            species: Vec::new(),
-            ..sys.clone()
-        };
-        for &i in &stay {
-            let row = pack(sys, i, ids[i], &self.species);
-            self.halo.id.push(unpack(&mut kept, &row, &self.species));
-        }
+        retain(&mut self.halo.id, &stays);
+        sys.retain_particles(&stays);
         for (side, out) in going.iter().enumerate() {
             let to = self.bricks.neighbour(k, side == 1).map(|n| n.0);
             let from = self.bricks.neighbour(k, side == 0).map(|n| n.0);
             let got = self.comm.exchange(to, out, from);
             for row in got.chunks(CARRIED) {
-                self.halo.id.push(unpack(&mut kept, row, &self.species));
+                self.halo.id.push(unpack(sys, row, &self.species));
             }
         }
-        *sys = kept;
     }
 
     /// The staged ghost exchange at a build (see the module's text).
@@ -457,6 +445,12 @@ impl Domain {
             }
         }
     }
+}
+
+/// Keeps the entries of `v` where `keep` is true, in order.
+pub(crate) fn retain<T>(v: &mut Vec<T>, keep: &[bool]) {
+    let mut k = keep.iter();
+    v.retain(|_| *k.next().expect("one flag per entry"));
 }
 
 /// The distinct names in `names`, in order of first appearance.

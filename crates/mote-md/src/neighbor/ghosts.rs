@@ -353,11 +353,16 @@ impl GhostList {
         let ghosts = halo.ghosts.iter().map(|g| (g.id, g.image, g.base));
         let copies: Vec<(u64, [i32; 3], DVec3)> = own.chain(ghosts).collect();
         let cells: Vec<u32> = copies.par_iter().map(|c| grid.cell(c.2)).collect();
-        let mut order: Vec<u32> = (0..copies.len() as u32).collect();
-        order.par_sort_unstable_by_key(|&c| {
-            let (id, [mx, my, mz], _) = copies[c as usize];
-            (cells[c as usize], mz != 0, my != 0, mx != 0, id, mx, my, mz)
-        });
+        // By cell (a counting sort), then each cell's few copies by key.
+        let mut order = grid.counting_sort(&cells);
+        let first = grid.first(&cells);
+        let key = |c: &u32| {
+            let (id, [mx, my, mz], _) = copies[*c as usize];
+            (mz != 0, my != 0, mx != 0, id, mx, my, mz)
+        };
+        for cell in first.windows(2) {
+            order[cell[0] as usize..cell[1] as usize].sort_unstable_by_key(key);
+        }
         let sorted: Vec<Copy> = order
             .iter()
             .map(|&c| Copy {
