@@ -21,7 +21,7 @@
 //! ξ_r = 8πηa³.
 //!
 //! Random numbers are counter-based like the thermostat's
-//! (`Simulation::noise`): the normal deviates of particle block b at step k
+//! (`crate::thermostat::Noise`): the normal deviates of particle block b at step k
 //! come from xoshiro256++ seeded by (seed, k, b), with blocks of a fixed
 //! size [`NOISE_BLOCK`]. A step's result therefore depends on neither the
 //! thread count nor the history (a resumed run draws the same numbers).

@@ -8,7 +8,6 @@ use crate::observe::Observables;
 use crate::particles::System;
 use crate::thermostat::Thermostat;
 use glam::DVec3;
-use rand_xoshiro::Xoshiro256PlusPlus;
 
 pub use mote_run::scene::RunLength;
 
@@ -24,9 +23,10 @@ pub struct Simulation {
     pub dt: f64,
     /// Applied after every step (NVE when `None`).
     pub thermostat: Option<Thermostat>,
-    /// The run's seed. Thermostat noise of step k comes from a generator
-    /// seeded by (seed, k) ([`Simulation::noise`]), so a run resumed from a
-    /// checkpoint draws exactly the numbers the uninterrupted run would.
+    /// The run's seed. Thermostat noise of step k comes from generators
+    /// seeded by (seed, k) and the particles' ids
+    /// ([`crate::thermostat::Noise`]), so a run resumed from a checkpoint,
+    /// or decomposed, draws exactly the numbers the uninterrupted run would.
     pub seed: u64,
     /// Overdamped Brownian dynamics instead of the inertial `stepper`
     /// (004 Eqs. 14–16); its noise is counter-based like the thermostat's.
@@ -92,9 +92,6 @@ impl Simulation {
         if self.brownian.is_some() {
             return not_yet("Brownian dynamics");
         }
-        if self.thermostat.is_some() {
-            return not_yet("a thermostat");
-        }
         if self.stepper.scheme != crate::Integrator::LeapFrog {
             return not_yet(&format!(
                 "the {} integrator (leap-frog does)",
@@ -138,15 +135,6 @@ impl Simulation {
     pub fn max_energy_error(&self) -> f64 {
         self.energy_watch.map_or(0.0, |w| w.1)
     }
-
-    /// The random stream of step `step`: xoshiro256++ seeded (through
-    /// SplitMix64) from the run's seed and the step number.
-    pub fn noise(&self, step: u64) -> Xoshiro256PlusPlus {
-        use rand::SeedableRng;
-        Xoshiro256PlusPlus::seed_from_u64(
-            self.seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(17),
-        )
-    }
 }
 
 impl mote_run::Propagator for Simulation {
@@ -188,8 +176,14 @@ impl mote_run::Propagator for Simulation {
                 .step(&mut self.system, &mut self.forces, self.dt);
         }
         if let Some(t) = self.thermostat {
-            let mut rng = self.noise(self.system.step);
-            t.apply(&mut self.system, self.dt, &mut rng);
+            let domain = self.forces.domain.as_ref();
+            let noise = crate::thermostat::Noise {
+                seed: self.seed,
+                step: self.system.step,
+                ids: domain.map_or(&[], |d| &d.halo().id),
+                comm: domain.map(|d| d.comm()),
+            };
+            t.apply(&mut self.system, self.dt, &noise);
         }
         self.stepping += since.elapsed();
         Ok(())

@@ -75,6 +75,7 @@ fn decomposed(
 fn a_decomposed_liquid_steps_as_one_process_does() {
     let mut one = simulation(crystal());
     let (first, last) = run(&mut one);
+    assert!((last.kt - 1.7).abs() < 0.2, "kT = {}", last.kt);
     let p = &one.system.particles;
     let mut builds = None;
     for (ranks, grid) in [
@@ -203,5 +204,58 @@ fn checkpoints_of_a_decomposed_run_resume_on_any_number_of_ranks() {
             differ, 0,
             "particles that differ, resumed on {ranks} ranks (by {worst} at most)"
         );
+    }
+}
+
+/// Thermostats on ranks: Langevin's noise comes from each particle's id
+/// and the step, so a decomposed run is one process's to the bit; Bussi
+/// rescales by the kinetic energy summed over the ranks (in rank order):
+/// the same to round-off.
+#[test]
+fn thermostatted_liquids_decompose() {
+    use mote_md::thermostat::Thermostat;
+    for (thermostat, exact) in [
+        (
+            Thermostat::Langevin {
+                kt: 1.0,
+                gamma: 2.0,
+            },
+            true,
+        ),
+        (Thermostat::Bussi { kt: 1.0, tau: 0.1 }, false),
+    ] {
+        let run = |comm: Option<Arc<dyn Comm>>| {
+            let mut sim = simulation(crystal());
+            sim.thermostat = Some(thermostat);
+            if let Some(comm) = comm {
+                sim.decompose(comm, None).unwrap();
+            }
+            run(&mut sim);
+            match &sim.forces.domain {
+                Some(d) => d.gather(&sim.system),
+                None => Some(sim.system),
+            }
+        };
+        let one = run(None).unwrap();
+        let three = in_process(3, |comm| run(Some(comm))).remove(0).unwrap();
+        let (p, q) = (&one.particles, &three.particles);
+        let worst = (0..p.len())
+            .map(|i| (p.position[i] - q.position[i]).length())
+            .fold(0.0, f64::max);
+        if exact {
+            assert!(
+                p.position == q.position && p.velocity == q.velocity,
+                "{thermostat:?}: by {worst}"
+            );
+        } else {
+            assert!(worst > 0.0 && worst < 1e-9, "{thermostat:?}: by {worst}");
+        }
+        // The thermostat acted: the liquid ends at kT ≈ 1, where without
+        // one it ends near kT = 1.7 (the crystal started at 3).
+        let kt = (0..p.len())
+            .map(|i| p.mass[i] * p.velocity[i].length_squared())
+            .sum::<f64>()
+            / (3.0 * p.len() as f64);
+        assert!((kt - 1.0).abs() < 0.15, "{thermostat:?}: kT = {kt}");
     }
 }

@@ -127,11 +127,7 @@ fn bussi_thermostat_reaches_its_temperature() {
     let mut sum = 0.0;
     let mut count = 0.0;
     for k in 0..1500 {
-        sim.stepper.step(&mut sim.system, &mut sim.forces, sim.dt);
-        let mut noise = sim.noise(sim.system.step);
-        sim.thermostat
-            .unwrap()
-            .apply(&mut sim.system, sim.dt, &mut noise);
+        mote_run::Propagator::advance(&mut sim).unwrap();
         if k >= 500 {
             sum += Observables::measure(&sim.system, &mut sim.forces).kt;
             count += 1.0;

@@ -38,11 +38,7 @@ tau = 0.1
     let (u_tail, p_tail) = LennardJones::new(1.0, 1.0, 2.5, false, 0.3).tail_corrections(rho);
     let run = |sim: &mut mote_md::Simulation, steps: u64| {
         for _ in 0..steps {
-            sim.stepper.step(&mut sim.system, &mut sim.forces, sim.dt);
-            if let Some(t) = sim.thermostat {
-                let mut noise = sim.noise(sim.system.step);
-                t.apply(&mut sim.system, sim.dt, &mut noise);
-            }
+            mote_run::Propagator::advance(sim).unwrap();
         }
     };
     run(&mut sim, 1000); // melt
