@@ -165,6 +165,7 @@ impl Stepper {
         let mut alpha = std::mem::take(&mut sys.carried_angular_acceleration);
         let n = sys.particles.len();
         if acc.len() != n || alpha.len() != n {
+            ff.before_forces(sys);
             Self::eval_rotating(ff, sys, t, 0.0, &mut acc, &mut alpha);
         }
         let half = 0.5 * h;
@@ -189,6 +190,9 @@ impl Stepper {
                     }
                 });
         }
+        // A decomposed run's particles may migrate here: `acc` and
+        // `alpha` are overwritten whole by the evaluation.
+        ff.before_forces(sys);
         Self::eval_rotating(ff, sys, t + h, h, &mut acc, &mut alpha);
         let p = &mut sys.particles;
         kick(&mut p.velocity, &acc, half);
@@ -213,6 +217,7 @@ impl Stepper {
         let mut acc = std::mem::take(&mut sys.carried_acceleration);
         if ff.exerts_torques() {
             let mut alpha = std::mem::take(&mut sys.carried_angular_acceleration);
+            ff.before_forces(sys);
             Self::eval_rotating(ff, sys, t, 0.0, &mut acc, &mut alpha);
             sys.carried_angular_acceleration = alpha;
         } else {

@@ -102,7 +102,8 @@ impl Simulation {
             Ok(reach) => reach,
             Err(names) => {
                 return not_yet(&format!(
-                    "{} (Lennard-Jones/WCA, uniform fields and damping do)",
+                    "{} (Lennard-Jones/WCA, cut-off dipoles, applied and uniform fields and \
+                     damping do)",
                     names.join(", ")
                 ))
             }

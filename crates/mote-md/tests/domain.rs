@@ -259,3 +259,72 @@ fn thermostatted_liquids_decompose() {
         assert!((kt - 1.0).abs() < 0.15, "{thermostat:?}: kT = {kt}");
     }
 }
+
+/// The dipolar LJ fluid of `bench/dipole3d.toml`, smaller: LJ and point
+/// dipoles in one cut-off pair loop, the particles turning (leap-frog
+/// with rotation), the ghosts' moments forwarded with their positions.
+const DIPOLAR: &str = r#"
+units = "lj"
+seed = 98934
+
+[run]
+integrator = "leapfrog"
+dt = 0.005
+steps = 300
+
+[lennard_jones]
+cutoff = 2.5
+shifted = false
+skin = 0.3
+
+[dipolar]
+cutoff = 2.5
+skin = 0.3
+random_orientation = true
+
+[[fcc]]
+cells = [6, 6, 6]
+density = 0.8442
+kt = 1.44
+radius = 0.5
+dipole = [0.0, 0.0, 0.75]
+"#;
+
+/// A dipolar fluid on 3 ranks turns and moves as in one process, to the
+/// bit: positions, velocities, moments and angular velocities.
+#[test]
+fn a_decomposed_dipolar_fluid_steps_as_one_process_does() {
+    let run = |comm: Option<Arc<dyn Comm>>| {
+        let mut sim = crate::common::build(DIPOLAR).simulation;
+        assert!(sim.forces.exerts_torques());
+        if let Some(comm) = comm {
+            sim.decompose(comm, None).unwrap();
+        }
+        let (first, last) = run(&mut sim);
+        let whole = match &sim.forces.domain {
+            Some(d) => d.gather(&sim.system),
+            None => Some(sim.system),
+        };
+        (whole, first, last)
+    };
+    let (one, first, last) = run(None);
+    let one = one.unwrap();
+    let (three, f3, l3) = in_process(3, |comm| run(Some(comm))).remove(0);
+    let (p, q) = (&one.particles, &three.unwrap().particles);
+    assert!(p.position == q.position, "positions");
+    assert!(p.velocity == q.velocity, "velocities");
+    assert!(p.dipole == q.dipole, "moments");
+    assert!(
+        p.angular_velocity == q.angular_velocity,
+        "angular velocities"
+    );
+    // The dipoles turned, and the energies agree to round-off.
+    let turned = (0..p.len())
+        .filter(|&i| p.angular_velocity[i] != DVec3::ZERO)
+        .count();
+    assert!(turned == p.len(), "{turned} of {} turned", p.len());
+    for (a, e) in [(&f3, &first), (&l3, &last)] {
+        assert!((a.potential - e.potential).abs() < 1e-11 * e.potential.abs());
+        assert!((a.kinetic - e.kinetic).abs() < 1e-11 * e.kinetic);
+    }
+}

@@ -59,6 +59,8 @@ pub struct Halo {
     /// The minimum-image displacement since the build of this rank's
     /// particles, then of the ghosts (each its particle's).
     pub displacement: Vec<DVec3>,
+    /// The ghosts' magnetic moments now (where an interaction reads them).
+    pub moment: Vec<DVec3>,
     /// The number of particles on all ranks.
     pub total: usize,
     /// The smallest and largest wrapped coordinates of all particles at the
@@ -85,6 +87,8 @@ pub struct Domain {
     pub skin: f64,
     /// Rebuild at least every this many evaluations (0: on displacement).
     pub every: u64,
+    /// Forward the ghosts' magnetic moments with their displacements.
+    moments: bool,
     halo: Halo,
     stages: Vec<Stage>,
     since_build: u64,
@@ -128,6 +132,7 @@ impl Domain {
             cutoff,
             skin,
             every: reach.every,
+            moments: reach.moments,
             halo: Halo::default(),
             stages: Vec::new(),
             since_build: 0,
@@ -247,7 +252,7 @@ impl Domain {
     /// rule of [`GhostList`](crate::neighbor::GhostList)); else the
     /// displacements forwarded to the ghosts. Returns whether it rebuilt.
     pub fn prepare(&mut self, sys: &mut System) -> bool {
-        self.remake_restored(&sys.boundary);
+        self.remake_restored(&sys.boundary, &sys.particles.dipole);
         self.since_build += 1;
         let due = self.every > 0 && self.since_build >= self.every;
         let farthest = self.displace(&sys.particles.position, &sys.boundary);
@@ -256,25 +261,25 @@ impl Domain {
             self.build(sys);
             return true;
         }
-        self.forward();
+        self.forward(&sys.particles.dipole);
         false
     }
 
-    /// Brings the ghosts to positions `position` of this rank's particles
-    /// without counting an evaluation or rebuilding (measurements between
+    /// Brings the ghosts to positions `position` (and moments `dipole`)
+    /// of this rank's particles without counting an evaluation or rebuilding (measurements between
     /// steps, at the positions of the last evaluation).
-    pub fn refresh(&mut self, position: &[DVec3], boundary: &Boundary) {
-        self.remake_restored(boundary);
+    pub fn refresh(&mut self, position: &[DVec3], dipole: &[DVec3], boundary: &Boundary) {
+        self.remake_restored(boundary, dipole);
         if self.builds > 0 {
             self.displace(position, boundary);
-            self.forward();
+            self.forward(dipole);
         }
     }
 
     /// Makes the build a checkpoint restored ([`Domain::scatter`]), once.
-    fn remake_restored(&mut self, boundary: &Boundary) {
+    fn remake_restored(&mut self, boundary: &Boundary, dipole: &[DVec3]) {
         if let Some(since) = self.restored.take() {
-            self.share(boundary);
+            self.share(boundary, dipole);
             self.since_build = since;
         }
     }
@@ -294,17 +299,30 @@ impl Domain {
         farthest
     }
 
-    /// Forwards the displacements along the build's six messages.
-    fn forward(&mut self) {
+    /// Forwards the displacements (and moments, `dipole` this rank's)
+    /// along the build's six messages.
+    fn forward(&mut self, dipole: &[DVec3]) {
         let h = &mut self.halo;
+        let n = h.reference.len();
+        h.moment.clear();
+        let width = if self.moments { 6 } else { 3 };
         for stage in &self.stages {
-            let out: Vec<f64> = stage
-                .send
-                .iter()
-                .flat_map(|&s| h.displacement[s as usize].to_array())
-                .collect();
+            let mut out = Vec::with_capacity(width * stage.send.len());
+            for &s in &stage.send {
+                let s = s as usize;
+                out.extend(h.displacement[s].to_array());
+                if self.moments {
+                    let m = if s < n { dipole[s] } else { h.moment[s - n] };
+                    out.extend(m.to_array());
+                }
+            }
             let got = self.comm.exchange(stage.to, &out, stage.from);
-            h.displacement.extend(got.chunks(3).map(DVec3::from_slice));
+            for g in got.chunks(width) {
+                h.displacement.push(DVec3::from_slice(&g[..3]));
+                if self.moments {
+                    h.moment.push(DVec3::from_slice(&g[3..6]));
+                }
+            }
         }
     }
 
@@ -315,15 +333,16 @@ impl Domain {
         }
         let b = sys.boundary;
         self.halo.reference = sys.particles.position.iter().map(|r| b.wrap(*r)).collect();
-        self.share(&b);
+        self.share(&b, &sys.particles.dipole);
     }
 
     /// Makes the build at the halo's reference positions: the ghosts,
     /// the particle count and extent every rank's grid needs.
-    fn share(&mut self, b: &Boundary) {
+    fn share(&mut self, b: &Boundary, dipole: &[DVec3]) {
         let h = &mut self.halo;
         h.displacement = vec![DVec3::ZERO; h.reference.len()];
         h.ghosts.clear();
+        h.moment.clear();
         h.total = self.comm.sum(&[h.id.len() as f64])[0] as usize;
         let lo = h.reference.iter().fold(DVec3::INFINITY, |a, r| a.min(*r));
         let hi = h
@@ -333,7 +352,7 @@ impl Domain {
         let lo = -DVec3::from_array(self.comm_max3(-lo));
         let hi = DVec3::from_array(self.comm_max3(hi));
         self.halo.extent = (lo, hi);
-        self.send_ghosts(b);
+        self.send_ghosts(b, dipole);
         self.since_build = 0;
         self.builds += 1;
         self.halo.generation += 1;
@@ -381,8 +400,11 @@ impl Domain {
         }
     }
 
-    /// The staged ghost exchange at a build (see the module's text).
-    fn send_ghosts(&mut self, boundary: &Boundary) {
+    /// The staged ghost exchange at a build (see the module's text), the
+    /// moments with the copies where interactions read them.
+    fn send_ghosts(&mut self, boundary: &Boundary, dipole: &[DVec3]) {
+        let moments = self.moments;
+        let width = if moments { 10 } else { 7 };
         let reach = self.cutoff + self.skin;
         let l = boundary.lengths();
         self.stages.clear();
@@ -426,16 +448,23 @@ impl Domain {
                         send.push(s as u32);
                         out.extend([id as f64, m[0] as f64, m[1] as f64, m[2] as f64]);
                         out.extend(at.to_array());
+                        if moments {
+                            let mu = if s < n { dipole[s] } else { h.moment[s - n] };
+                            out.extend(mu.to_array());
+                        }
                     }
                 }
                 let got = self.comm.exchange(neighbour.map(|n| n.0), &out, from);
-                for g in got.chunks(7) {
+                for g in got.chunks(width) {
                     h.ghosts.push(Ghost {
                         id: g[0] as u64,
                         image: [g[1] as i32, g[2] as i32, g[3] as i32],
                         base: DVec3::new(g[4], g[5], g[6]),
                     });
                     h.displacement.push(DVec3::ZERO);
+                    if moments {
+                        h.moment.push(DVec3::new(g[7], g[8], g[9]));
+                    }
                 }
                 self.stages.push(Stage {
                     to: neighbour.map(|n| n.0),

@@ -94,6 +94,9 @@ pub struct HaloReach {
     pub cutoff: f64,
     pub skin: f64,
     pub every: u64,
+    /// Whether it reads the ghosts' magnetic moments (forwarded with
+    /// their displacements at every evaluation: they turn).
+    pub moments: bool,
 }
 
 impl HaloReach {
@@ -102,6 +105,7 @@ impl HaloReach {
         cutoff: 0.0,
         skin: f64::INFINITY,
         every: 0,
+        moments: false,
     };
 
     /// One halo for both: the widest cut-off and skin together, rebuilt
@@ -124,6 +128,7 @@ impl HaloReach {
             cutoff: reach - skin,
             skin,
             every,
+            moments: self.moments || other.moments,
         }
     }
 }
@@ -503,7 +508,7 @@ impl ForceField {
     /// Brings a decomposed run's ghosts to `state` for a measurement.
     fn refresh_halo(&mut self, state: &State) {
         if let Some(domain) = &mut self.domain {
-            domain.refresh(state.position, state.boundary);
+            domain.refresh(state.position, state.dipole, state.boundary);
         }
     }
 

@@ -163,6 +163,18 @@ impl GhostList {
         }));
     }
 
+    /// [`GhostList::gather`] over a halo: the copies of this rank's
+    /// particles take `own`, the ghosts `ghosts` (in the halo's order).
+    pub fn gather_halo(&self, own: &[DVec3], ghosts: &[DVec3], out: &mut Vec<Copy4>) {
+        let n = own.len();
+        out.clear();
+        out.par_extend(self.particle.par_iter().with_min_len(BLOCK).map(|&i| {
+            let i = i as usize;
+            let v = if i < n { own[i] } else { ghosts[i - n] };
+            Copy4([v.x, v.y, v.z, 0.0])
+        }));
+    }
+
     /// Adds the value of each particle's row (`sorted`, in row order) to
     /// the particle's entry of `to`.
     pub fn scatter_add(&self, sorted: &[DVec3], to: &mut [DVec3]) {

@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use super::portable::pair_lanes;
 use super::{DipoleDipole, Kernel};
 use crate::boundary::Boundary;
+use crate::domain::Halo;
 use crate::neighbor::{Copy4, GhostList};
 
 /// What a row adds up: force and torque on its particle, Σ r·F and Σ U
@@ -145,16 +146,12 @@ impl DipoleDipole {
         pos: &[DVec3],
         dipoles: &[DVec3],
         boundary: &Boundary,
+        halo: Option<&Halo>,
         step: bool,
         energy: bool,
     ) -> (f64, f64) {
-        if step {
-            self.list.update(pos, boundary);
-        } else {
-            self.list.refresh(pos, boundary);
-        }
+        self.follow(pos, dipoles, boundary, halo, step);
         let list = &self.list;
-        list.gather(dipoles, &mut self.moment);
         let (kern, moment) = (self.kernel(), &self.moment);
         let isa = (self.isa, self.reference_rows);
         self.sorted.resize(pos.len(), (DVec3::ZERO, DVec3::ZERO));
@@ -163,6 +160,33 @@ impl DipoleDipole {
             ((s.force, s.torque), [s.virial, s.energy])
         });
         (0.5 * w, 0.5 * u)
+    }
+
+    /// Brings the ghost list to `pos` (a step when `step`, else a
+    /// refresh; over the halo in a decomposed run) and takes the moments
+    /// onto its copies.
+    pub(super) fn follow(
+        &mut self,
+        pos: &[DVec3],
+        dipoles: &[DVec3],
+        boundary: &Boundary,
+        halo: Option<&Halo>,
+        step: bool,
+    ) {
+        match halo {
+            Some(h) => {
+                self.list.follow_halo(h, boundary);
+                self.list.gather_halo(dipoles, &h.moment, &mut self.moment);
+            }
+            None => {
+                if step {
+                    self.list.update(pos, boundary);
+                } else {
+                    self.list.refresh(pos, boundary);
+                }
+                self.list.gather(dipoles, &mut self.moment);
+            }
+        }
     }
 
     /// Adds the rows' forces and torques to the particles'.

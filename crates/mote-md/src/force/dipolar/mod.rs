@@ -67,8 +67,9 @@ mod listed;
 mod portable;
 mod tiled;
 
-use super::{Interaction, Spin, State, ViewerHooks, Virial};
+use super::{HaloReach, Interaction, Spin, State, ViewerHooks, Virial};
 use crate::boundary::Boundary;
+use crate::domain::Halo;
 use crate::neighbor::{Copy4, GhostList};
 use crate::units::UnitSystem;
 
@@ -409,7 +410,7 @@ impl DipoleDipole {
         torque: &mut [DVec3],
     ) -> f64 {
         let boundary = self.boundary;
-        self.forces_in(pos, dipoles, &boundary, force, torque)
+        self.forces_in(pos, dipoles, &boundary, None, force, torque)
     }
 
     /// [`Self::forces_and_torques`] in `boundary`.
@@ -418,6 +419,7 @@ impl DipoleDipole {
         pos: &[DVec3],
         dipoles: &[DVec3],
         boundary: &Boundary,
+        halo: Option<&Halo>,
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) -> f64 {
@@ -426,7 +428,7 @@ impl DipoleDipole {
             // The stepping pass sums forces and torques only; the virial is
             // measured with the energy, which `Observables::measure` asks
             // for first. Until then it is not a number, never a stale one.
-            self.cut_off_rows(pos, dipoles, boundary, true, false);
+            self.cut_off_rows(pos, dipoles, boundary, halo, true, false);
             self.add_sorted(force, torque);
             f64::NAN
         } else {
@@ -439,13 +441,19 @@ impl DipoleDipole {
     /// this interaction's box).
     pub fn energy(&mut self, pos: &[DVec3], dipoles: &[DVec3]) -> f64 {
         let boundary = self.boundary;
-        self.energy_in(pos, dipoles, &boundary)
+        self.energy_in(pos, dipoles, &boundary, None)
     }
 
-    fn energy_in(&mut self, pos: &[DVec3], dipoles: &[DVec3], boundary: &Boundary) -> f64 {
+    fn energy_in(
+        &mut self,
+        pos: &[DVec3],
+        dipoles: &[DVec3],
+        boundary: &Boundary,
+        halo: Option<&Halo>,
+    ) -> f64 {
         assert_eq!(pos.len(), dipoles.len(), "one dipole per particle");
         if self.cutoff.is_finite() {
-            let (virial, energy) = self.cut_off_rows(pos, dipoles, boundary, false, true);
+            let (virial, energy) = self.cut_off_rows(pos, dipoles, boundary, halo, false, true);
             self.virial = virial;
             return energy;
         }
@@ -657,6 +665,7 @@ impl Interaction for DipoleDipole {
                 state.position,
                 state.dipole,
                 state.boundary,
+                state.halo,
                 force,
                 &mut torque,
             );
@@ -667,6 +676,22 @@ impl Interaction for DipoleDipole {
         true
     }
 
+    /// With a cut-off: its ghost list over the halo, the moments
+    /// forwarded. All pairs (open space) does not decompose (a ring of
+    /// the particle blocks would).
+    fn halo_reach(&self) -> Option<HaloReach> {
+        self.cutoff.is_finite().then_some(HaloReach {
+            cutoff: self.list.cutoff,
+            skin: self.list.skin,
+            every: self.list.every,
+            moments: true,
+        })
+    }
+
+    fn take_restored_list(&mut self) -> Option<(u64, Vec<DVec3>)> {
+        self.list.take_restored()
+    }
+
     fn add_forces_and_torques(
         &mut self,
         state: &State,
@@ -675,14 +700,21 @@ impl Interaction for DipoleDipole {
         torque: &mut [DVec3],
     ) {
         if state.dipole.len() == state.position.len() {
-            self.forces_in(state.position, state.dipole, state.boundary, force, torque);
+            self.forces_in(
+                state.position,
+                state.dipole,
+                state.boundary,
+                state.halo,
+                force,
+                torque,
+            );
         }
     }
 
     /// Σ_{i<j} U_ij (0 for a state without dipoles).
     fn potential_energy(&mut self, state: &State) -> f64 {
         if state.dipole.len() == state.position.len() {
-            self.energy_in(state.position, state.dipole, state.boundary)
+            self.energy_in(state.position, state.dipole, state.boundary, state.halo)
         } else {
             0.0
         }
@@ -702,9 +734,14 @@ impl Interaction for DipoleDipole {
         if state.dipole.len() != state.position.len() {
             return Some(Virial::default());
         }
-        self.list.refresh(state.position, state.boundary);
+        self.follow(
+            state.position,
+            state.dipole,
+            state.boundary,
+            state.halo,
+            false,
+        );
         let list = &self.list;
-        list.gather(state.dipole, &mut self.moment);
         let (kern, moment) = (self.kernel(), &self.moment);
         let xyz = |c: &Copy4| DVec3::new(c.0[0], c.0[1], c.0[2]);
         let mut rows = vec![(); list.len()];
@@ -912,6 +949,11 @@ impl Zeeman {
 impl Interaction for Zeeman {
     fn viewer(&self) -> Option<&dyn ViewerHooks> {
         Some(self)
+    }
+
+    /// A force and torque on each dipole alone.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        Some(HaloReach::NONE)
     }
 
     fn viewer_mut(&mut self) -> Option<&mut dyn ViewerHooks> {

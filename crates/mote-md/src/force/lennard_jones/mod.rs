@@ -284,6 +284,7 @@ impl Interaction for LennardJones {
             cutoff: self.cutoff,
             skin: self.list.skin,
             every: self.list.every,
+            moments: false,
         })
     }
 
