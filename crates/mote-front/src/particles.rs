@@ -195,8 +195,21 @@ impl EngineRun for PointsRun {
                     ranks.0.size()
                 );
             }
-            sim.decompose(ranks.0.clone(), None)
-                .map_err(|m| FrontError::request(format!("{label}: {m}: run it on one")))?;
+            let parallel = self.scene.parallel.as_ref();
+            let grid = parallel.and_then(|p| p.get_ref().grid);
+            sim.decompose(ranks.0.clone(), grid).map_err(|m| {
+                let at = match parallel.filter(|_| grid.is_some()) {
+                    Some(p) => {
+                        let source = mote_io::Source::new(label, &self.input.text);
+                        format!(
+                            "{label}:{}: [parallel] grid",
+                            source.line_of(p.span().start)
+                        )
+                    }
+                    None => label.to_string(),
+                };
+                FrontError::request(format!("{at}: {m}"))
+            })?;
         }
         let done = resumed.map_or(0, |cp| cp.step.min(self.total_steps));
         self.last_step = sim.system.step + (self.total_steps - done);

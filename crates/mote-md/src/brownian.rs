@@ -21,15 +21,15 @@
 //! ξ_r = 8πηa³.
 //!
 //! Random numbers are counter-based like the thermostat's
-//! (`crate::thermostat::Noise`): the normal deviates of particle block b at step k
-//! come from xoshiro256++ seeded by (seed, k, b), with blocks of a fixed
-//! size [`NOISE_BLOCK`]. A step's result therefore depends on neither the
-//! thread count nor the history (a resumed run draws the same numbers).
+//! ([`Noise`]): the normal deviates of particle i at step k come from
+//! xoshiro256++ seeded by (seed, k, id of i). A step's result therefore
+//! depends on neither the thread count, nor the number of ranks of a
+//! decomposed run, nor the history (a resumed run draws the same numbers).
 //!
 //! [`rotate`]: crate::integrate::rotate
 
 use glam::DVec3;
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_distr::StandardNormal;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
@@ -37,19 +37,7 @@ use rayon::prelude::*;
 use crate::force::{ForceField, Spin, State};
 use crate::integrate::rotate;
 use crate::particles::System;
-
-/// Particles per independent random stream.
-pub const NOISE_BLOCK: usize = 256;
-
-/// The random stream of particle block `block` at step `step` of a run with `seed`.
-pub fn block_noise(seed: u64, step: u64, block: u64) -> Xoshiro256PlusPlus {
-    Xoshiro256PlusPlus::seed_from_u64(
-        seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(17)
-            ^ (block.wrapping_add(1))
-                .wrapping_mul(0xD1B5_4A32_D192_ED03)
-                .rotate_left(41),
-    )
-}
+use crate::thermostat::Noise;
 
 /// Translational and rotational friction coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -135,36 +123,45 @@ impl BrownianStepper {
         step_index: u64,
         seed: u64,
     ) {
+        // A decomposed run's particles may migrate here, before the
+        // evaluation.
+        ff.before_forces(sys);
         self.forces_and_torques(sys, ff, h);
         let (kt, friction, turn) = (self.kt, self.friction, self.rotate);
         let (force, torque) = (&self.force, &self.torque);
+        let noise = Noise {
+            seed,
+            step: step_index,
+            ids: ff.domain.as_ref().map_or(&[], |d| &d.halo().id),
+            comm: None,
+        };
         let p = &mut sys.particles;
         let radius = &p.radius;
         let mobility = &p.mobility;
-        p.position
-            .par_chunks_mut(NOISE_BLOCK)
-            .zip(p.velocity.par_chunks_mut(NOISE_BLOCK))
-            .zip(p.angular_velocity.par_chunks_mut(NOISE_BLOCK))
-            .zip(p.dipole.par_chunks_mut(NOISE_BLOCK))
+        (
+            &mut p.position,
+            &mut p.velocity,
+            &mut p.angular_velocity,
+            &mut p.dipole,
+        )
+            .into_par_iter()
             .enumerate()
-            .for_each(|(b, (((pos, vel), omega), dip))| {
-                let mut rng = block_noise(seed, step_index, b as u64);
-                for k in 0..pos.len() {
-                    let i = b * NOISE_BLOCK + k;
-                    let zt = normal3(&mut rng);
-                    let zr = normal3(&mut rng);
-                    let (xi_t, xi_r) = friction.of(radius[i]);
-                    let drift = force[i] / xi_t;
-                    let dr = (drift * h + zt * (2.0 * kt * h / xi_t).sqrt()) * mobility[i];
-                    pos[k] += dr;
-                    vel[k] = drift * mobility[i];
-                    if turn && mobility[i] != DVec3::ZERO {
-                        let spin = torque[i] / xi_r;
-                        omega[k] = spin;
-                        if dip[k] != DVec3::ZERO {
-                            let dphi = spin * h + zr * (2.0 * kt * h / xi_r).sqrt();
-                            dip[k] = rotate(dip[k], dphi);
-                        }
+            .with_min_len(256)
+            .for_each(|(i, (pos, vel, omega, dip))| {
+                let mut rng = noise.particle(i);
+                let zt = normal3(&mut rng);
+                let zr = normal3(&mut rng);
+                let (xi_t, xi_r) = friction.of(radius[i]);
+                let drift = force[i] / xi_t;
+                let dr = (drift * h + zt * (2.0 * kt * h / xi_t).sqrt()) * mobility[i];
+                *pos += dr;
+                *vel = drift * mobility[i];
+                if turn && mobility[i] != DVec3::ZERO {
+                    let spin = torque[i] / xi_r;
+                    *omega = spin;
+                    if *dip != DVec3::ZERO {
+                        let dphi = spin * h + zr * (2.0 * kt * h / xi_r).sqrt();
+                        *dip = rotate(*dip, dphi);
                     }
                 }
             });

@@ -88,10 +88,11 @@ impl Simulation {
         grid: Option<[usize; 3]>,
     ) -> Result<(), String> {
         let ranks = comm.size();
-        let not_yet = |what: &str| Err(format!("{what} does not run on {ranks} ranks yet"));
-        if self.brownian.is_some() {
-            return not_yet("Brownian dynamics");
-        }
+        let not_yet = |what: &str| {
+            Err(format!(
+                "{what} does not run on {ranks} ranks yet: run it on one"
+            ))
+        };
         if self.stepper.scheme != crate::Integrator::LeapFrog {
             return not_yet(&format!(
                 "the {} integrator (leap-frog does)",

@@ -328,3 +328,68 @@ fn a_decomposed_dipolar_fluid_steps_as_one_process_does() {
         assert!((a.kinetic - e.kinetic).abs() < 1e-11 * e.kinetic);
     }
 }
+
+/// `examples/ferrofluid.toml`, smaller: Brownian dynamics of WCA dipoles
+/// with a reaction field in an applied field.
+const FERROFLUID: &str = r#"
+units = "lj"
+seed = 4
+
+[run]
+dt = 0.002
+steps = 300
+
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [16.284, 16.284, 16.284]
+
+[dipolar]
+cutoff = 4.0
+reaction_field = "conducting"
+wca = { epsilon = 1.0, sigma = 1.0 }
+random_orientation = true
+
+[magnetic_field]
+h = [0.0, 0.0, 0.09189]
+
+[brownian]
+kt = 1.0
+translational = 1.0
+rotational = 0.3333333333333333
+
+[[lattice]]
+n = [6, 6, 6]
+spacing = [2.714, 2.714, 2.714]
+origin = [1.357, 1.357, 1.357]
+radius = 0.5
+dipole = [0.0, 0.0, 1.7320508075688772]
+"#;
+
+/// Brownian dynamics on ranks: each particle's noise comes from its id and
+/// the step, so 3 ranks give one process's bits.
+#[test]
+fn a_decomposed_ferrofluid_diffuses_as_one_process_does() {
+    let run = |comm: Option<Arc<dyn Comm>>| {
+        let mut sim = crate::common::build(FERROFLUID).simulation;
+        assert!(sim.brownian.is_some());
+        if let Some(comm) = comm {
+            sim.decompose(comm, None).unwrap();
+        }
+        run(&mut sim);
+        match &sim.forces.domain {
+            Some(d) => d.gather(&sim.system),
+            None => Some(sim.system),
+        }
+    };
+    let one = run(None).unwrap();
+    let three = in_process(3, |comm| run(Some(comm))).remove(0).unwrap();
+    let (p, q) = (&one.particles, &three.particles);
+    assert!(p.position == q.position, "positions");
+    assert!(p.dipole == q.dipole, "moments");
+    // The noise moved every particle off its lattice site.
+    let start = crate::common::build(FERROFLUID).simulation.system;
+    let moved = (0..p.len())
+        .filter(|&i| (p.position[i] - start.particles.position[i]).length() > 1e-3)
+        .count();
+    assert_eq!(moved, p.len());
+}

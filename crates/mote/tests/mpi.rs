@@ -202,3 +202,38 @@ fn a_run_stopped_on_three_ranks_resumes_on_two() {
         at_stop.step
     );
 }
+
+/// `[parallel] grid` cuts the box as given; a grid that does not fit the
+/// ranks is refused at its line.
+#[test]
+fn the_scene_can_choose_the_bricks() {
+    let dir = tempfile::tempdir().unwrap();
+    let with_grid = |grid: &str| format!("{LIQUID}\n[parallel]\ngrid = {grid}\n");
+    std::fs::write(dir.path().join("grid.toml"), with_grid("[1, 2, 2]")).unwrap();
+    std::fs::write(dir.path().join("bad.toml"), with_grid("[3, 1, 1]")).unwrap();
+    // One process reads the table and ignores it.
+    let one = plain(&["run", "grid.toml", "-o", "one", "-q"], dir.path());
+    assert!(one.status.success(), "{}", text(&one.stderr));
+    let o = mpirun(4, &["run", "grid.toml", "-o", "grid"], dir.path());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("on 4 ranks (1 × 2 × 2 bricks)"),
+        "{}",
+        text(&o.stderr)
+    );
+    let read = |run: &str| std::fs::read(dir.path().join(run).join("trajectory.xyz")).unwrap();
+    assert!(
+        read("one") == read("grid"),
+        "the trajectory on a 1 × 2 × 2 grid"
+    );
+    let o = mpirun(2, &["run", "bad.toml", "-o", "bad"], dir.path());
+    let stderr = text(&o.stderr);
+    assert!(!o.status.success());
+    let line = LIQUID.lines().count() + 2;
+    assert!(
+        stderr.contains(&format!(
+            "bad.toml:{line}: [parallel] grid: a grid of 3×1×1 bricks for 2 ranks"
+        )),
+        "{stderr}"
+    );
+}

@@ -266,14 +266,22 @@ impl Domain {
     }
 
     /// Brings the ghosts to positions `position` (and moments `dipole`)
-    /// of this rank's particles without counting an evaluation or rebuilding (measurements between
-    /// steps, at the positions of the last evaluation).
+    /// of this rank's particles without counting an evaluation or
+    /// rebuilding (measurements between steps, at the positions of the
+    /// last evaluation; the first build where none was made).
     pub fn refresh(&mut self, position: &[DVec3], dipole: &[DVec3], boundary: &Boundary) {
         self.remake_restored(boundary, dipole);
-        if self.builds > 0 {
-            self.displace(position, boundary);
-            self.forward(dipole);
+        if self.builds == 0 {
+            // Measured before any evaluation (Brownian dynamics primes
+            // none): the particles are in their bricks since the scatter,
+            // so the first build needs no migration, as one process's
+            // list is built at its first refresh.
+            self.halo.reference = position.iter().map(|r| boundary.wrap(*r)).collect();
+            self.share(boundary, dipole);
+            return;
         }
+        self.displace(position, boundary);
+        self.forward(dipole);
     }
 
     /// Makes the build a checkpoint restored ([`Domain::scatter`]), once.

@@ -29,6 +29,7 @@ pub mod electric;
 pub mod granular;
 pub mod gravity;
 pub mod lennard_jones;
+pub mod parallel;
 pub mod particles;
 pub mod plist;
 pub mod run;
@@ -101,6 +102,8 @@ pub struct SceneFile<R> {
     pub wall: Vec<Spanned<WallSpec>>,
     #[serde(rename = "box")]
     pub bounds: Option<Spanned<BoxTable>>,
+    /// `[parallel]`: the bricks of a run on several ranks.
+    pub parallel: Option<Spanned<parallel::ParallelTable>>,
     #[serde(default)]
     pub particle: Vec<Spanned<ParticleSpec>>,
     #[serde(default)]
@@ -242,6 +245,14 @@ impl Scene {
                 r.span(),
                 "[rigid] makes rigid bodies: the scene is the rigid engine's (mote run builds it so)",
             ));
+        }
+        if let Some(p) = &self.parallel {
+            if p.get_ref().grid.is_some_and(|g| g.contains(&0)) {
+                return Err(src.error(
+                    p.span(),
+                    "[parallel] grid: every axis needs at least one brick",
+                ));
+            }
         }
         let files = (self.lammps_data.iter().map(|s| ("lammps_data", s)))
             .chain(self.from_file.iter().map(|s| ("from_file", s)));

@@ -57,6 +57,11 @@ pub(super) fn refuse(scene: &RigidScene, src: Source) -> Result<(), ParseError> 
             "rigid bodies have no thermostat",
         ),
         (
+            table(&scene.parallel),
+            "[parallel]",
+            "rigid bodies do not run on several ranks yet (docs/parallel.md)",
+        ),
+        (
             table(&scene.brownian),
             "[brownian]",
             "rigid bodies have no Brownian dynamics",
