@@ -199,15 +199,22 @@ pub(crate) fn run_engine<E: EngineRun>(
     resumed: Option<&Checkpoint>,
     monitor: &mut dyn Monitor,
 ) -> Result<Outcome, FrontError> {
-    let (seed, chosen) = crate::seed::resolve(options.seed, engine.scene_seed());
-    let chosen = chosen || engine.seed_chosen();
-    let dir = input.output_dir(options.output.as_ref(), engine.scene_dir());
-    let mut state = engine.build(seed, resumed)?;
     // On several ranks rank 0 alone takes the folder and writes; the
     // others follow its observers' schedule (their measurements and
     // frames are collective) and write nothing.
     let ranks = options.ranks.as_ref().filter(|r| r.0.size() > 1);
     let root = ranks.is_none_or(|r| r.is_root());
+    let (mut seed, chosen) = crate::seed::resolve(options.seed, engine.scene_seed());
+    if let Some(r) = ranks.filter(|_| chosen) {
+        // A seed chosen from the clock is rank 0's on every rank (each
+        // rank builds the whole scene from it), in two exact halves.
+        let halves =
+            r.0.broadcast(&[(seed >> 32) as f64, (seed & 0xFFFF_FFFF) as f64]);
+        seed = ((halves[0] as u64) << 32) | halves[1] as u64;
+    }
+    let chosen = chosen || engine.seed_chosen();
+    let dir = input.output_dir(options.output.as_ref(), engine.scene_dir());
+    let mut state = engine.build(seed, resumed)?;
     let files = RunFiles {
         dir,
         provenance: crate::provenance(&input.label, seed),

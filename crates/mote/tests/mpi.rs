@@ -237,3 +237,28 @@ fn the_scene_can_choose_the_bricks() {
         "{stderr}"
     );
 }
+
+/// A scene without a seed on several ranks: the seed rank 0 chose from the
+/// clock is every rank's (each builds the scene from it), so the run is one
+/// process's with that seed.
+#[test]
+fn a_chosen_seed_is_every_ranks() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["run", "example:ferrofluid", "--steps", "200"];
+    let o = mpirun(2, &[&args[..], &["-o", "ranks"]].concat(), dir.path());
+    let opening = text(&o.stderr);
+    assert!(o.status.success(), "{opening}");
+    let seed = opening
+        .split("seed ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .expect("the opening names the seed");
+    assert!(opening.contains("(chosen)"), "{opening}");
+    let one = plain(
+        &[&["--seed", seed], &args[..], &["-o", "one", "-q"]].concat(),
+        dir.path(),
+    );
+    assert!(one.status.success(), "{}", text(&one.stderr));
+    let read = |run: &str| std::fs::read(dir.path().join(run).join("trajectory.xyz")).unwrap();
+    assert!(read("one") == read("ranks"), "seed {seed}");
+}
