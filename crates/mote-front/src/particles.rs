@@ -295,8 +295,34 @@ impl EngineRun for PointsRun {
         report: &RunReport,
         done: &Done,
     ) -> Result<Vec<String>, FrontError> {
-        Ok(vec![summary(report, sim, &self.scene, &done.files.dir)])
+        let mut lines = vec![summary(report, sim, &self.scene, &done.files.dir)];
+        // Every rank takes part in the census; rank 0 says it.
+        if let Some(census) = sim.forces.domain.as_ref().and_then(|d| d.census()) {
+            lines.push(ranks_sentence(&census));
+        }
+        Ok(lines)
     }
+}
+
+/// "Ranks: particles 15 998–16 002 a rank (…), ghosts …, … migrated.": how a
+/// decomposed run's particles and ghosts were spread over its ranks.
+fn ranks_sentence(census: &[[u64; 3]]) -> String {
+    let range = |k: usize| {
+        let lo = census.iter().map(|c| c[k]).min().unwrap_or(0);
+        let hi = census.iter().map(|c| c[k]).max().unwrap_or(0);
+        if lo == hi {
+            format!("{lo}")
+        } else {
+            format!("{lo}–{hi}")
+        }
+    };
+    let moved: u64 = census.iter().map(|c| c[2]).sum();
+    format!(
+        "Ranks: {} particles a rank at the end, {} ghosts a rank at the last list build; \
+         {moved} particles changed rank.",
+        range(0),
+        range(1)
+    )
 }
 
 /// The tables a time-stepped run writes as it goes, by the scene's

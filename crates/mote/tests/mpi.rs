@@ -103,6 +103,10 @@ fn a_liquid_on_two_three_and_four_ranks_writes_one_process_trajectory() {
         );
         assert_eq!(stdout.matches("Ran 400 steps").count(), 1, "{stdout}");
         assert!(
+            stdout.contains("ghosts a rank at the last list build"),
+            "{stdout}"
+        );
+        assert!(
             read("one", "trajectory.xyz") == read(&run, "trajectory.xyz"),
             "the trajectory on {ranks} ranks differs from one process's"
         );
@@ -261,4 +265,22 @@ fn a_chosen_seed_is_every_ranks() {
     assert!(one.status.success(), "{}", text(&one.stderr));
     let read = |run: &str| std::fs::read(dir.path().join(run).join("trajectory.xyz")).unwrap();
     assert!(read("one") == read("ranks"), "seed {seed}");
+}
+
+/// A run that goes unstable on ranks ends every rank at one step, with
+/// the message printed once and exit status 3, the files kept.
+#[test]
+fn an_unstable_run_ends_every_rank_with_one_message() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("hot.toml"),
+        LIQUID.replace("dt = 0.005", "dt = 0.5"),
+    )
+    .unwrap();
+    let o = mpirun(3, &["run", "hot.toml", "-o", "hot"], dir.path());
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{stderr}");
+    assert_eq!(stderr.matches("error:").count(), 1, "{stderr}");
+    assert!(stderr.contains("non-finite"), "{stderr}");
+    assert!(dir.path().join("hot/observables.csv").exists());
 }

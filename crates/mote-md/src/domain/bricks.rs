@@ -33,12 +33,19 @@ impl Bricks {
         grid: Option<[usize; 3]>,
     ) -> Result<[usize; 3], String> {
         let l = boundary.lengths();
-        let fits = |d: [usize; 3]| {
-            (0..3).all(|k| {
-                let width = l[k] / d[k] as f64;
-                let needed = d[k] > 1 || boundary.periodic[k];
-                !needed || (width.is_finite() && width >= reach)
-            })
+        let fits_axis = |k: usize, p: usize| {
+            let width = l[k] / p as f64;
+            let needed = p > 1 || boundary.periodic[k];
+            !needed || (width.is_finite() && width >= reach)
+        };
+        let fits = |d: [usize; 3]| (0..3).all(|k| fits_axis(k, d[k]));
+        // The most bricks along axis k, each at least `reach` wide.
+        let most = |k: usize| {
+            if l[k].is_finite() {
+                ((l[k] / reach).floor() as usize).max(1)
+            } else {
+                1
+            }
         };
         if let Some(d) = grid {
             if d.iter().product::<usize>() != ranks {
@@ -48,10 +55,18 @@ impl Bricks {
                 ));
             }
             if !fits(d) {
+                let k = (0..3).find(|&k| !fits_axis(k, d[k])).unwrap_or(0);
                 return Err(format!(
-                    "a grid of {}×{}×{} bricks leaves a brick narrower than the \
-                     cut-off and skin ({reach})",
-                    d[0], d[1], d[2]
+                    "a grid of {}×{}×{} bricks leaves bricks {} wide along {}, narrower \
+                     than the cut-off and skin ({reach}): at most {} along {} (a brick at \
+                     least {reach} wide)",
+                    d[0],
+                    d[1],
+                    d[2],
+                    l[k] / d[k] as f64,
+                    ["x", "y", "z"][k],
+                    most(k),
+                    ["x", "y", "z"][k],
                 ));
             }
             return Ok(d);
@@ -75,8 +90,14 @@ impl Bricks {
         best.map(|(d, _)| d).ok_or_else(|| {
             format!(
                 "the box ({} × {} × {}) cannot be cut into {ranks} bricks each at \
-                 least the cut-off and skin ({reach}) wide: run on fewer ranks",
-                l.x, l.y, l.z
+                 least the cut-off and skin ({reach}) wide: it holds at most {}×{}×{} \
+                 such bricks; run on fewer ranks",
+                l.x,
+                l.y,
+                l.z,
+                most(0),
+                most(1),
+                most(2)
             )
         })
     }
@@ -170,7 +191,14 @@ mod tests {
         assert_eq!(Bricks::choose(3, &b, 2.8, None), Ok([3, 1, 1]));
         // Bricks narrower than the reach are refused.
         assert_eq!(Bricks::choose(4, &b, 6.0, None), Ok([2, 2, 1]));
-        assert!(Bricks::choose(8, &b, 11.0, None).is_err());
+        // Refused with the most the box holds.
+        let e = Bricks::choose(8, &b, 11.0, None).unwrap_err();
+        assert!(e.contains("at most 1×1×1 such bricks"), "{e}");
+        let e = Bricks::choose(4, &b, 6.0, Some([4, 1, 1])).unwrap_err();
+        assert!(
+            e.contains("bricks 5 wide along x") && e.contains("at most 3 along x"),
+            "{e}"
+        );
         assert!(Bricks::choose(4, &b, 2.0, Some([3, 1, 1])).is_err());
         // An axis without periodicity and without walls is never cut.
         let open = Boundary {

@@ -196,6 +196,23 @@ impl Domain {
         part
     }
 
+    /// Each rank's particles, ghosts (at the last build) and particles
+    /// sent away so far, at rank 0 in rank order (`None` elsewhere): the
+    /// summary's census of the decomposition.
+    pub fn census(&self) -> Option<Vec<[u64; 3]>> {
+        let mine = [
+            self.halo.id.len() as f64,
+            self.halo.ghosts.len() as f64,
+            self.migrated as f64,
+        ];
+        let all = self.comm.gather(&mine);
+        (self.comm.rank() == 0).then(|| {
+            all.iter()
+                .map(|v| [v[0] as u64, v[1] as u64, v[2] as u64])
+                .collect()
+        })
+    }
+
     /// What a checkpoint holds of the lists over the halo, in one
     /// process's form ([`GhostList::carried_state`]): evaluations since the
     /// build, then the wrapped positions there in id order. At rank 0
