@@ -118,6 +118,25 @@ fn main() -> ExitCode {
     ) {
         stop_cleanly_on_signals();
     }
+    if let Some(ranks) = launched_on_ranks() {
+        let why = if !cfg!(feature = "mpi") {
+            "this mote was built without MPI: build it with `cargo build --release --features mpi`"
+        } else if !matches!(cli.command, Command::Run(_)) {
+            "only `mote run` runs on several ranks"
+        } else {
+            ""
+        };
+        if !why.is_empty() {
+            // Said once, by rank 0.
+            let rank = ["OMPI_COMM_WORLD_RANK", "PMI_RANK"]
+                .iter()
+                .find_map(|v| std::env::var(v).ok());
+            if rank.as_deref().unwrap_or("0") == "0" {
+                tell!("error: started on {ranks} ranks, but {why}");
+            }
+            return ended(ExitCode::FAILURE);
+        }
+    }
     let global = cli.global;
     let pool = global.threads();
     let command = move || match cli.command {
@@ -143,6 +162,16 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     })
+}
+
+/// The number of ranks `mpirun` started this process among, where more
+/// than one (OpenMPI's `OMPI_COMM_WORLD_SIZE`, MPICH's `PMI_SIZE`): each
+/// would otherwise run the whole command on its own, into the same files.
+fn launched_on_ranks() -> Option<usize> {
+    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok()?.parse::<usize>().ok())
+        .filter(|&n| n > 1)
 }
 
 /// The exit status: `code`, or 1 with a one-line message (if stderr can

@@ -140,6 +140,16 @@ fn what_does_not_decompose_yet_is_refused_by_name() {
         "{stderr}"
     );
     assert!(stderr.contains("gravity"), "{stderr}");
+    let o = mpirun(2, &["examples"], dir.path());
+    assert!(!o.status.success());
+    let stderr = text(&o.stderr);
+    assert_eq!(
+        stderr
+            .matches("only `mote run` runs on several ranks")
+            .count(),
+        1,
+        "{stderr}"
+    );
     for (example, what) in [
         ("example:cube", "an event-driven scene"),
         ("example:clumps-settling", "rigid clumps"),
