@@ -54,6 +54,41 @@ struct Sums {
     wall_forces: Vec<(String, DVec3)>,
 }
 
+impl Sums {
+    /// The sums of a decomposed run's ranks, added in rank order (the same
+    /// bits on every rank).
+    fn over_ranks(self, comm: &dyn mote_run::comm::Comm) -> Self {
+        let mut local = vec![
+            self.kinetic,
+            self.rotational,
+            self.potential,
+            self.free,
+            self.count,
+        ];
+        local.extend(self.momentum.to_array());
+        local.extend(self.angular_momentum.to_array());
+        local.extend(self.magnetisation.to_array());
+        local.push(self.virial.unwrap_or(f64::NAN));
+        local.extend(self.tensor.map_or([f64::NAN; 6], |t| t.0));
+        let total = comm.sum(&local);
+        Self {
+            kinetic: total[0],
+            rotational: total[1],
+            potential: total[2],
+            free: total[3],
+            count: total[4],
+            momentum: DVec3::from_slice(&total[5..8]),
+            angular_momentum: DVec3::from_slice(&total[8..11]),
+            magnetisation: DVec3::from_slice(&total[11..14]),
+            virial: self.virial.map(|_| total[14]),
+            tensor: self
+                .tensor
+                .map(|_| Virial(total[15..21].try_into().expect("six"))),
+            wall_forces: self.wall_forces,
+        }
+    }
+}
+
 impl Observables {
     pub fn total_energy(&self) -> f64 {
         self.kinetic + self.potential
@@ -78,10 +113,10 @@ impl Observables {
             angular_momentum += iw;
         }
         let state = State::of(sys, &p.position, &p.velocity, sys.time, 0.0);
-        let (mut potential, _) = ff.potential_energy(&state);
+        let (potential, _) = ff.potential_energy(&state);
         let periodic =
             sys.boundary.periodic.iter().all(|p| *p) && sys.boundary.volume().is_finite();
-        let mut virial = ff.virial().filter(|_| periodic);
+        let virial = ff.virial().filter(|_| periodic);
         let mut tensor = None;
         if ff.pressure_tensor && virial.is_some_and(f64::is_finite) {
             if let Some(w) = ff.virial_tensor(&state) {
@@ -92,63 +127,29 @@ impl Observables {
                 tensor = Some(kinetic + w);
             }
         }
-        let mut magnetisation: DVec3 = p.dipole.iter().sum();
-        let free: f64 = p.mobility.iter().map(|m| m.x + m.y + m.z).sum();
-        let mut count = p.len() as f64;
-        if let Some(domain) = &ff.domain {
-            // A decomposed run: every rank's sums, added in rank order.
-            let mut local = vec![kinetic, rotational, potential, free, count];
-            local.extend(momentum.to_array());
-            local.extend(angular_momentum.to_array());
-            local.extend(magnetisation.to_array());
-            local.push(virial.unwrap_or(f64::NAN));
-            local.extend(tensor.map_or([f64::NAN; 6], |t| t.0));
-            let total = domain.comm().sum(&local);
-            [kinetic, rotational, potential, count] = [total[0], total[1], total[2], total[4]];
-            let free_total = total[3];
-            momentum = DVec3::from_slice(&total[5..8]);
-            angular_momentum = DVec3::from_slice(&total[8..11]);
-            magnetisation = DVec3::from_slice(&total[11..14]);
-            virial = virial.map(|_| total[14]);
-            tensor = tensor.map(|_| Virial(total[15..21].try_into().expect("six")));
-            return Self::from_sums(
-                sys,
-                Sums {
-                    kinetic,
-                    rotational,
-                    potential,
-                    momentum,
-                    angular_momentum,
-                    magnetisation,
-                    virial,
-                    tensor,
-                    free: free_total,
-                    count,
-                    wall_forces: Vec::new(),
-                },
-            );
-        }
-        Self::from_sums(
-            sys,
-            Sums {
-                kinetic,
-                rotational,
-                potential,
-                momentum,
-                angular_momentum,
-                magnetisation,
-                virial,
-                tensor,
-                free,
-                count,
-                wall_forces: ff
-                    .interactions
-                    .iter()
-                    .filter_map(|i| i.viewer())
-                    .flat_map(|v| v.wall_forces())
-                    .collect(),
-            },
-        )
+        let sums = Sums {
+            kinetic,
+            rotational,
+            potential,
+            momentum,
+            angular_momentum,
+            magnetisation: p.dipole.iter().sum(),
+            virial,
+            tensor,
+            free: p.mobility.iter().map(|m| m.x + m.y + m.z).sum(),
+            count: p.len() as f64,
+            wall_forces: ff
+                .interactions
+                .iter()
+                .filter_map(|i| i.viewer())
+                .flat_map(|v| v.wall_forces())
+                .collect(),
+        };
+        let sums = match &ff.domain {
+            Some(domain) => sums.over_ranks(domain.comm()),
+            None => sums,
+        };
+        Self::from_sums(sys, sums)
     }
 
     /// The observables of the whole system's sums.

@@ -129,6 +129,19 @@ impl System {
         }
     }
 
+    /// The same box, time and step, without particles.
+    pub fn without_particles(&self) -> System {
+        System {
+            particles: Particles::default(),
+            boundary: self.boundary,
+            time: self.time,
+            step: self.step,
+            carried_acceleration: Vec::new(),
+            carried_angular_acceleration: Vec::new(),
+            species: Vec::new(),
+        }
+    }
+
     /// Keeps the particles where `keep` is true, in order, with all they
     /// carry (a decomposed run's particles leaving this rank).
     pub(crate) fn retain_particles(&mut self, keep: &[bool]) {

@@ -55,6 +55,15 @@ fn run(sim: &mut Simulation) -> (Observables, Observables) {
     (first, sim.measure())
 }
 
+/// The whole system at the end: gathered at rank 0 of a decomposed run
+/// (`None` on the others), or one process's own.
+fn whole(sim: Simulation) -> Option<System> {
+    match &sim.forces.domain {
+        Some(d) => d.gather(&sim.system),
+        None => Some(sim.system),
+    }
+}
+
 /// What one rank of a decomposed run ends with: the whole system (at rank
 /// 0), the observables, and the list builds.
 fn decomposed(
@@ -185,10 +194,7 @@ fn checkpoints_of_a_decomposed_run_resume_on_any_number_of_ranks() {
             for _ in HALF..STEPS {
                 sim.advance().unwrap();
             }
-            match &sim.forces.domain {
-                Some(d) => d.gather(&sim.system),
-                None => Some(sim.system.clone()),
-            }
+            whole(sim)
         });
         let whole = out[0].as_ref().unwrap();
         let differ = (0..end.len())
@@ -231,10 +237,7 @@ fn thermostatted_liquids_decompose() {
                 sim.decompose(comm, None).unwrap();
             }
             run(&mut sim);
-            match &sim.forces.domain {
-                Some(d) => d.gather(&sim.system),
-                None => Some(sim.system),
-            }
+            whole(sim)
         };
         let one = run(None).unwrap();
         let three = in_process(3, |comm| run(Some(comm))).remove(0).unwrap();
@@ -301,11 +304,7 @@ fn a_decomposed_dipolar_fluid_steps_as_one_process_does() {
             sim.decompose(comm, None).unwrap();
         }
         let (first, last) = run(&mut sim);
-        let whole = match &sim.forces.domain {
-            Some(d) => d.gather(&sim.system),
-            None => Some(sim.system),
-        };
-        (whole, first, last)
+        (whole(sim), first, last)
     };
     let (one, first, last) = run(None);
     let one = one.unwrap();
@@ -376,10 +375,7 @@ fn a_decomposed_ferrofluid_diffuses_as_one_process_does() {
             sim.decompose(comm, None).unwrap();
         }
         run(&mut sim);
-        match &sim.forces.domain {
-            Some(d) => d.gather(&sim.system),
-            None => Some(sim.system),
-        }
+        whole(sim)
     };
     let one = run(None).unwrap();
     let three = in_process(3, |comm| run(Some(comm))).remove(0).unwrap();

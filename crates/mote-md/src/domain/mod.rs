@@ -167,6 +167,9 @@ impl Domain {
         self.species = distinct(&whole.species);
         let b = &whole.boundary;
         let n = whole.particles.len();
+        // A build for another number of particles is not this run's: the
+        // list is then built afresh, as one process builds it.
+        let restored = restored.filter(|(_, reference)| reference.len() == n);
         let at = |i: usize| match &restored {
             Some((_, reference)) => reference[i],
             None => b.wrap(whole.particles.position[i]),
@@ -174,13 +177,7 @@ impl Domain {
         let mine: Vec<usize> = (0..n)
             .filter(|&i| self.bricks.owner(at(i)) == self.comm.rank())
             .collect();
-        let mut part = System {
-            particles: Default::default(),
-            carried_acceleration: Vec::new(),
-            carried_angular_acceleration: Vec::new(),
-            species: Vec::new(),
-            ..whole.clone()
-        };
+        let mut part = whole.without_particles();
         self.halo = Halo {
             total: n,
             ..Halo::default()
@@ -249,13 +246,7 @@ impl Domain {
         }
         let mut rows: Vec<&[f64]> = all.iter().flat_map(|v| v.chunks(CARRIED)).collect();
         rows.sort_by_key(|r| r[0] as u64);
-        let mut whole = System {
-            particles: Default::default(),
-            carried_acceleration: Vec::new(),
-            carried_angular_acceleration: Vec::new(),
-            species: Vec::new(),
-            ..part.clone()
-        };
+        let mut whole = part.without_particles();
         for r in rows {
             unpack(&mut whole, r, &self.species);
         }
