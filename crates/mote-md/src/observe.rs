@@ -155,13 +155,7 @@ impl Observables {
     /// The observables of the whole system's sums.
     fn from_sums(sys: &System, s: Sums) -> Self {
         let translational = s.kinetic;
-        // Translation's degrees of freedom: the free axes, less the three
-        // of total momentum when nothing is fixed.
-        let nf = if s.free == 3.0 * s.count && s.count > 1.0 {
-            s.free - 3.0
-        } else {
-            s.free
-        };
+        let nf = crate::particles::translational_freedom(s.free, s.count);
         let volume = sys.boundary.volume();
         let pressure = s
             .virial

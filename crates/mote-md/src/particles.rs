@@ -187,11 +187,7 @@ impl System {
     pub fn degrees_of_freedom(&self) -> f64 {
         let p = &self.particles;
         let free: f64 = p.mobility.iter().map(|m| m.x + m.y + m.z).sum();
-        if free == 3.0 * p.len() as f64 && p.len() > 1 {
-            free - 3.0
-        } else {
-            free
-        }
+        translational_freedom(free, p.len() as f64)
     }
 
     /// Moves to the centre-of-mass frame: subtracts the mass-weighted mean
@@ -218,5 +214,16 @@ impl System {
             / m_tot;
         p.position.iter_mut().for_each(|r| *r -= r_cm);
         p.velocity.iter_mut().for_each(|v| *v -= v_cm);
+    }
+}
+
+/// Degrees of freedom of translation of `count` particles with `free`
+/// free axes in all: less the three of total momentum when nothing is
+/// fixed (the sums may be a decomposed run's, over its ranks).
+pub fn translational_freedom(free: f64, count: f64) -> f64 {
+    if free == 3.0 * count && count > 1.0 {
+        free - 3.0
+    } else {
+        free
     }
 }

@@ -114,11 +114,7 @@ impl Thermostat {
                     let free: f64 = p.mobility.iter().map(|m| m.x + m.y + m.z).sum();
                     let total = comm.sum(&[k, free, p.len() as f64]);
                     k = total[0];
-                    nf = if total[1] == 3.0 * total[2] && total[2] > 1.0 {
-                        total[1] - 3.0
-                    } else {
-                        total[1]
-                    };
+                    nf = crate::particles::translational_freedom(total[1], total[2]);
                 }
                 if k <= 0.0 || nf < 1.0 {
                     return;
