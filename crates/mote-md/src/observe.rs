@@ -70,7 +70,9 @@ impl Sums {
         local.extend(self.magnetisation.to_array());
         local.push(self.virial.unwrap_or(f64::NAN));
         local.extend(self.tensor.map_or([f64::NAN; 6], |t| t.0));
+        local.extend(self.wall_forces.iter().flat_map(|w| w.1.to_array()));
         let total = comm.sum(&local);
+        let walls = total[21..].chunks(3).map(DVec3::from_slice);
         Self {
             kinetic: total[0],
             rotational: total[1],
@@ -84,7 +86,12 @@ impl Sums {
             tensor: self
                 .tensor
                 .map(|_| Virial(total[15..21].try_into().expect("six"))),
-            wall_forces: self.wall_forces,
+            wall_forces: self
+                .wall_forces
+                .into_iter()
+                .zip(walls)
+                .map(|(w, f)| (w.0, f))
+                .collect(),
         }
     }
 }

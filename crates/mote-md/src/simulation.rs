@@ -103,8 +103,8 @@ impl Simulation {
             Ok(reach) => reach,
             Err(names) => {
                 return not_yet(&format!(
-                    "{} (Lennard-Jones/WCA, cut-off dipoles, applied and uniform fields and \
-                     damping do)",
+                    "{} (Lennard-Jones/WCA, cut-off dipoles, granular contacts and walls, \
+                     applied and uniform fields and damping do)",
                     names.join(", ")
                 ))
             }
@@ -118,7 +118,7 @@ impl Simulation {
             .iter_mut()
             .filter_map(|i| i.take_restored_list())
             .next();
-        self.system = domain.scatter(&self.system, restored);
+        self.system = domain.scatter(&self.system, restored, &mut self.forces.interactions);
         self.forces.domain = Some(domain);
         Ok(())
     }
@@ -318,6 +318,27 @@ impl mote_run::Propagator for Simulation {
             // resumes from it on any number of ranks, or on one process.
             let whole = domain.gather(&self.system);
             let lists = domain.carried_state();
+            // Every rank's rows of what the interactions carry per
+            // particle, at rank 0 in one process's order.
+            let rows: Vec<Option<Vec<f64>>> = self
+                .forces
+                .interactions
+                .iter()
+                .map(|i| {
+                    let mine = i.carried_rows(&domain.halo().id)?;
+                    let all = domain.comm().gather(&mine.rows);
+                    let mut rows: Vec<&[f64]> =
+                        all.iter().flat_map(|r| r.chunks(mine.width)).collect();
+                    rows.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+                    Some(
+                        mine.head
+                            .iter()
+                            .chain(rows.into_iter().flatten())
+                            .copied()
+                            .collect(),
+                    )
+                })
+                .collect();
             let Some(whole) = whole else {
                 return Ok(());
             };
@@ -325,8 +346,10 @@ impl mote_run::Propagator for Simulation {
             let carried: Vec<(String, Vec<f64>)> = keys
                 .into_iter()
                 .zip(&self.forces.interactions)
-                .map(|(key, i)| match i.halo_reach() {
-                    Some(r) if r != crate::force::HaloReach::NONE => {
+                .zip(rows)
+                .map(|((key, i), rows)| match (rows, i.halo_reach()) {
+                    (Some(rows), _) => (key, rows),
+                    (None, Some(r)) if r != crate::force::HaloReach::NONE => {
                         (key, lists.clone().unwrap_or_default())
                     }
                     _ => (key, i.carried_state()),

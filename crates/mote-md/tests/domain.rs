@@ -47,9 +47,14 @@ fn simulation(system: System) -> Simulation {
 
 /// Steps `sim` STEPS times; returns the observables at the start and end.
 fn run(sim: &mut Simulation) -> (Observables, Observables) {
+    run_for(sim, STEPS)
+}
+
+/// Steps `sim` `steps` times; returns the observables at the start and end.
+fn run_for(sim: &mut Simulation, steps: usize) -> (Observables, Observables) {
     sim.prime(&mut |_| {}).unwrap();
     let first = sim.measure();
-    for _ in 0..STEPS {
+    for _ in 0..steps {
         sim.advance().unwrap();
     }
     (first, sim.measure())
@@ -388,4 +393,178 @@ fn a_decomposed_ferrofluid_diffuses_as_one_process_does() {
         .filter(|&i| (p.position[i] - start.particles.position[i]).length() > 1e-3)
         .count();
     assert_eq!(moved, p.len());
+}
+
+/// Spheres falling onto a floor in a box periodic across: Hertz–Mindlin
+/// contacts with friction and rolling resistance (their histories) and
+/// the floor's, under gravity.
+const GRANULAR: &str = r#"
+units = "si"
+seed = 5
+
+[run]
+integrator = "leapfrog"
+dt = 1e-5
+
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [0.024, 0.024, 0.06]
+periodic = [true, true, false]
+
+[field]
+g = [0.0, 0.0, -200.0]
+
+[granular]
+young = 1e6
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+rolling_friction = 0.05
+skin = 0.0005
+
+[[wall]]
+kind = "plane"
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+
+[[cloud]]
+n = 600
+min = [0.0, 0.0, 0.0]
+max = [0.024, 0.024, 0.05]
+radius = 0.001
+spread = 0.2
+density = 2500.0
+"#;
+
+/// A granular bed on 2, 3 and 4 ranks lands as in one process, to the
+/// bit: the contacts' histories travel with their particles, every
+/// contact is evaluated from its lower id's side wherever it is, and each
+/// particle adds its contacts in its partners' order.
+#[test]
+fn a_decomposed_granular_bed_settles_as_one_process_does() {
+    let run = |comm: Option<Arc<dyn Comm>>, grid: Option<[usize; 3]>| {
+        let mut sim = crate::common::build(GRANULAR).simulation;
+        if let Some(comm) = comm {
+            sim.decompose(comm, grid).unwrap();
+        }
+        let (first, last) = run_for(&mut sim, 1200);
+        // The touching pairs, each counted on one rank.
+        let granular = sim
+            .forces
+            .interactions
+            .iter()
+            .find(|i| i.name() == "granular")
+            .unwrap();
+        let counts = match &sim.forces.domain {
+            Some(d) => {
+                let rows = granular.carried_rows(&d.halo().id).unwrap();
+                let contacts = (rows.rows.len() / rows.width) as f64;
+                d.comm().sum(&[contacts, d.migrated as f64])
+            }
+            None => vec![(granular.carried_state().len() / 8) as f64, 0.0],
+        };
+        (whole(sim), first, last, counts)
+    };
+    let (one, first, last, counts) = run(None, None);
+    let p = &one.unwrap().particles;
+    // The bed formed: many contacts, the floor's among them.
+    assert!(counts[0] > 200.0, "{} contacts", counts[0]);
+    assert!(last.wall_forces[0].1.z < -0.1 * p.mass.iter().sum::<f64>() * 200.0);
+    for (ranks, grid) in [(2, None), (3, None), (4, Some([2, 2, 1]))] {
+        let (q, f, l, c) = in_process(ranks, |comm| run(Some(comm), grid)).remove(0);
+        let q = &q.unwrap().particles;
+        let what = format!("{ranks} ranks, grid {grid:?}");
+        assert!(c[1] > 0.0, "{what}: no particle changed rank");
+        assert_eq!(c[0], counts[0], "{what}: contacts");
+        assert!(p.position == q.position, "{what}: positions");
+        assert!(p.velocity == q.velocity, "{what}: velocities");
+        assert!(p.angular_velocity == q.angular_velocity, "{what}: spins");
+        for (a, e) in [(&f, &first), (&l, &last)] {
+            assert!((a.potential - e.potential).abs() <= 1e-11 * e.potential.abs());
+            assert!((a.kinetic - e.kinetic).abs() <= 1e-11 * e.kinetic);
+            let (fa, fe) = (a.wall_forces[0].1, e.wall_forces[0].1);
+            assert!((fa - fe).length() <= 1e-11 * fe.length(), "{what}: floor");
+        }
+    }
+}
+
+/// Puts a checkpoint's state into the simulation of scene `text`, as the
+/// front's resume does (positions, velocities, spins, the carried
+/// accelerations and what each interaction carries, by its key).
+fn resume_scene(text: &str, cp: &mote_io::checkpoint::Checkpoint) -> Simulation {
+    let mut sim = crate::common::build(text).simulation;
+    let sys = &mut sim.system;
+    sys.time = cp.time;
+    sys.step = cp.step;
+    for (i, (r, v)) in cp.positions.iter().zip(&cp.velocities).enumerate() {
+        sys.particles.position[i] = DVec3::from(*r);
+        sys.particles.velocity[i] = DVec3::from(*v);
+    }
+    sys.carried_acceleration = cp.accelerations.iter().map(|a| DVec3::from(*a)).collect();
+    sys.carried_angular_acceleration.clear();
+    for (i, a) in cp.angular.iter().enumerate() {
+        sys.particles.angular_velocity[i] = DVec3::new(a[0], a[1], a[2]);
+        sys.carried_angular_acceleration
+            .push(DVec3::new(a[3], a[4], a[5]));
+    }
+    let keys = sim.forces.carried_keys();
+    for (key, values) in &cp.carried {
+        let k = keys.iter().position(|x| x == key).unwrap();
+        sim.forces.interactions[k]
+            .restore_carried_state(values)
+            .unwrap();
+    }
+    sim
+}
+
+/// A granular bed's checkpoint written on 2 ranks is one process's (the
+/// contact histories of spheres and of the floor among it) and resumes
+/// on 1 and 3 ranks to the end of the uninterrupted run, to the bit.
+#[test]
+fn a_granular_checkpoint_of_two_ranks_resumes_on_one_and_three() {
+    const HALF: usize = 600;
+    let mut one = crate::common::build(GRANULAR).simulation;
+    let plain = checkpoint_at(&mut one, HALF);
+    for _ in HALF..2 * HALF {
+        one.advance().unwrap();
+    }
+    let end = one.system.particles;
+    let taken = in_process(2, |comm| {
+        let mut sim = crate::common::build(GRANULAR).simulation;
+        sim.decompose(comm, None).unwrap();
+        checkpoint_at(&mut sim, HALF)
+    });
+    let cp = &taken[0];
+    assert_eq!(cp.positions, plain.positions);
+    assert_eq!(cp.angular, plain.angular);
+    let carried = |c: &mote_io::checkpoint::Checkpoint, key: &str| {
+        let v = &c.carried.iter().find(|k| k.0 == key).unwrap().1;
+        // Past the head (NaN, which no comparison equals).
+        v[1..].to_vec()
+    };
+    for key in ["granular", "walls"] {
+        let rows = carried(cp, key);
+        assert!(rows.len() > 50, "{key}: {} numbers", rows.len());
+        assert_eq!(rows, carried(&plain, key), "{key}");
+    }
+    for ranks in [1, 3] {
+        let out = in_process(ranks, |comm| {
+            let mut sim = resume_scene(GRANULAR, cp);
+            if ranks > 1 {
+                sim.decompose(comm, None).unwrap();
+            }
+            sim.prime(&mut |_| {}).unwrap();
+            for _ in HALF..2 * HALF {
+                sim.advance().unwrap();
+            }
+            whole(sim)
+        });
+        let q = &out[0].as_ref().unwrap().particles;
+        assert!(q.position == end.position, "positions, resumed on {ranks}");
+        assert!(
+            q.angular_velocity == end.angular_velocity,
+            "spins, resumed on {ranks}"
+        );
+    }
 }

@@ -28,7 +28,7 @@ use glam::DVec3;
 use mote_run::comm::Comm;
 
 use crate::boundary::Boundary;
-use crate::force::HaloReach;
+use crate::force::{HaloReach, Interaction};
 use crate::particles::System;
 pub use bricks::Bricks;
 
@@ -61,11 +61,88 @@ pub struct Halo {
     pub displacement: Vec<DVec3>,
     /// The ghosts' magnetic moments now (where an interaction reads them).
     pub moment: Vec<DVec3>,
+    /// The ghosts' motion now (where an interaction reads it).
+    pub motion: Vec<Motion>,
     /// The number of particles on all ranks.
     pub total: usize,
     /// The smallest and largest wrapped coordinates of all particles at the
     /// build: the cell grid of an open axis spans them.
     pub extent: (DVec3, DVec3),
+}
+
+/// What contacts read of a ghost's particle (granular contacts: the
+/// relative velocity at the contact point), as its rank holds it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Motion {
+    /// The position as the particle's rank holds it (not wrapped, not
+    /// shifted by the image: a contact takes the minimum image, as one
+    /// process does).
+    pub position: DVec3,
+    pub velocity: DVec3,
+    /// The angular velocity ω.
+    pub spin: DVec3,
+    pub radius: f64,
+    pub mass: f64,
+}
+
+impl Motion {
+    /// Numbers per motion in a message.
+    const WIDTH: usize = 11;
+
+    fn write(&self, out: &mut Vec<f64>) {
+        out.extend(self.position.to_array());
+        out.extend(self.velocity.to_array());
+        out.extend(self.spin.to_array());
+        out.extend([self.radius, self.mass]);
+    }
+
+    fn read(g: &[f64]) -> Self {
+        Self {
+            position: DVec3::from_slice(&g[0..3]),
+            velocity: DVec3::from_slice(&g[3..6]),
+            spin: DVec3::from_slice(&g[6..9]),
+            radius: g[9],
+            mass: g[10],
+        }
+    }
+}
+
+/// This rank's particles as the ghosts copy them: positions, velocities
+/// and angular velocities at the evaluation (spins empty: at rest, as a
+/// measurement, which reads none, takes them), radii, masses and moments.
+#[derive(Clone, Copy)]
+pub struct Sources<'a> {
+    pub position: &'a [DVec3],
+    pub velocity: &'a [DVec3],
+    pub spin: &'a [DVec3],
+    pub radius: &'a [f64],
+    pub mass: &'a [f64],
+    pub dipole: &'a [DVec3],
+}
+
+impl<'a> Sources<'a> {
+    /// The particles of `sys` as they stand.
+    pub fn of(sys: &'a System) -> Self {
+        let p = &sys.particles;
+        Self {
+            position: &p.position,
+            velocity: &p.velocity,
+            spin: &p.angular_velocity,
+            radius: &p.radius,
+            mass: &p.mass,
+            dipole: &p.dipole,
+        }
+    }
+
+    fn motion(&self, i: usize) -> Motion {
+        Motion {
+            position: self.position[i],
+            velocity: self.velocity[i],
+            spin: self.spin.get(i).copied().unwrap_or_default(),
+            radius: self.radius.get(i).copied().unwrap_or_default(),
+            mass: self.mass[i],
+        }
+    }
 }
 
 /// One of the six messages of a ghost exchange: what goes to one face
@@ -89,6 +166,8 @@ pub struct Domain {
     pub every: u64,
     /// Forward the ghosts' magnetic moments with their displacements.
     moments: bool,
+    /// Forward the ghosts' [`Motion`] with their displacements.
+    motion: bool,
     halo: Halo,
     stages: Vec<Stage>,
     since_build: u64,
@@ -133,6 +212,7 @@ impl Domain {
             skin,
             every: reach.every,
             moments: reach.moments,
+            motion: reach.motion,
             halo: Halo::default(),
             stages: Vec::new(),
             since_build: 0,
@@ -162,8 +242,14 @@ impl Domain {
     /// what they carry. With `restored` (a checkpoint's list: evaluations
     /// since its build and the particles' wrapped positions there, by id),
     /// the bricks hold the particles where they stood at that build, which
-    /// is remade at the first evaluation, as one process remakes it.
-    pub fn scatter(&mut self, whole: &System, restored: Option<(u64, Vec<DVec3>)>) -> System {
+    /// is remade at the first evaluation, as one process remakes it. The
+    /// `interactions` keep what they hold of this rank's particles.
+    pub fn scatter(
+        &mut self,
+        whole: &System,
+        restored: Option<(u64, Vec<DVec3>)>,
+        interactions: &mut [Box<dyn Interaction>],
+    ) -> System {
         self.species = distinct(&whole.species);
         let b = &whole.boundary;
         let n = whole.particles.len();
@@ -177,6 +263,11 @@ impl Domain {
         let mine: Vec<usize> = (0..n)
             .filter(|&i| self.bricks.owner(at(i)) == self.comm.rank())
             .collect();
+        let mut keep = vec![false; n];
+        mine.iter().for_each(|&i| keep[i] = true);
+        for interaction in interactions {
+            interaction.retain_particles(&keep);
+        }
         let mut part = whole.without_particles();
         self.halo = Halo {
             total: n,
@@ -259,43 +350,46 @@ impl Domain {
     /// half the skin, a rebuild is due, or none was made (the one-process
     /// rule of [`GhostList`](crate::neighbor::GhostList)); else the
     /// displacements forwarded to the ghosts. Returns whether it rebuilt.
-    pub fn prepare(&mut self, sys: &mut System) -> bool {
-        self.remake_restored(&sys.boundary, &sys.particles.dipole);
+    /// Particles that migrate take with them what the `interactions` keep
+    /// of them ([`Interaction::pack_particle`]).
+    pub fn prepare(&mut self, sys: &mut System, interactions: &mut [Box<dyn Interaction>]) -> bool {
+        self.remake_restored(&sys.boundary, &Sources::of(sys));
         self.since_build += 1;
         let due = self.every > 0 && self.since_build >= self.every;
         let farthest = self.displace(&sys.particles.position, &sys.boundary);
         let farthest = self.comm.max(farthest);
         if self.builds == 0 || due || farthest > 0.25 * self.skin * self.skin {
-            self.build(sys);
+            self.build(sys, interactions);
             return true;
         }
-        self.forward(&sys.particles.dipole);
+        self.forward(&Sources::of(sys));
         false
     }
 
-    /// Brings the ghosts to positions `position` (and moments `dipole`)
-    /// of this rank's particles without counting an evaluation or
-    /// rebuilding (measurements between steps, at the positions of the
-    /// last evaluation; the first build where none was made).
-    pub fn refresh(&mut self, position: &[DVec3], dipole: &[DVec3], boundary: &Boundary) {
-        self.remake_restored(boundary, dipole);
+    /// Brings the ghosts to this rank's particles `own` without counting
+    /// an evaluation or rebuilding (measurements between steps, at the
+    /// positions of the last evaluation; the first build where none was
+    /// made).
+    pub fn refresh(&mut self, own: &Sources, boundary: &Boundary) {
+        self.remake_restored(boundary, own);
+        let position = own.position;
         if self.builds == 0 {
             // Measured before any evaluation (Brownian dynamics primes
             // none): the particles are in their bricks since the scatter,
             // so the first build needs no migration, as one process's
             // list is built at its first refresh.
             self.halo.reference = position.iter().map(|r| boundary.wrap(*r)).collect();
-            self.share(boundary, dipole);
+            self.share(boundary, own);
             return;
         }
         self.displace(position, boundary);
-        self.forward(dipole);
+        self.forward(own);
     }
 
     /// Makes the build a checkpoint restored ([`Domain::scatter`]), once.
-    fn remake_restored(&mut self, boundary: &Boundary, dipole: &[DVec3]) {
+    fn remake_restored(&mut self, boundary: &Boundary, own: &Sources) {
         if let Some(since) = self.restored.take() {
-            self.share(boundary, dipole);
+            self.share(boundary, own);
             self.since_build = since;
         }
     }
@@ -315,50 +409,48 @@ impl Domain {
         farthest
     }
 
-    /// Forwards the displacements (and moments, `dipole` this rank's)
-    /// along the build's six messages.
-    fn forward(&mut self, dipole: &[DVec3]) {
+    /// Forwards the displacements (and moments and motion, where read,
+    /// `own` this rank's) along the build's six messages.
+    fn forward(&mut self, own: &Sources) {
         let h = &mut self.halo;
         let n = h.reference.len();
         h.moment.clear();
-        let width = if self.moments { 6 } else { 3 };
+        h.motion.clear();
+        let extra = Extra::new(self.moments, self.motion);
+        let width = 3 + extra.width();
         for stage in &self.stages {
             let mut out = Vec::with_capacity(width * stage.send.len());
             for &s in &stage.send {
                 let s = s as usize;
                 out.extend(h.displacement[s].to_array());
-                if self.moments {
-                    let m = if s < n { dipole[s] } else { h.moment[s - n] };
-                    out.extend(m.to_array());
-                }
+                extra.write(s, n, own, h, &mut out);
             }
             let got = self.comm.exchange(stage.to, &out, stage.from);
             for g in got.chunks(width) {
                 h.displacement.push(DVec3::from_slice(&g[..3]));
-                if self.moments {
-                    h.moment.push(DVec3::from_slice(&g[3..6]));
-                }
+                extra.read(&g[3..], h);
             }
         }
     }
 
     /// Migrates the particles that left the brick, then sends the ghosts.
-    fn build(&mut self, sys: &mut System) {
+    fn build(&mut self, sys: &mut System, interactions: &mut [Box<dyn Interaction>]) {
         for k in 0..3 {
-            self.migrate(sys, k);
+            self.migrate(sys, k, interactions);
         }
         let b = sys.boundary;
         self.halo.reference = sys.particles.position.iter().map(|r| b.wrap(*r)).collect();
-        self.share(&b, &sys.particles.dipole);
+        self.share(&b, &Sources::of(sys));
     }
 
     /// Makes the build at the halo's reference positions: the ghosts,
     /// the particle count and extent every rank's grid needs.
-    fn share(&mut self, b: &Boundary, dipole: &[DVec3]) {
+    fn share(&mut self, b: &Boundary, own: &Sources) {
         let h = &mut self.halo;
         h.displacement = vec![DVec3::ZERO; h.reference.len()];
         h.ghosts.clear();
         h.moment.clear();
+        h.motion.clear();
         h.total = self.comm.sum(&[h.id.len() as f64])[0] as usize;
         let lo = h.reference.iter().fold(DVec3::INFINITY, |a, r| a.min(*r));
         let hi = h
@@ -368,7 +460,7 @@ impl Domain {
         let lo = -DVec3::from_array(self.comm_max3(-lo));
         let hi = DVec3::from_array(self.comm_max3(hi));
         self.halo.extent = (lo, hi);
-        self.send_ghosts(b, dipole);
+        self.send_ghosts(b, own);
         self.since_build = 0;
         self.builds += 1;
         self.halo.generation += 1;
@@ -381,7 +473,9 @@ impl Domain {
     /// Sends along axis k the particles whose brick index along k is no
     /// longer this rank's, to the face neighbour on their side (a particle
     /// moves less than a brick between builds), and takes in the others'.
-    fn migrate(&mut self, sys: &mut System, k: usize) {
+    /// Each particle's row is followed by what every interaction keeps of
+    /// it, as (length, numbers).
+    fn migrate(&mut self, sys: &mut System, k: usize, interactions: &mut [Box<dyn Interaction>]) {
         if self.bricks.dims[k] == 1 {
             return;
         }
@@ -399,28 +493,47 @@ impl Domain {
                 } else {
                     usize::from(c > at)
                 };
-                going[side].extend(pack(sys, i, self.halo.id[i], &self.species));
+                let id = self.halo.id[i];
+                let out = &mut going[side];
+                out.extend(pack(sys, i, id, &self.species));
+                for interaction in interactions.iter() {
+                    let head = out.len();
+                    out.push(0.0);
+                    interaction.pack_particle(i, id, out);
+                    out[head] = (out.len() - head - 1) as f64;
+                }
                 self.migrated += 1;
                 *stay = false;
             }
         }
         retain(&mut self.halo.id, &stays);
         sys.retain_particles(&stays);
+        for interaction in interactions.iter_mut() {
+            interaction.retain_particles(&stays);
+        }
         for (side, out) in going.iter().enumerate() {
             let to = self.bricks.neighbour(k, side == 1).map(|n| n.0);
             let from = self.bricks.neighbour(k, side == 0).map(|n| n.0);
             let got = self.comm.exchange(to, out, from);
-            for row in got.chunks(CARRIED) {
-                self.halo.id.push(unpack(sys, row, &self.species));
+            let mut at = 0;
+            while at < got.len() {
+                let id = unpack(sys, &got[at..at + CARRIED], &self.species);
+                self.halo.id.push(id);
+                at += CARRIED;
+                for interaction in interactions.iter_mut() {
+                    let len = got[at] as usize;
+                    interaction.unpack_particle(id, &got[at + 1..at + 1 + len]);
+                    at += 1 + len;
+                }
             }
         }
     }
 
     /// The staged ghost exchange at a build (see the module's text), the
-    /// moments with the copies where interactions read them.
-    fn send_ghosts(&mut self, boundary: &Boundary, dipole: &[DVec3]) {
-        let moments = self.moments;
-        let width = if moments { 10 } else { 7 };
+    /// moments and motion with the copies where interactions read them.
+    fn send_ghosts(&mut self, boundary: &Boundary, own: &Sources) {
+        let extra = Extra::new(self.moments, self.motion);
+        let width = 7 + extra.width();
         let reach = self.cutoff + self.skin;
         let l = boundary.lengths();
         self.stages.clear();
@@ -464,10 +577,7 @@ impl Domain {
                         send.push(s as u32);
                         out.extend([id as f64, m[0] as f64, m[1] as f64, m[2] as f64]);
                         out.extend(at.to_array());
-                        if moments {
-                            let mu = if s < n { dipole[s] } else { h.moment[s - n] };
-                            out.extend(mu.to_array());
-                        }
+                        extra.write(s, n, own, h, &mut out);
                     }
                 }
                 let got = self.comm.exchange(neighbour.map(|n| n.0), &out, from);
@@ -478,9 +588,7 @@ impl Domain {
                         base: DVec3::new(g[4], g[5], g[6]),
                     });
                     h.displacement.push(DVec3::ZERO);
-                    if moments {
-                        h.moment.push(DVec3::new(g[7], g[8], g[9]));
-                    }
+                    extra.read(&g[7..], h);
                 }
                 self.stages.push(Stage {
                     to: neighbour.map(|n| n.0),
@@ -488,6 +596,56 @@ impl Domain {
                     send,
                 });
             }
+        }
+    }
+}
+
+/// What a ghost's record carries beyond its place: its magnetic moment,
+/// its motion, where interactions read them.
+#[derive(Clone, Copy)]
+struct Extra {
+    moments: bool,
+    motion: bool,
+}
+
+impl Extra {
+    fn new(moments: bool, motion: bool) -> Self {
+        Self { moments, motion }
+    }
+
+    fn width(self) -> usize {
+        3 * usize::from(self.moments) + Motion::WIDTH * usize::from(self.motion)
+    }
+
+    /// Appends copy s's (this rank's particle s < n, else ghost s − n).
+    fn write(self, s: usize, n: usize, own: &Sources, h: &Halo, out: &mut Vec<f64>) {
+        if self.moments {
+            let m = if s < n {
+                own.dipole[s]
+            } else {
+                h.moment[s - n]
+            };
+            out.extend(m.to_array());
+        }
+        if self.motion {
+            let m = if s < n {
+                own.motion(s)
+            } else {
+                h.motion[s - n]
+            };
+            m.write(out);
+        }
+    }
+
+    /// Takes a received copy's from `g`.
+    fn read(self, g: &[f64], h: &mut Halo) {
+        let mut g = g;
+        if self.moments {
+            h.moment.push(DVec3::from_slice(&g[..3]));
+            g = &g[3..];
+        }
+        if self.motion {
+            h.motion.push(Motion::read(g));
         }
     }
 }

@@ -97,6 +97,10 @@ pub struct HaloReach {
     /// Whether it reads the ghosts' magnetic moments (forwarded with
     /// their displacements at every evaluation: they turn).
     pub moments: bool,
+    /// Whether it reads the ghosts' [`Motion`](crate::domain::Motion):
+    /// position, velocity, angular velocity, radius and mass as their
+    /// particles hold them (forwarded at every evaluation; contacts).
+    pub motion: bool,
 }
 
 impl HaloReach {
@@ -106,6 +110,7 @@ impl HaloReach {
         skin: f64::INFINITY,
         every: 0,
         moments: false,
+        motion: false,
     };
 
     /// One halo for both: the widest cut-off and skin together, rebuilt
@@ -129,8 +134,20 @@ impl HaloReach {
             skin,
             every,
             moments: self.moments || other.moments,
+            motion: self.motion || other.motion,
         }
     }
+}
+
+/// A rank's part of what an interaction carries, in one process's form
+/// ([`Interaction::carried_rows`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CarriedRows {
+    /// What comes before the rows (the same on every rank).
+    pub head: Vec<f64>,
+    /// Numbers per row.
+    pub width: usize,
+    pub rows: Vec<f64>,
 }
 
 /// The box of a state given without one.
@@ -283,6 +300,32 @@ pub trait Interaction: Send + Sync {
             Err(format!("{} carries no state", self.name()))
         }
     }
+    /// In a decomposed run, this rank's part of
+    /// [`Interaction::carried_state`] in one process's form, its particles
+    /// named by their ids (row i of the rank is particle `id[i]`): a head,
+    /// then rows of `width` numbers, each row held by one rank, which rank
+    /// 0 puts in the order of their first two numbers. `None`: it carries
+    /// nothing per particle (or its list, which the domain gathers).
+    fn carried_rows(&self, id: &[u64]) -> Option<CarriedRows> {
+        let _ = id;
+        None
+    }
+    /// Appends to `out` what it keeps of particle i (id `id`) that goes
+    /// with the particle when it moves to another rank (contact
+    /// histories); nothing by default.
+    fn pack_particle(&self, i: usize, id: u64, out: &mut Vec<f64>) {
+        let _ = (i, id, out);
+    }
+    /// Keeps the particles where `keep` is true, in order, as a
+    /// decomposed run's system does (those leaving already packed).
+    fn retain_particles(&mut self, keep: &[bool]) {
+        let _ = keep;
+    }
+    /// Takes in particle `id`, arriving from another rank after this
+    /// rank's particles, with what [`Interaction::pack_particle`] wrote.
+    fn unpack_particle(&mut self, id: u64, data: &[f64]) {
+        let _ = (id, data);
+    }
     /// The live viewer's hooks (walls, their loads, steering), where this
     /// interaction has any.
     fn viewer(&self) -> Option<&dyn ViewerHooks> {
@@ -356,6 +399,18 @@ impl Interaction for Box<dyn Interaction> {
     fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
         (**self).restore_carried_state(state)
     }
+    fn carried_rows(&self, id: &[u64]) -> Option<CarriedRows> {
+        (**self).carried_rows(id)
+    }
+    fn pack_particle(&self, i: usize, id: u64, out: &mut Vec<f64>) {
+        (**self).pack_particle(i, id, out)
+    }
+    fn retain_particles(&mut self, keep: &[bool]) {
+        (**self).retain_particles(keep)
+    }
+    fn unpack_particle(&mut self, id: u64, data: &[f64]) {
+        (**self).unpack_particle(id, data)
+    }
     fn viewer(&self) -> Option<&dyn ViewerHooks> {
         (**self).viewer()
     }
@@ -371,34 +426,6 @@ impl Interaction for Box<dyn Interaction> {
     fn neighbour_reach(&self) -> Option<(f64, f64)> {
         (**self).neighbour_reach()
     }
-}
-
-/// (force, torque) buffers of the parallel blocks of a half-list pair loop
-/// (j > i): the buffer of a block starting at particle s covers s..n, the
-/// only particles its pairs touch, so it holds the last n − s entries.
-pub(crate) type BlockBuffers = Vec<(Vec<DVec3>, Vec<DVec3>)>;
-
-/// Adds the blocks' buffers to `force` and `torque` (each aligned to the
-/// end), buffer after buffer in block order for every particle: the bits
-/// depend on the blocks, not on the threads that ran them.
-pub(crate) fn add_block_buffers(force: &mut [DVec3], torque: &mut [DVec3], buffers: &BlockBuffers) {
-    if buffers.is_empty() {
-        return;
-    }
-    let n = force.len();
-    force
-        .par_iter_mut()
-        .zip(torque.par_iter_mut())
-        .enumerate()
-        .with_min_len(1024)
-        .for_each(|(i, (f, t))| {
-            for (bf, bt) in buffers {
-                if let Some(k) = (i + bf.len()).checked_sub(n) {
-                    *f += bf[k];
-                    *t += bt[k];
-                }
-            }
-        });
 }
 
 /// `state` with the shared list.
@@ -463,6 +490,10 @@ impl ForceField {
     /// build and one displacement check per evaluation, however many
     /// interactions read it.
     fn refresh_neighbours(&mut self, state: &State) {
+        if self.domain.is_some() {
+            // A decomposed run's interactions list their pairs over the halo.
+            return;
+        }
         let count = self.interactions.len();
         if self
             .neighbours
@@ -498,7 +529,7 @@ impl ForceField {
     pub fn before_forces(&mut self, sys: &mut System) {
         if let Some(domain) = &mut self.domain {
             let since = std::time::Instant::now();
-            if domain.prepare(sys) {
+            if domain.prepare(sys, &mut self.interactions) {
                 self.timing.builds += 1;
             }
             self.timing.neighbours += since.elapsed();
@@ -508,7 +539,15 @@ impl ForceField {
     /// Brings a decomposed run's ghosts to `state` for a measurement.
     fn refresh_halo(&mut self, state: &State) {
         if let Some(domain) = &mut self.domain {
-            domain.refresh(state.position, state.dipole, state.boundary);
+            let own = crate::domain::Sources {
+                position: state.position,
+                velocity: state.velocity,
+                spin: &[],
+                radius: state.radius,
+                mass: state.mass,
+                dipole: state.dipole,
+            };
+            domain.refresh(&own, state.boundary);
         }
     }
 

@@ -685,6 +685,7 @@ impl Interaction for DipoleDipole {
             skin: self.list.skin,
             every: self.list.every,
             moments: true,
+            motion: false,
         })
     }
 

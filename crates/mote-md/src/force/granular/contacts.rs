@@ -1,33 +1,142 @@
-//! Contacts between spheres, through a half Verlet list whose every entry
-//! carries the history of that pair's contact. The list is the force
-//! field's shared one when the step's [`State`] brings it (every run built
-//! from a scene), else the interaction's own.
+//! Contacts between spheres, over pairs listed in one order on one process
+//! and on any number of ranks ([`ContactPairs`]), each carrying the history
+//! of its contact. On one process the pairs are those of the force field's
+//! shared half list when the step's [`State`] brings it (every run built
+//! from a scene), else of the interaction's own; in a decomposed run, those
+//! within reach among the rank's particles and ghosts ([`State::halo`]).
+//!
+//! A step evaluates the rows in parallel blocks: each pair once, its force
+//! and torque summed into its row's particle, those on the partner put in
+//! the partner's inbox; then each particle adds its inbox and its row, in
+//! parallel. No two threads write one place, and the bits depend neither
+//! on the threads nor on the ranks.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::history::{block_firsts, split_blocks, PairHistories};
+use super::history::{block_firsts, split_blocks};
 use super::law::{ContactLaw, History};
-use crate::force::{add_block_buffers, BlockBuffers, Interaction, Spin, State, Virial};
+use super::pairs::{ContactPairs, GHOST};
+use crate::boundary::Boundary;
+use crate::domain::Halo;
+use crate::force::{CarriedRows, HaloReach, Interaction, Spin, State, Virial};
 use crate::neighbor::VerletList;
 
 /// Hertz–Mindlin contacts between all spheres (see [`super::law`]).
 ///
-/// The history (tangential and rolling elongations) sits beside the
-/// neighbour list, one entry per listed pair ([`PairHistories`]). Radii and
-/// the box come with the step's [`State`].
+/// The history (tangential and rolling elongations) sits beside the listed
+/// pairs, one entry each. Radii and the box come with the step's [`State`].
 #[derive(Debug, Clone)]
 pub struct GranularContacts {
     pub law: ContactLaw,
     /// The list used when the state brings none (direct callers).
     pub list: VerletList,
-    pairs: PairHistories,
-    /// The build of the list the histories were last carried to.
-    carried_to_build: u64,
-    /// One (force, torque) buffer per extra block of particles.
-    buffers: BlockBuffers,
+    pairs: ContactPairs,
+    /// What the pairs were listed from.
+    listed_from: Option<Listed>,
+    /// The list the inbox was laid out for (zero where no contact is).
+    inbox_for: Option<Listed>,
+    /// Each row's sum of its contacts' forces and torques.
+    row_sum: Vec<(DVec3, DVec3)>,
+    /// The force and torque of each contact on its partner, in the
+    /// partners' inboxes.
+    inbox: Vec<(DVec3, DVec3)>,
+    /// A decomposed run's particles and ghosts as the pairs read them.
+    bodies: Bodies,
+    /// The list over a rank's particles and ghosts (decomposed runs).
+    halo_list: VerletList,
     contacts: usize,
     virial: Virial,
+}
+
+/// The list the pairs were taken from: a half list's build and length, or
+/// a halo's generation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Listed {
+    List(u64, usize),
+    Halo(u64),
+}
+
+/// A rank's particles and one copy of each other rank's particle near its
+/// brick, in order of their ids: the rows its pairs read (decomposed runs).
+#[derive(Debug, Clone, Default)]
+struct Bodies {
+    /// The halo's ghost copy each row that is not the rank's reads.
+    copy: Vec<u32>,
+    position: Vec<DVec3>,
+    velocity: Vec<DVec3>,
+    spin: Vec<DVec3>,
+    radius: Vec<f64>,
+    mass: Vec<f64>,
+}
+
+/// The particles a step's pairs read, by row.
+#[derive(Clone, Copy)]
+struct View<'a> {
+    position: &'a [DVec3],
+    velocity: &'a [DVec3],
+    spin: &'a [DVec3],
+    radius: &'a [f64],
+    mass: &'a [f64],
+}
+
+impl Bodies {
+    /// The rows at `state` (spins `omega`): this rank's particles as
+    /// `pairs` places them, the ghosts' motion now.
+    fn gather(&mut self, state: &State, omega: &[DVec3], halo: &Halo, pairs: &ContactPairs) {
+        let rows = pairs.rows();
+        let motion = |r: usize| {
+            halo.motion
+                .get(self.copy[r] as usize)
+                .copied()
+                .expect("the halo forwards the ghosts' motion to granular contacts")
+        };
+        let mut out = (
+            Vec::with_capacity(rows),
+            Vec::with_capacity(rows),
+            Vec::with_capacity(rows),
+            Vec::with_capacity(rows),
+            Vec::with_capacity(rows),
+        );
+        for r in 0..rows {
+            let p = pairs.particle[r];
+            let (x, v, w, radius, mass) = if p == GHOST {
+                let m = motion(r);
+                (m.position, m.velocity, m.spin, m.radius, m.mass)
+            } else {
+                let p = p as usize;
+                (
+                    state.position[p],
+                    state.velocity[p],
+                    omega[p],
+                    state.radius[p],
+                    state.mass[p],
+                )
+            };
+            out.0.push(x);
+            out.1.push(v);
+            out.2.push(w);
+            out.3.push(radius);
+            out.4.push(mass);
+        }
+        (
+            self.position,
+            self.velocity,
+            self.spin,
+            self.radius,
+            self.mass,
+        ) = out;
+    }
+
+    fn view(&self) -> View<'_> {
+        View {
+            position: &self.position,
+            velocity: &self.velocity,
+            spin: &self.spin,
+            radius: &self.radius,
+            mass: &self.mass,
+        }
+    }
 }
 
 impl GranularContacts {
@@ -37,39 +146,139 @@ impl GranularContacts {
         Self {
             law,
             list: VerletList::half(2.0 * r_max, skin),
-            pairs: PairHistories::default(),
-            carried_to_build: 0,
-            buffers: Vec::new(),
+            pairs: ContactPairs::default(),
+            listed_from: None,
+            inbox_for: None,
+            row_sum: Vec::new(),
+            inbox: Vec::new(),
+            bodies: Bodies::default(),
+            halo_list: VerletList::half(2.0 * r_max, skin),
             contacts: 0,
             virial: Virial::default(),
         }
     }
 
-    /// Number of touching pairs at the last force evaluation.
+    /// Number of touching pairs at the last force evaluation (on this
+    /// rank, those whose lower id is its own).
     pub fn contacts(&self) -> usize {
         self.contacts
     }
 
-    /// The contact history of pair (i, j), if they are listed.
+    /// The contact history of the particles with ids i and j, if they are
+    /// listed.
     pub fn history(&self, i: usize, j: usize) -> Option<History> {
-        self.pairs.get(i, j)
+        self.pairs.get(i as u64, j as u64)
     }
 
-    /// Brings the own list up to date when the state brings no shared one.
-    fn refresh_own(&mut self, state: &State) {
-        if state.neighbours.is_none() {
-            self.list.update(state.position, state.boundary);
+    /// Lists the pairs anew where the list they come from was rebuilt, and
+    /// gathers a decomposed run's particles and ghosts (spins `omega`).
+    fn bring_up_to_date(&mut self, state: &State, omega: &[DVec3]) {
+        match state.halo {
+            Some(halo) => {
+                if self.listed_from != Some(Listed::Halo(halo.generation)) {
+                    self.list_halo(halo);
+                    self.listed_from = Some(Listed::Halo(halo.generation));
+                }
+                self.bodies.gather(state, omega, halo, &self.pairs);
+            }
+            None => {
+                if state.neighbours.is_none() {
+                    self.list.update(state.position, state.boundary);
+                }
+                let list = state.neighbours.unwrap_or(&self.list);
+                let from = Listed::List(list.builds, list.neighbors.len());
+                if self.listed_from != Some(from) {
+                    // The rows are the particles.
+                    let n = state.position.len();
+                    let rows: Vec<u32> = (0..n as u32).collect();
+                    let (start, partner) = (list.start.clone(), list.neighbors.clone());
+                    self.pairs.rebuild(rows.clone(), rows, n, start, partner);
+                    self.listed_from = Some(from);
+                }
+            }
         }
     }
 
-    /// After a rebuild of `list` the histories move with it.
-    fn follow(pairs: &mut PairHistories, carried_to_build: &mut u64, list: &VerletList) {
-        if list.builds != *carried_to_build || pairs.len() != list.neighbors.len() {
-            pairs.carry_to(&list.start, &list.neighbors);
-            *carried_to_build = list.builds;
+    /// The particles the pairs read: the state's, or on a rank its
+    /// particles and ghosts as gathered.
+    fn view<'a>(&'a self, state: &State<'a>, omega: &'a [DVec3]) -> View<'a> {
+        match state.halo {
+            Some(_) => self.bodies.view(),
+            None => View {
+                position: state.position,
+                velocity: state.velocity,
+                spin: omega,
+                radius: state.radius,
+                mass: state.mass,
+            },
         }
     }
 
+    /// Lists the pairs within reach among a rank's particles and ghosts
+    /// at the halo's build: the rows are its particles and one copy of
+    /// each other particle near its brick (a particle's copies across
+    /// periodic faces are one row), in order of their ids; each pair has
+    /// at least one particle of this rank.
+    fn list_halo(&mut self, halo: &Halo) {
+        let n = halo.id.len();
+        assert!(
+            halo.total < GHOST as usize,
+            "too many particles for u32 lists"
+        );
+        // (id, particle or GHOST, copy) of every copy; rows are the ids.
+        let own = halo.id.iter().enumerate().map(|(i, id)| (*id, i as u32, i));
+        let ghosts = halo
+            .ghosts
+            .iter()
+            .enumerate()
+            .map(|(g, ghost)| (ghost.id, GHOST, n + g));
+        let mut copies: Vec<(u64, u32, usize)> = own.chain(ghosts).collect();
+        // A particle of this rank sorts before its copies.
+        copies.sort_unstable_by_key(|c| (c.0, c.1 == GHOST, c.2));
+        let mut row_of_copy = vec![0u32; copies.len()];
+        let (mut row_id, mut particle) = (Vec::new(), Vec::new());
+        self.bodies.copy.clear();
+        for (k, &(id, p, c)) in copies.iter().enumerate() {
+            if k == 0 || copies[k - 1].0 != id {
+                row_id.push(id as u32);
+                particle.push(p);
+                self.bodies.copy.push(c.saturating_sub(n) as u32);
+            }
+            row_of_copy[c] = (row_id.len() - 1) as u32;
+        }
+        let at: Vec<DVec3> = halo
+            .reference
+            .iter()
+            .copied()
+            .chain(halo.ghosts.iter().map(|g| g.base))
+            .collect();
+        self.halo_list.build(&at, &Boundary::open());
+        let mut listed: Vec<(u32, u32)> = Vec::new();
+        for (c, &a) in row_of_copy.iter().enumerate() {
+            for &d in self.halo_list.of(c) {
+                let b = row_of_copy[d as usize];
+                let ghosts = particle[a as usize] == GHOST && particle[b as usize] == GHOST;
+                if a != b && !ghosts {
+                    listed.push((a.min(b), a.max(b)));
+                }
+            }
+        }
+        listed.sort_unstable();
+        listed.dedup();
+        let mut start = vec![0u32; row_id.len() + 1];
+        for &(a, _) in &listed {
+            start[a as usize + 1] += 1;
+        }
+        for r in 0..row_id.len() {
+            start[r + 1] += start[r];
+        }
+        let partner = listed.iter().map(|l| l.1).collect();
+        self.pairs.rebuild(row_id, particle, n, start, partner);
+    }
+
+    /// The rows' contacts in parallel blocks of rows, then each of this
+    /// rank's particles' sum of its inbox and its row, in parallel over the
+    /// particles.
     fn evaluate(
         &mut self,
         state: &State,
@@ -77,147 +286,158 @@ impl GranularContacts {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
-        let n = state.position.len();
-        self.refresh_own(state);
-        let list = state.neighbours.unwrap_or(&self.list);
-        Self::follow(&mut self.pairs, &mut self.carried_to_build, list);
-        let dt = state.step.dt;
-
-        let blocks = Self::blocks(n);
-        let firsts = block_firsts(&list.start, blocks);
-        self.buffers
-            .resize_with(blocks.saturating_sub(1), Default::default);
-        let mut buffers = std::mem::take(&mut self.buffers);
+        self.bring_up_to_date(state, omega);
+        let pairs = &self.pairs;
+        let rows = pairs.rows();
+        // Blocks of equal numbers of pairs: how the work is cut changes no
+        // sum.
+        let firsts = block_firsts(&pairs.start, (pairs.len() / 4096).clamp(1, 256));
         let mut history = std::mem::take(&mut self.pairs.history);
         let mut touching = std::mem::take(&mut self.pairs.touching);
-
-        let history_blocks = split_blocks(&mut history, &mut touching, &list.start, &firsts);
-        // Block 0 adds into the output, block b > 0 into a buffer over the
-        // particles from its first one to the end (pairs have j > i).
-        let mut targets: Vec<(&mut [DVec3], &mut [DVec3])> = Vec::with_capacity(blocks);
-        targets.push((&mut *force, &mut *torque));
-        for (b, (f, t)) in buffers.iter_mut().enumerate() {
-            let len = n - firsts[b + 1];
-            f.clear();
-            f.resize(len, DVec3::ZERO);
-            t.clear();
-            t.resize(len, DVec3::ZERO);
-            targets.push((f.as_mut_slice(), t.as_mut_slice()));
+        let pairs = &self.pairs;
+        self.row_sum.resize(rows, (DVec3::ZERO, DVec3::ZERO));
+        if self.inbox.len() != pairs.inbox_pair.len() || self.listed_from != self.inbox_for {
+            self.inbox.clear();
+            self.inbox
+                .resize(pairs.inbox_pair.len(), (DVec3::ZERO, DVec3::ZERO));
+            self.inbox_for = self.listed_from;
         }
-
-        let this = &*self;
-        let results: Vec<(usize, Virial)> = targets
+        let inbox = Inbox(self.inbox.as_mut_ptr());
+        let mut row_sums = Vec::with_capacity(firsts.len());
+        let mut rest = self.row_sum.as_mut_slice();
+        for w in firsts.windows(2) {
+            let (head, tail) = rest.split_at_mut(w[1] - w[0]);
+            row_sums.push(head);
+            rest = tail;
+        }
+        let at = match state.halo {
+            Some(_) => self.bodies.view(),
+            None => View {
+                position: state.position,
+                velocity: state.velocity,
+                spin: omega,
+                radius: state.radius,
+                mass: state.mass,
+            },
+        };
+        let image = state.boundary.image();
+        let (law, dt) = (&self.law, state.step.dt);
+        let blocks = split_blocks(&mut history, &mut touching, &pairs.start, &firsts);
+        let sums: Vec<(usize, Virial)> = blocks
             .into_par_iter()
-            .zip(history_blocks)
+            .zip(row_sums)
             .enumerate()
-            .map(|(b, ((f, t), (hist, touch)))| {
-                let (first, last) = (firsts[b], firsts[b + 1]);
-                let base = n - f.len();
-                this.block(
-                    state,
-                    list,
-                    omega,
-                    first..last,
-                    dt,
-                    (base, f, t),
-                    hist,
-                    touch,
-                )
+            .map(|(block, ((history, touching), row_sum))| {
+                let (first, base) = (firsts[block], pairs.start[firsts[block]] as usize);
+                let mut count = 0usize;
+                let mut virial = Virial::default();
+                for (a, sum) in (first..).zip(row_sum.iter_mut()) {
+                    let (mut f, mut t) = (DVec3::ZERO, DVec3::ZERO);
+                    let (xa, va, wa, ra, ma) = (
+                        at.position[a],
+                        at.velocity[a],
+                        at.spin[a],
+                        at.radius[a],
+                        at.mass[a],
+                    );
+                    let counts = pairs.counts(a);
+                    for s in pairs.start[a] as usize..pairs.start[a + 1] as usize {
+                        let (k, b) = (s - base, pairs.partner[s] as usize);
+                        let d = image.apply(xa - at.position[b]);
+                        let rb = at.radius[b];
+                        let reach = ra + rb;
+                        let r2 = d.length_squared();
+                        if r2 >= reach * reach {
+                            if touching[k] {
+                                touching[k] = false;
+                                history[k] = History::default();
+                                let slot = pairs.inbox_slot[s];
+                                if slot != GHOST {
+                                    // SAFETY: as below.
+                                    unsafe { inbox.put(slot as usize, (DVec3::ZERO, DVec3::ZERO)) };
+                                }
+                            }
+                            continue;
+                        }
+                        touching[k] = true;
+                        let r = r2.sqrt();
+                        let nrm = d / r;
+                        let delta = reach - r;
+                        let (arm_a, arm_b) = (ra - 0.5 * delta, rb - 0.5 * delta);
+                        let wb = at.spin[b];
+                        let v_rel = va - at.velocity[b] - (wa * arm_a + wb * arm_b).cross(nrm);
+                        let mb = at.mass[b];
+                        let c = law.force(
+                            delta,
+                            nrm,
+                            v_rel,
+                            wa - wb,
+                            arm_a,
+                            arm_b,
+                            ra * rb / reach,
+                            ma * mb / (ma + mb),
+                            dt,
+                            &mut history[k],
+                        );
+                        f += c.force;
+                        t += c.torque_i;
+                        let slot = pairs.inbox_slot[s];
+                        if slot != GHOST {
+                            // SAFETY: each pair has its own slot (a
+                            // pair's place in its partner's inbox), so no
+                            // two writes meet, and the slot is within the
+                            // inbox, sized for every slot.
+                            unsafe { inbox.put(slot as usize, (-c.force, c.torque_j)) };
+                        }
+                        if counts {
+                            count += 1;
+                            virial += Virial::pair(d, c.force);
+                        }
+                    }
+                    *sum = (f, t);
+                }
+                (count, virial)
             })
             .collect();
-
-        add_block_buffers(force, torque, &buffers);
+        let (row_sum, inbox) = (&self.row_sum, &self.inbox);
+        force
+            .par_iter_mut()
+            .zip(torque.par_iter_mut())
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(p, (f, t))| {
+                let (mut in_f, mut in_t) = (DVec3::ZERO, DVec3::ZERO);
+                for e in pairs.inbox_start[p] as usize..pairs.inbox_start[p + 1] as usize {
+                    in_f += inbox[e].0;
+                    in_t += inbox[e].1;
+                }
+                let (row_f, row_t) = row_sum[pairs.row[p] as usize];
+                *f += in_f + row_f;
+                *t += in_t + row_t;
+            });
         self.pairs.history = history;
         self.pairs.touching = touching;
-        self.buffers = buffers;
-        self.contacts = results.iter().map(|r| r.0).sum();
-        self.virial = results.iter().map(|r| r.1).sum();
+        self.contacts = sums.iter().map(|s| s.0).sum();
+        self.virial = sums.iter().map(|s| s.1).sum();
     }
+}
 
-    /// Blocks of particles of the parallel pair loop: a function of N
-    /// alone (never of the thread count), one per 4096 particles, at most
-    /// 16, so that the sums, and so the bits, are the same on any number of
-    /// threads; each block past the first costs a buffer of forces and
-    /// torques.
-    fn blocks(n: usize) -> usize {
-        (n / 4096).clamp(1, 16)
-    }
+/// The inbox as the blocks of rows write it, each pair to its own slot.
+#[derive(Clone, Copy)]
+struct Inbox(*mut (DVec3, DVec3));
 
-    /// The pairs of particles `range` (and their partners j > i), adding
-    /// forces and torques into `out` = (base, f, t), f[k] and t[k] those of
-    /// particle base + k; returns (contacts, virial tensor).
-    #[allow(clippy::too_many_arguments)]
-    fn block(
-        &self,
-        state: &State,
-        list: &VerletList,
-        omega: &[DVec3],
-        range: std::ops::Range<usize>,
-        dt: f64,
-        out: (usize, &mut [DVec3], &mut [DVec3]),
-        hist: &mut [History],
-        touch: &mut [bool],
-    ) -> (usize, Virial) {
-        let (base, f, t) = out;
-        debug_assert!(base <= range.start);
-        let pos = state.position;
-        let vel = state.velocity;
-        let mass = state.mass;
-        let radius = state.radius;
-        let image = state.boundary.image();
-        let offset = list.start[range.start] as usize;
-        let mut contacts = 0usize;
-        let mut virial = Virial::default();
-        for i in range {
-            let (ri, vi, wi, radi, mi) = (pos[i], vel[i], omega[i], radius[i], mass[i]);
-            let (mut fi, mut ti) = (DVec3::ZERO, DVec3::ZERO);
-            let lo = list.start[i] as usize;
-            for (k, &j) in list.of(i).iter().enumerate() {
-                let j = j as usize;
-                let slot = lo + k - offset;
-                let d = image.apply(ri - pos[j]);
-                let reach = radi + radius[j];
-                let r2 = d.length_squared();
-                if r2 >= reach * reach {
-                    if touch[slot] {
-                        touch[slot] = false;
-                        hist[slot] = History::default();
-                    }
-                    continue;
-                }
-                touch[slot] = true;
-                let h = &mut hist[slot];
-                let r = r2.sqrt();
-                let nrm = d / r;
-                let delta = reach - r;
-                let (arm_i, arm_j) = (radi - 0.5 * delta, radius[j] - 0.5 * delta);
-                let wj = omega[j];
-                let v_rel = vi - vel[j] - (wi * arm_i + wj * arm_j).cross(nrm);
-                let r_eff = radi * radius[j] / reach;
-                let m_eff = mi * mass[j] / (mi + mass[j]);
-                let c = self.law.force(
-                    delta,
-                    nrm,
-                    v_rel,
-                    wi - wj,
-                    arm_i,
-                    arm_j,
-                    r_eff,
-                    m_eff,
-                    dt,
-                    h,
-                );
-                fi += c.force;
-                f[j - base] -= c.force;
-                ti += c.torque_i;
-                t[j - base] += c.torque_j;
-                contacts += 1;
-                virial += Virial::pair(d, c.force);
-            }
-            f[i - base] += fi;
-            t[i - base] += ti;
-        }
-        (contacts, virial)
+// SAFETY: the blocks write disjoint slots (see the write) and nothing
+// reads the inbox until they are done.
+unsafe impl Send for Inbox {}
+unsafe impl Sync for Inbox {}
+
+impl Inbox {
+    /// Writes slot k.
+    ///
+    /// # Safety
+    /// k is within the inbox and no other thread touches slot k meanwhile.
+    unsafe fn put(&self, k: usize, value: (DVec3, DVec3)) {
+        *self.0.add(k) = value;
     }
 }
 
@@ -247,6 +467,19 @@ impl Interaction for GranularContacts {
         self.evaluate(state, spin.angular_velocity, force, torque);
     }
 
+    /// Pairs within 2 r_max + skin of the rank's particles; the ghosts'
+    /// positions, velocities, spins, radii and masses forwarded at every
+    /// evaluation.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        Some(HaloReach {
+            cutoff: self.list.cutoff,
+            skin: self.list.skin,
+            every: self.list.every,
+            moments: false,
+            motion: true,
+        })
+    }
+
     /// [NaN (the time of the last evaluation before dt came with the
     /// state; kept so earlier checkpoints load), then per touching pair
     /// i, j, ξ (3), ψ (3)].
@@ -256,32 +489,52 @@ impl Interaction for GranularContacts {
         out
     }
 
+    /// The pairs are named by their ids already: each rank writes those
+    /// whose lower id is its own.
+    fn carried_rows(&self, _: &[u64]) -> Option<CarriedRows> {
+        let mut rows = Vec::new();
+        self.pairs.write_rows(&mut rows);
+        Some(CarriedRows {
+            head: vec![f64::NAN],
+            width: super::history::PAIR_ROW,
+            rows,
+        })
+    }
+
     fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
         let Some((_, rows)) = state.split_first() else {
             return Ok(());
         };
         self.pairs
-            .restore_rows(rows, usize::MAX)
+            .restore_rows(rows)
             .map_err(|m| format!("granular {m}"))
     }
 
-    /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}.
+    fn pack_particle(&self, _: usize, id: u64, out: &mut Vec<f64>) {
+        self.pairs.pack(id, out);
+    }
+
+    fn unpack_particle(&mut self, id: u64, data: &[f64]) {
+        self.pairs.arrive(id, data);
+    }
+
+    /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}
+    /// (on a rank, of the pairs it counts).
     fn potential_energy(&mut self, state: &State) -> f64 {
-        let pos = state.position;
-        self.refresh_own(state);
-        let list = state.neighbours.unwrap_or(&self.list);
+        let omega = vec![DVec3::ZERO; state.position.len()];
+        self.bring_up_to_date(state, &omega);
+        let at = self.view(state, &omega);
         let image = state.boundary.image();
-        let radius = state.radius;
+        let pairs = &self.pairs;
         let mut u = 0.0;
-        for i in 0..pos.len() {
-            for &j in list.of(i) {
-                let j = j as usize;
-                let reach = radius[i] + radius[j];
-                let r = image.apply(pos[i] - pos[j]).length();
+        for a in (0..pairs.rows()).filter(|&a| pairs.counts(a)) {
+            for &b in &pairs.partner[pairs.start[a] as usize..pairs.start[a + 1] as usize] {
+                let b = b as usize;
+                let reach = at.radius[a] + at.radius[b];
+                let r = image.apply(at.position[a] - at.position[b]).length();
                 if r < reach {
-                    let delta = reach - r;
-                    let r_eff = radius[i] * radius[j] / reach;
-                    u += self.law.elastic_energy(delta, r_eff);
+                    let r_eff = at.radius[a] * at.radius[b] / reach;
+                    u += self.law.elastic_energy(reach - r, r_eff);
                 }
             }
         }

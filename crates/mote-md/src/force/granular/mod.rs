@@ -7,9 +7,11 @@
 pub mod contacts;
 pub mod history;
 pub mod law;
+pub mod pairs;
 pub mod walls;
 
 pub use contacts::GranularContacts;
 pub use history::PairHistories;
 pub use law::{ContactForce, ContactLaw, Damping, History, Material};
+pub use pairs::ContactPairs;
 pub use walls::{GranularWalls, Wall, WallShape};

@@ -7,7 +7,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::law::{ContactLaw, History};
-use crate::force::{Interaction, Spin, State, ViewerHooks, Virial};
+use crate::force::{CarriedRows, HaloReach, Interaction, Spin, State, ViewerHooks, Virial};
 
 /// The shape of a wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -306,6 +306,64 @@ impl Interaction for GranularWalls {
             }
         }
         out
+    }
+
+    /// Rows (id · walls + wall, ξ, ψ) of this rank's touching slots.
+    fn carried_rows(&self, id: &[u64]) -> Option<CarriedRows> {
+        let walls = self.walls.len();
+        let mut rows = Vec::new();
+        for (k, h) in self.history.iter().enumerate() {
+            if self.touching[k] {
+                rows.push((id[k / walls] * walls as u64 + (k % walls) as u64) as f64);
+                rows.extend(h.shear.to_array());
+                rows.extend(h.roll.to_array());
+            }
+        }
+        Some(CarriedRows {
+            head: vec![f64::NAN],
+            width: 7,
+            rows,
+        })
+    }
+
+    /// A force on each particle alone.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        Some(HaloReach::NONE)
+    }
+
+    /// (wall, ξ, ψ) of each wall particle i touches.
+    fn pack_particle(&self, i: usize, _: u64, out: &mut Vec<f64>) {
+        let walls = self.walls.len();
+        for w in 0..walls {
+            let k = i * walls + w;
+            if self.touching[k] {
+                out.push(w as f64);
+                out.extend(self.history[k].shear.to_array());
+                out.extend(self.history[k].roll.to_array());
+            }
+        }
+    }
+
+    fn retain_particles(&mut self, keep: &[bool]) {
+        let walls = self.walls.len().max(1);
+        let slots: Vec<bool> = (0..self.history.len()).map(|k| keep[k / walls]).collect();
+        crate::domain::retain(&mut self.history, &slots);
+        crate::domain::retain(&mut self.touching, &slots);
+    }
+
+    fn unpack_particle(&mut self, _: u64, data: &[f64]) {
+        let first = self.history.len();
+        let walls = self.walls.len();
+        self.history.resize(first + walls, History::default());
+        self.touching.resize(first + walls, false);
+        for r in data.chunks_exact(7) {
+            let k = first + r[0] as usize;
+            self.touching[k] = true;
+            self.history[k] = History {
+                shear: DVec3::new(r[1], r[2], r[3]),
+                roll: DVec3::new(r[4], r[5], r[6]),
+            };
+        }
     }
 
     fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {

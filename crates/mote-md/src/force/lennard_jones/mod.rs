@@ -285,6 +285,7 @@ impl Interaction for LennardJones {
             skin: self.list.skin,
             every: self.list.every,
             moments: false,
+            motion: false,
         })
     }
 
