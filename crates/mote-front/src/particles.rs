@@ -210,6 +210,12 @@ impl EngineRun for PointsRun {
                 };
                 FrontError::request(format!("{at}: {m}"))
             })?;
+            if let (Some(domain), Some(b)) = (
+                sim.forces.domain.as_mut(),
+                parallel.and_then(|p| p.get_ref().balance),
+            ) {
+                domain.balance = b;
+            }
         }
         let done = resumed.map_or(0, |cp| cp.step.min(self.total_steps));
         self.last_step = sim.system.step + (self.total_steps - done);
@@ -297,8 +303,10 @@ impl EngineRun for PointsRun {
     ) -> Result<Vec<String>, FrontError> {
         let mut lines = vec![summary(report, sim, &self.scene, &done.files.dir)];
         // Every rank takes part in the census; rank 0 says it.
-        if let Some(census) = sim.forces.domain.as_ref().and_then(|d| d.census()) {
-            lines.push(ranks_sentence(&census));
+        if let Some(domain) = sim.forces.domain.as_ref() {
+            if let Some(census) = domain.census() {
+                lines.push(ranks_sentence(&census, domain.shifts));
+            }
         }
         Ok(lines)
     }
@@ -306,7 +314,7 @@ impl EngineRun for PointsRun {
 
 /// "Ranks: particles 15 998–16 002 a rank (…), ghosts …, … migrated.": how a
 /// decomposed run's particles and ghosts were spread over its ranks.
-fn ranks_sentence(census: &[[u64; 3]]) -> String {
+fn ranks_sentence(census: &[[u64; 3]], shifts: u64) -> String {
     let range = |k: usize| {
         let lo = census.iter().map(|c| c[k]).min().unwrap_or(0);
         let hi = census.iter().map(|c| c[k]).max().unwrap_or(0);
@@ -317,9 +325,14 @@ fn ranks_sentence(census: &[[u64; 3]]) -> String {
         }
     };
     let moved: u64 = census.iter().map(|c| c[2]).sum();
+    let shifted = match shifts {
+        0 => String::new(),
+        1 => " The cuts between bricks shifted once to balance them.".to_string(),
+        n => format!(" The cuts between bricks shifted {n} times to balance them."),
+    };
     format!(
         "Ranks: {} particles a rank at the end, {} ghosts a rank at the last list build; \
-         {moved} particles changed rank.",
+         {moved} particles changed rank.{shifted}",
         range(0),
         range(1)
     )

@@ -568,3 +568,47 @@ fn a_granular_checkpoint_of_two_ranks_resumes_on_one_and_three() {
         );
     }
 }
+
+/// A bed settling across the cut of 2 bricks leaves the upper one empty;
+/// the cut shifts to keep the halves even, and the trajectory stays one
+/// process's to the bit.
+#[test]
+fn the_cut_follows_a_settling_bed() {
+    let run = |comm: Option<Arc<dyn Comm>>, balance: f64| {
+        let mut sim = crate::common::build(GRANULAR).simulation;
+        if let Some(comm) = comm {
+            sim.decompose(comm, None).unwrap();
+            let domain = sim.forces.domain.as_mut().unwrap();
+            assert_eq!(domain.bricks.dims, [1, 1, 2]);
+            domain.balance = balance;
+        }
+        run_for(&mut sim, 1200);
+        let spread = sim.forces.domain.as_ref().map(|d| {
+            let n = d.comm().gather(&[sim.system.particles.len() as f64]);
+            let most = n.iter().map(|v| v[0]).fold(0.0, f64::max);
+            (most * n.len() as f64 / d.total() as f64, d.shifts)
+        });
+        (whole(sim), spread)
+    };
+    let one = run(None, 0.0).0.unwrap();
+    for balance in [0.0, 1.1] {
+        let (two, spread) = in_process(2, |comm| run(Some(comm), balance)).remove(0);
+        let two = two.unwrap();
+        assert!(
+            two.particles.position == one.particles.position,
+            "balance {balance}"
+        );
+        assert!(
+            two.particles.velocity == one.particles.velocity,
+            "balance {balance}"
+        );
+        let (imbalance, shifts) = spread.unwrap();
+        if balance == 0.0 {
+            assert_eq!(shifts, 0);
+            assert!(imbalance > 1.3, "unbalanced: {imbalance}");
+        } else {
+            assert!(shifts > 0);
+            assert!(imbalance < 1.1 + 0.05, "balanced: {imbalance}");
+        }
+    }
+}

@@ -1,6 +1,8 @@
 //! The box cut into a grid of bricks, one per rank (MPI's Cartesian
 //! communicator): the grid chosen from the box's shape so that a brick's
 //! surface, hence its ghost layer, is least (LAMMPS's `processors *`).
+//! The cuts along each axis start even and may shift so that every slab
+//! between two cuts holds as many particles (LAMMPS's `balance shift`).
 
 use glam::DVec3;
 
@@ -13,9 +15,9 @@ pub struct Bricks {
     pub dims: [usize; 3],
     /// This rank's brick, (x, y, z) in the grid.
     pub at: [usize; 3],
-    /// The box's lower corner and edges.
-    origin: DVec3,
-    edge: DVec3,
+    /// The planes between the slabs along each axis: `cuts[k]` holds
+    /// dims[k] + 1 coordinates, the box's faces first and last, increasing.
+    cuts: [Vec<f64>; 3],
     periodic: [bool; 3],
 }
 
@@ -112,10 +114,31 @@ impl Bricks {
                 (rank / dims[0]) % dims[1],
                 rank / (dims[0] * dims[1]),
             ],
-            origin: boundary.lo,
-            edge: boundary.lengths(),
+            cuts: std::array::from_fn(|k| {
+                let (lo, hi, p) = (boundary.lo[k], boundary.hi[k], dims[k]);
+                let inner = (1..p).map(|c| lo + (hi - lo) * c as f64 / p as f64);
+                std::iter::once(lo).chain(inner).chain([hi]).collect()
+            }),
             periodic: boundary.periodic,
         }
+    }
+
+    /// The planes between the slabs along axis k (see `cuts`).
+    pub fn cuts(&self, k: usize) -> &[f64] {
+        &self.cuts[k]
+    }
+
+    /// Moves the planes between the slabs along axis k to `inner` (dims[k]
+    /// − 1 increasing coordinates inside the box).
+    pub fn shift(&mut self, k: usize, inner: &[f64]) {
+        let p = self.dims[k];
+        assert_eq!(
+            inner.len() + 1,
+            p,
+            "{} planes between {p} slabs",
+            inner.len()
+        );
+        self.cuts[k][1..p].copy_from_slice(inner);
     }
 
     /// The rank of brick `c`.
@@ -130,8 +153,7 @@ impl Bricks {
         if p == 1 {
             return 0;
         }
-        let c = ((x - self.origin[k]) / self.edge[k] * p as f64).floor();
-        c.clamp(0.0, (p - 1) as f64) as usize
+        self.cuts[k][1..p].partition_point(|&c| c <= x)
     }
 
     /// The rank whose brick holds the (wrapped) point `r`.
@@ -142,15 +164,8 @@ impl Bricks {
     /// This brick's faces along axis k, (lower, upper); the box's own faces
     /// where the axis is not cut (infinite on an open axis).
     pub fn faces(&self, k: usize) -> (f64, f64) {
-        let p = self.dims[k] as f64;
-        let c = self.at[k] as f64;
-        if self.dims[k] == 1 {
-            return (self.origin[k], self.origin[k] + self.edge[k]);
-        }
-        (
-            self.origin[k] + self.edge[k] * c / p,
-            self.origin[k] + self.edge[k] * (c + 1.0) / p,
-        )
+        let c = self.at[k];
+        (self.cuts[k][c], self.cuts[k][c + 1])
     }
 
     /// The neighbour along axis k below (`up` false) or above, with the

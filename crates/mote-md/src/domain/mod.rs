@@ -175,6 +175,11 @@ pub struct Domain {
     pub builds: u64,
     /// The particles this rank has sent to another so far.
     pub migrated: u64,
+    /// Shift the bricks' cuts at a build where the most particles a rank
+    /// holds exceed the mean by this factor (0: never).
+    pub balance: f64,
+    /// The builds at which the cuts shifted so far.
+    pub shifts: u64,
     /// A checkpoint's build to remake at the first evaluation: its
     /// evaluations since (the positions are the halo's reference).
     restored: Option<u64>,
@@ -182,6 +187,14 @@ pub struct Domain {
     /// species as an index into them.
     species: Vec<String>,
 }
+
+/// The imbalance (most particles a rank over the mean) above which the
+/// cuts shift, unless the scene says otherwise: LAMMPS's usual threshold.
+pub const DEFAULT_BALANCE: f64 = 1.1;
+
+/// Bins of the particles' histogram along an axis from which the cuts are
+/// placed.
+const BINS: usize = 1024;
 
 /// The numbers a migrating particle carries, [`pack`]'s layout.
 const CARRIED: usize = 31;
@@ -218,6 +231,8 @@ impl Domain {
             since_build: 0,
             builds: 0,
             migrated: 0,
+            balance: DEFAULT_BALANCE,
+            shifts: 0,
             restored: None,
             species: Vec::new(),
         })
@@ -433,10 +448,21 @@ impl Domain {
         }
     }
 
-    /// Migrates the particles that left the brick, then sends the ghosts.
+    /// Migrates the particles that left the brick, shifts the cuts where
+    /// the ranks' loads are uneven, then sends the ghosts.
     fn build(&mut self, sys: &mut System, interactions: &mut [Box<dyn Interaction>]) {
         for k in 0..3 {
             self.migrate(sys, k, interactions);
+        }
+        if self.balance > 0.0 && self.imbalance(sys.particles.len()) > self.balance {
+            self.shift_cuts(sys);
+            // A particle may now lie bricks away: it moves a brick a pass.
+            loop {
+                let sent: usize = (0..3).map(|k| self.migrate(sys, k, interactions)).sum();
+                if self.comm.sum(&[sent as f64])[0] == 0.0 {
+                    break;
+                }
+            }
         }
         let b = sys.boundary;
         self.halo.reference = sys.particles.position.iter().map(|r| b.wrap(*r)).collect();
@@ -470,15 +496,85 @@ impl Domain {
         [self.comm.max(v.x), self.comm.max(v.y), self.comm.max(v.z)]
     }
 
+    /// The most particles a rank holds over the mean.
+    fn imbalance(&self, mine: usize) -> f64 {
+        let most = self.comm.max(mine as f64);
+        let mean = self.comm.sum(&[mine as f64])[0] / self.comm.size() as f64;
+        if mean > 0.0 {
+            most / mean
+        } else {
+            1.0
+        }
+    }
+
+    /// Places the cuts along every cut axis so that each slab holds as
+    /// many particles, from their histogram along the axis summed over the
+    /// ranks (the same cuts on every rank); each slab stays at least the
+    /// cut-off and skin wide, so ghosts still come from face neighbours.
+    fn shift_cuts(&mut self, sys: &System) {
+        let reach = self.cutoff + self.skin;
+        for k in 0..3 {
+            let p = self.bricks.dims[k];
+            let cuts = self.bricks.cuts(k);
+            let (lo, hi) = (cuts[0], cuts[p]);
+            if p == 1 || !(hi - lo).is_finite() {
+                continue;
+            }
+            let width = (hi - lo) / BINS as f64;
+            let mut mine = vec![0.0; BINS];
+            for r in &sys.particles.position {
+                let x = sys.boundary.wrap(*r)[k];
+                mine[(((x - lo) / width) as usize).min(BINS - 1)] += 1.0;
+            }
+            let count = self.comm.sum(&mine);
+            let total: f64 = count.iter().sum();
+            let mut inner = Vec::with_capacity(p - 1);
+            let (mut below, mut bin) = (0.0, 0);
+            for j in 1..p {
+                let target = total * j as f64 / p as f64;
+                while bin < BINS - 1 && below + count[bin] < target {
+                    below += count[bin];
+                    bin += 1;
+                }
+                let within = if count[bin] > 0.0 {
+                    ((target - below) / count[bin]).clamp(0.0, 1.0)
+                } else {
+                    0.5
+                };
+                inner.push(lo + (bin as f64 + within) * width);
+            }
+            // Every slab at least `reach` wide: from below, then from above.
+            let mut last = lo;
+            for c in inner.iter_mut() {
+                *c = c.max(last + reach);
+                last = *c;
+            }
+            let mut next = hi;
+            for c in inner.iter_mut().rev() {
+                *c = c.min(next - reach);
+                next = *c;
+            }
+            self.bricks.shift(k, &inner);
+        }
+        self.shifts += 1;
+    }
+
     /// Sends along axis k the particles whose brick index along k is no
     /// longer this rank's, to the face neighbour on their side (a particle
     /// moves less than a brick between builds), and takes in the others'.
     /// Each particle's row is followed by what every interaction keeps of
     /// it, as (length, numbers).
-    fn migrate(&mut self, sys: &mut System, k: usize, interactions: &mut [Box<dyn Interaction>]) {
+    /// Returns how many it sent.
+    fn migrate(
+        &mut self,
+        sys: &mut System,
+        k: usize,
+        interactions: &mut [Box<dyn Interaction>],
+    ) -> usize {
         if self.bricks.dims[k] == 1 {
-            return;
+            return 0;
         }
+        let mut sent = 0;
         let (b, at, p) = (sys.boundary, self.bricks.at[k], self.bricks.dims[k]);
         let mut going = [Vec::new(), Vec::new()];
         let mut stays = vec![true; sys.particles.len()];
@@ -503,6 +599,7 @@ impl Domain {
                     out[head] = (out.len() - head - 1) as f64;
                 }
                 self.migrated += 1;
+                sent += 1;
                 *stay = false;
             }
         }
@@ -527,6 +624,7 @@ impl Domain {
                 }
             }
         }
+        sent
     }
 
     /// The staged ghost exchange at a build (see the module's text), the

@@ -253,6 +253,15 @@ impl Scene {
                     "[parallel] grid: every axis needs at least one brick",
                 ));
             }
+            if let Some(b) = p.get_ref().balance.filter(|b| !(*b == 0.0 || *b >= 1.0)) {
+                return Err(src.error(
+                    p.span(),
+                    format!(
+                        "[parallel] balance = {b}: the imbalance (most particles a rank over \
+                         the mean) above which the bricks shift is at least 1, or 0 for never"
+                    ),
+                ));
+            }
         }
         let files = (self.lammps_data.iter().map(|s| ("lammps_data", s)))
             .chain(self.from_file.iter().map(|s| ("from_file", s)));

@@ -10,4 +10,8 @@ pub struct ParallelTable {
     /// Bricks along x, y and z, their product the number of ranks
     /// (default: the grid of least brick surface for the box's shape).
     pub grid: Option<[usize; 3]>,
+    /// At a list build where the most particles a rank holds exceed the
+    /// mean by this factor, the cuts between bricks shift so that each
+    /// slab holds as many (default 1.1; 0: never).
+    pub balance: Option<f64>,
 }
