@@ -109,7 +109,16 @@ impl Simulation {
                 ))
             }
         };
-        let mut domain = crate::domain::Domain::new(comm, &self.system.boundary, reach, grid)?;
+        let b = &self.system.boundary;
+        let extent = self
+            .system
+            .particles
+            .position
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), r| {
+                (lo.min(b.wrap(*r)), hi.max(b.wrap(*r)))
+            });
+        let mut domain = crate::domain::Domain::new(comm, b, extent, reach, grid)?;
         // A resumed run's lists: one build for all (a decomposed run's
         // lists are built together), the first restored.
         let restored = self

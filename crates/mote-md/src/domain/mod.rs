@@ -203,11 +203,15 @@ impl Domain {
     /// This rank's part of a run over `boundary` on `comm`'s ranks, for
     /// pair lists of `reach` ([`ForceField::halo_reach`]); `grid` forces
     /// the bricks. A run without pairs rebuilds (migrates) every step.
+    /// Along an axis without periodicity or box (walls, or nothing, keep
+    /// the particles) the slabs are cut over the particles' `extent` (the
+    /// smallest and largest coordinates), the outer two reaching beyond.
     ///
     /// [`ForceField::halo_reach`]: crate::ForceField::halo_reach
     pub fn new(
         comm: Arc<dyn Comm>,
         boundary: &Boundary,
+        extent: (DVec3, DVec3),
         reach: HaloReach,
         grid: Option<[usize; 3]>,
     ) -> Result<Self, String> {
@@ -216,8 +220,9 @@ impl Domain {
         } else {
             (reach.cutoff, reach.skin)
         };
-        let dims = Bricks::choose(comm.size(), boundary, cutoff + skin, grid)?;
-        let bricks = Bricks::new(dims, comm.rank(), boundary);
+        let cut = cut_box(boundary, extent);
+        let dims = Bricks::choose(comm.size(), &cut, cutoff + skin, grid)?;
+        let bricks = Bricks::new(dims, comm.rank(), &cut);
         Ok(Self {
             comm,
             bricks,
@@ -515,9 +520,23 @@ impl Domain {
         let reach = self.cutoff + self.skin;
         for k in 0..3 {
             let p = self.bricks.dims[k];
-            let cuts = self.bricks.cuts(k);
-            let (lo, hi) = (cuts[0], cuts[p]);
-            if p == 1 || !(hi - lo).is_finite() {
+            if p == 1 {
+                continue;
+            }
+            let (lo, hi) = if sys.boundary.lengths()[k].is_finite() {
+                (sys.boundary.lo[k], sys.boundary.hi[k])
+            } else {
+                // Over the particles now; the outer slabs reach beyond.
+                let (lo, hi) = sys
+                    .particles
+                    .position
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+                        (lo.min(r[k]), hi.max(r[k]))
+                    });
+                (-self.comm.max(-lo), self.comm.max(hi))
+            };
+            if !(hi - lo).is_finite() {
                 continue;
             }
             let width = (hi - lo) / BINS as f64;
@@ -670,8 +689,12 @@ impl Domain {
                         if !near {
                             continue;
                         }
-                        m[k] += image;
-                        at[k] += image as f64 * l[k];
+                        if image != 0 {
+                            // (Only across a periodic face: an open axis
+                            // has no length.)
+                            m[k] += image;
+                            at[k] += image as f64 * l[k];
+                        }
                         send.push(s as u32);
                         out.extend([id as f64, m[0] as f64, m[1] as f64, m[2] as f64]);
                         out.extend(at.to_array());
@@ -746,6 +769,19 @@ impl Extra {
             h.motion.push(Motion::read(g));
         }
     }
+}
+
+/// The box the bricks cut: `boundary`, with the particles' `extent` along
+/// its axes of infinite length.
+fn cut_box(boundary: &Boundary, extent: (DVec3, DVec3)) -> Boundary {
+    let mut cut = *boundary;
+    for k in 0..3 {
+        if !boundary.lengths()[k].is_finite() {
+            cut.lo[k] = extent.0[k];
+            cut.hi[k] = extent.1[k];
+        }
+    }
+    cut
 }
 
 /// Keeps the entries of `v` where `keep` is true, in order.
