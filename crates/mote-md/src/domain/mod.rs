@@ -622,10 +622,12 @@ impl Domain {
                 *stay = false;
             }
         }
-        retain(&mut self.halo.id, &stays);
-        sys.retain_particles(&stays);
-        for interaction in interactions.iter_mut() {
-            interaction.retain_particles(&stays);
+        if sent > 0 {
+            retain(&mut self.halo.id, &stays);
+            sys.retain_particles(&stays);
+            for interaction in interactions.iter_mut() {
+                interaction.retain_particles(&stays);
+            }
         }
         for (side, out) in going.iter().enumerate() {
             let to = self.bricks.neighbour(k, side == 1).map(|n| n.0);

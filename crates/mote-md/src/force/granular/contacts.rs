@@ -84,48 +84,38 @@ impl Bodies {
     /// The rows at `state` (spins `omega`): this rank's particles as
     /// `pairs` places them, the ghosts' motion now.
     fn gather(&mut self, state: &State, omega: &[DVec3], halo: &Halo, pairs: &ContactPairs) {
-        let rows = pairs.rows();
-        let motion = |r: usize| {
+        let motion = |t: u32| {
             halo.motion
-                .get(self.copy[r] as usize)
+                .get(t as usize)
                 .copied()
                 .expect("the halo forwards the ghosts' motion to granular contacts")
         };
-        let mut out = (
-            Vec::with_capacity(rows),
-            Vec::with_capacity(rows),
-            Vec::with_capacity(rows),
-            Vec::with_capacity(rows),
-            Vec::with_capacity(rows),
-        );
-        for r in 0..rows {
-            let p = pairs.particle[r];
+        for v in [&mut self.position, &mut self.velocity, &mut self.spin] {
+            v.clear();
+        }
+        self.radius.clear();
+        self.mass.clear();
+        for (&p, &t) in pairs.particle.iter().zip(&self.copy) {
             let (x, v, w, radius, mass) = if p == GHOST {
-                let m = motion(r);
+                let m = motion(t);
                 (m.position, m.velocity, m.spin, m.radius, m.mass)
             } else {
                 let p = p as usize;
+                let at = |a: &[f64]| a[p];
                 (
                     state.position[p],
                     state.velocity[p],
                     omega[p],
-                    state.radius[p],
-                    state.mass[p],
+                    at(state.radius),
+                    at(state.mass),
                 )
             };
-            out.0.push(x);
-            out.1.push(v);
-            out.2.push(w);
-            out.3.push(radius);
-            out.4.push(mass);
+            self.position.push(x);
+            self.velocity.push(v);
+            self.spin.push(w);
+            self.radius.push(radius);
+            self.mass.push(mass);
         }
-        (
-            self.position,
-            self.velocity,
-            self.spin,
-            self.radius,
-            self.mass,
-        ) = out;
     }
 
     fn view(&self) -> View<'_> {
