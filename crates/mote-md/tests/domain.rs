@@ -146,22 +146,7 @@ fn checkpoint_at(sim: &mut Simulation, step: usize) -> mote_io::checkpoint::Chec
 /// Puts a checkpoint's state into a freshly built simulation, as the
 /// front's resume does.
 fn resume(cp: &mote_io::checkpoint::Checkpoint) -> Simulation {
-    let mut sim = simulation(crystal());
-    let sys = &mut sim.system;
-    sys.time = cp.time;
-    sys.step = cp.step;
-    for (i, (r, v)) in cp.positions.iter().zip(&cp.velocities).enumerate() {
-        sys.particles.position[i] = DVec3::from(*r);
-        sys.particles.velocity[i] = DVec3::from(*v);
-    }
-    sys.carried_acceleration = cp.accelerations.iter().map(|a| DVec3::from(*a)).collect();
-    for (key, values) in &cp.carried {
-        assert_eq!(key, "lennard_jones");
-        sim.forces.interactions[0]
-            .restore_carried_state(values)
-            .unwrap();
-    }
-    sim
+    restore(simulation(crystal()), cp)
 }
 
 /// A decomposed run's checkpoint is one process's, number for number; a
@@ -398,44 +383,7 @@ fn a_decomposed_ferrofluid_diffuses_as_one_process_does() {
 /// Spheres falling onto a floor in a box periodic across: Hertz–Mindlin
 /// contacts with friction and rolling resistance (their histories) and
 /// the floor's, under gravity.
-const GRANULAR: &str = r#"
-units = "si"
-seed = 5
-
-[run]
-integrator = "leapfrog"
-dt = 1e-5
-
-[box]
-lo = [0.0, 0.0, 0.0]
-hi = [0.024, 0.024, 0.06]
-periodic = [true, true, false]
-
-[field]
-g = [0.0, 0.0, -200.0]
-
-[granular]
-young = 1e6
-poisson = 0.3
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.05
-skin = 0.0005
-
-[[wall]]
-kind = "plane"
-name = "floor"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-
-[[cloud]]
-n = 600
-min = [0.0, 0.0, 0.0]
-max = [0.024, 0.024, 0.05]
-radius = 0.001
-spread = 0.2
-density = 2500.0
-"#;
+const GRANULAR: &str = include_str!("data/granular-bed.toml");
 
 /// A granular bed on 2, 3 and 4 ranks lands as in one process, to the
 /// bit: the contacts' histories travel with their particles, every
@@ -489,11 +437,15 @@ fn a_decomposed_granular_bed_settles_as_one_process_does() {
     }
 }
 
-/// Puts a checkpoint's state into the simulation of scene `text`, as the
-/// front's resume does (positions, velocities, spins, the carried
-/// accelerations and what each interaction carries, by its key).
+/// Puts a checkpoint's state into the simulation of scene `text`.
 fn resume_scene(text: &str, cp: &mote_io::checkpoint::Checkpoint) -> Simulation {
-    let mut sim = crate::common::build(text).simulation;
+    restore(crate::common::build(text).simulation, cp)
+}
+
+/// Puts a checkpoint's state into `sim`, as the front's resume does
+/// (positions, velocities, spins, the carried accelerations and what each
+/// interaction carries, by its key).
+fn restore(mut sim: Simulation, cp: &mote_io::checkpoint::Checkpoint) -> Simulation {
     let sys = &mut sim.system;
     sys.time = cp.time;
     sys.step = cp.step;

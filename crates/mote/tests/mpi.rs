@@ -166,58 +166,17 @@ fn what_does_not_decompose_yet_is_refused_by_name() {
 
 /// Spheres falling onto a floor in a box periodic across: Hertz–Mindlin
 /// contacts with friction and rolling resistance, and the floor's.
-const BED: &str = r#"
-title = "granular bed on ranks"
-units = "si"
-seed = 5
-
-[run]
-integrator = "leapfrog"
-dt = 1e-5
-steps = 1500
-
-[box]
-lo = [0.0, 0.0, 0.0]
-hi = [0.024, 0.024, 0.06]
-periodic = [true, true, false]
-
-[field]
-g = [0.0, 0.0, -200.0]
-
-[granular]
-young = 1e6
-poisson = 0.3
-restitution = 0.5
-friction = 0.5
-rolling_friction = 0.05
-skin = 0.0005
-
-[[wall]]
-kind = "plane"
-name = "floor"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-
-[[cloud]]
-n = 600
-min = [0.0, 0.0, 0.0]
-max = [0.024, 0.024, 0.05]
-radius = 0.001
-spread = 0.2
-density = 2500.0
-
-[output]
-observables_every = 100
-trajectory_every = 500
-"#;
+const BED: &str = include_str!("../../mote-md/tests/data/granular-bed.toml");
 
 /// A granular bed with a wall on 2 and 3 ranks writes one process's
 /// trajectory byte for byte, and the floor's load to round-off.
 #[test]
 fn a_granular_bed_on_two_and_three_ranks_writes_one_process_trajectory() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("bed.toml"), BED).unwrap();
-    let one = plain(&["run", "bed.toml", "-o", "one", "-q"], dir.path());
+    let bed = format!("{BED}\n[output]\nobservables_every = 100\ntrajectory_every = 500\n");
+    std::fs::write(dir.path().join("bed.toml"), bed).unwrap();
+    let args = |out: &'static str| ["run", "bed.toml", "--steps", "1500", "-o", out, "-q"];
+    let one = plain(&args("one"), dir.path());
     assert!(one.status.success(), "{}", text(&one.stderr));
     let read = |run: &str| std::fs::read(dir.path().join(run).join("trajectory.xyz")).unwrap();
     let expected = table(&dir.path().join("one/observables.csv"));
@@ -227,14 +186,14 @@ fn a_granular_bed_on_two_and_three_ranks_writes_one_process_trajectory() {
         "the bed rests on the floor"
     );
     for ranks in [2, 3] {
-        let run = format!("np{ranks}");
-        let o = mpirun(ranks, &["run", "bed.toml", "-o", &run, "-q"], dir.path());
+        let run = if ranks == 2 { "np2" } else { "np3" };
+        let o = mpirun(ranks, &args(run), dir.path());
         assert!(o.status.success(), "{ranks} ranks: {}", text(&o.stderr));
         assert!(
-            read("one") == read(&run),
+            read("one") == read(run),
             "the bed on {ranks} ranks differs from one process's"
         );
-        let got = table(&dir.path().join(&run).join("observables.csv"));
+        let got = table(&dir.path().join(run).join("observables.csv"));
         for (g, e) in got.iter().zip(&expected) {
             let (a, b) = (g[floor], e[floor]);
             assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-3), "{a} against {b}");

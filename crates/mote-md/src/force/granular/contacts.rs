@@ -80,6 +80,23 @@ struct View<'a> {
     mass: &'a [f64],
 }
 
+impl<'a> View<'a> {
+    /// The state's particles (spins `omega`), or on a rank the rows
+    /// `bodies` gathered.
+    fn of(bodies: &'a Bodies, state: &State<'a>, omega: &'a [DVec3]) -> Self {
+        match state.halo {
+            Some(_) => bodies.view(),
+            None => View {
+                position: state.position,
+                velocity: state.velocity,
+                spin: omega,
+                radius: state.radius,
+                mass: state.mass,
+            },
+        }
+    }
+}
+
 impl Bodies {
     /// The rows at `state` (spins `omega`): this rank's particles as
     /// `pairs` places them, the ghosts' motion now.
@@ -192,16 +209,7 @@ impl GranularContacts {
     /// The particles the pairs read: the state's, or on a rank its
     /// particles and ghosts as gathered.
     fn view<'a>(&'a self, state: &State<'a>, omega: &'a [DVec3]) -> View<'a> {
-        match state.halo {
-            Some(_) => self.bodies.view(),
-            None => View {
-                position: state.position,
-                velocity: state.velocity,
-                spin: omega,
-                radius: state.radius,
-                mass: state.mass,
-            },
-        }
+        View::of(&self.bodies, state, omega)
     }
 
     /// Lists the pairs within reach among a rank's particles and ghosts
@@ -300,16 +308,7 @@ impl GranularContacts {
             row_sums.push(head);
             rest = tail;
         }
-        let at = match state.halo {
-            Some(_) => self.bodies.view(),
-            None => View {
-                position: state.position,
-                velocity: state.velocity,
-                spin: omega,
-                radius: state.radius,
-                mass: state.mass,
-            },
-        };
+        let at = View::of(&self.bodies, state, omega);
         let image = state.boundary.image();
         let (law, dt) = (&self.law, state.step.dt);
         let blocks = split_blocks(&mut history, &mut touching, &pairs.start, &firsts);
