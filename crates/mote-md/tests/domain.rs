@@ -253,6 +253,16 @@ fn thermostatted_liquids_decompose() {
     }
 }
 
+/// The simulation of scene `text`, split over `comm`'s ranks (bricks
+/// `grid`) where one is given.
+fn on_ranks(text: &str, comm: Option<Arc<dyn Comm>>, grid: Option<[usize; 3]>) -> Simulation {
+    let mut sim = crate::common::build(text).simulation;
+    if let Some(comm) = comm {
+        sim.decompose(comm, grid).unwrap();
+    }
+    sim
+}
+
 /// The dipolar LJ fluid of `bench/dipole3d.toml`, smaller: LJ and point
 /// dipoles in one cut-off pair loop, the particles turning (leap-frog
 /// with rotation), the ghosts' moments forwarded with their positions.
@@ -288,11 +298,8 @@ dipole = [0.0, 0.0, 0.75]
 #[test]
 fn a_decomposed_dipolar_fluid_steps_as_one_process_does() {
     let run = |comm: Option<Arc<dyn Comm>>| {
-        let mut sim = crate::common::build(DIPOLAR).simulation;
+        let mut sim = on_ranks(DIPOLAR, comm, None);
         assert!(sim.forces.exerts_torques());
-        if let Some(comm) = comm {
-            sim.decompose(comm, None).unwrap();
-        }
         let (first, last) = run(&mut sim);
         (whole(sim), first, last)
     };
@@ -359,11 +366,8 @@ dipole = [0.0, 0.0, 1.7320508075688772]
 #[test]
 fn a_decomposed_ferrofluid_diffuses_as_one_process_does() {
     let run = |comm: Option<Arc<dyn Comm>>| {
-        let mut sim = crate::common::build(FERROFLUID).simulation;
+        let mut sim = on_ranks(FERROFLUID, comm, None);
         assert!(sim.brownian.is_some());
-        if let Some(comm) = comm {
-            sim.decompose(comm, None).unwrap();
-        }
         run(&mut sim);
         whole(sim)
     };
@@ -392,10 +396,7 @@ const GRANULAR: &str = include_str!("data/granular-bed.toml");
 #[test]
 fn a_decomposed_granular_bed_settles_as_one_process_does() {
     let run = |comm: Option<Arc<dyn Comm>>, grid: Option<[usize; 3]>| {
-        let mut sim = crate::common::build(GRANULAR).simulation;
-        if let Some(comm) = comm {
-            sim.decompose(comm, grid).unwrap();
-        }
+        let mut sim = on_ranks(GRANULAR, comm, grid);
         let (first, last) = run_for(&mut sim, 1200);
         // The touching pairs, each counted on one rank.
         let granular = sim
@@ -483,9 +484,7 @@ fn a_granular_checkpoint_of_two_ranks_resumes_on_one_and_three() {
     }
     let end = one.system.particles;
     let taken = in_process(2, |comm| {
-        let mut sim = crate::common::build(GRANULAR).simulation;
-        sim.decompose(comm, None).unwrap();
-        checkpoint_at(&mut sim, HALF)
+        checkpoint_at(&mut on_ranks(GRANULAR, Some(comm), None), HALF)
     });
     let cp = &taken[0];
     assert_eq!(cp.positions, plain.positions);
@@ -544,10 +543,8 @@ fn walled_bed() -> String {
 fn the_cut_follows_a_settling_bed() {
     let bed = walled_bed();
     let run = |comm: Option<Arc<dyn Comm>>, balance: f64| {
-        let mut sim = crate::common::build(&bed).simulation;
-        if let Some(comm) = comm {
-            sim.decompose(comm, None).unwrap();
-            let domain = sim.forces.domain.as_mut().unwrap();
+        let mut sim = on_ranks(&bed, comm, None);
+        if let Some(domain) = sim.forces.domain.as_mut() {
             assert_eq!(domain.bricks.dims, [1, 1, 2]);
             domain.balance = balance;
         }

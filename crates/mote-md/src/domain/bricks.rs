@@ -26,7 +26,8 @@ impl Bricks {
     /// `ranks` as px·py·pz, the one whose bricks have the least surface
     /// Lx Ly/(px py) + Ly Lz/(py pz) + Lz Lx/(pz px), every cut brick at
     /// least `reach` wide (so ghosts come from face neighbours alone), and
-    /// no cut along an axis without walls on both sides. `grid` (from
+    /// no cut along an axis of infinite length (`Domain` hands it a box
+    /// whose open axes span the particles). `grid` (from
     /// `[parallel] grid`) chooses it instead.
     pub fn choose(
         ranks: usize,
