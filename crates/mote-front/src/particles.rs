@@ -434,8 +434,15 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
     } else {
         String::new()
     };
+    let solvers: String = sim
+        .forces
+        .interactions
+        .iter()
+        .filter_map(|i| i.describe())
+        .map(|d| format!(" {d}"))
+        .collect();
     format!(
-        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). {energy}{pressure} Output in {}: {}. {}",
+        "Ran {} steps to t = {:.6e} {} in {:.3} s of wall time ({:.0} steps/s). {energy}{pressure}{solvers} Output in {}: {}. {}",
         report.steps,
         report.last.time,
         t_unit,

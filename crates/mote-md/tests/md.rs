@@ -21,6 +21,7 @@ mod lennard_jones;
 mod lj_eos;
 mod magnet;
 mod oscillator;
+mod p3m;
 mod plist_twin;
 mod pressure;
 mod rigid_contacts;

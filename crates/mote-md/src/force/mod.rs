@@ -11,6 +11,7 @@ pub mod granular;
 mod gravity;
 pub mod latent;
 pub mod lennard_jones;
+pub mod p3m;
 pub mod slab;
 mod springs;
 pub mod timing;
@@ -361,6 +362,12 @@ pub trait Interaction: Send + Sync {
     fn neighbour_reach(&self) -> Option<(f64, f64)> {
         None
     }
+    /// A sentence for the run's summary on the parameters it chose (a
+    /// tuned long-range solver's mesh and error estimate); `None` if
+    /// there is nothing to say.
+    fn describe(&self) -> Option<String> {
+        None
+    }
 }
 
 /// A boxed interaction is one: a scene's tables make them so, and a law
@@ -425,6 +432,9 @@ impl Interaction for Box<dyn Interaction> {
     }
     fn neighbour_reach(&self) -> Option<(f64, f64)> {
         (**self).neighbour_reach()
+    }
+    fn describe(&self) -> Option<String> {
+        (**self).describe()
     }
 }
 

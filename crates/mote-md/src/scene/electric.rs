@@ -1,6 +1,8 @@
 //! `[coulomb]`: forces between the particles' charges, by direct summation
-//! or a Barnes–Hut tree in open space, or by Ewald summation in a cubic
-//! periodic box; `[electric_field]`: a uniform field E(t) = E₀ cos(ωt + φ).
+//! or a Barnes–Hut tree in open space, by Ewald summation in a cubic
+//! periodic box, or by P3M (particle–particle particle–mesh) in any
+//! orthorhombic periodic box; `[electric_field]`: a uniform field
+//! E(t) = E₀ cos(ωt + φ).
 
 use std::ops::Range;
 
@@ -13,6 +15,7 @@ use super::gravity::direct;
 use super::{Build, Scene, Section};
 use crate::boundary::Boundary;
 use crate::force::ewald::EwaldCoulomb;
+use crate::force::p3m::{self, P3mCoulomb};
 use crate::force::{DirectCoulomb, ElectricField};
 use crate::tree::TreeCoulomb;
 
@@ -23,19 +26,29 @@ pub struct CoulombSettings {
     /// Coulomb's constant 1/(4πε₀); default: the unit system's (1 in LJ units).
     pub k: Option<f64>,
     /// `direct` (default: every pair, open space), `tree` (Barnes–Hut with
-    /// multipoles to quadrupole, open space) or `ewald` (cubic periodic box,
-    /// tin-foil boundaries).
+    /// multipoles to quadrupole, open space), `ewald` (cubic periodic box,
+    /// tin-foil boundaries) or `p3m` (the Ewald sum's k-space part on a
+    /// mesh: any orthorhombic periodic box, O(N log N)).
     #[serde(default = "direct")]
     pub method: String,
     /// Softening length ε of `direct` and `tree` (default 0).
     pub softening: Option<f64>,
     /// Opening angle θ of the tree (default 0.5).
     pub theta: Option<f64>,
-    /// Ewald's real-space cut-off (default half the box side).
+    /// The real-space cut-off (Ewald: default half the box side; P3M:
+    /// tuned when not given).
     pub cutoff: Option<f64>,
-    /// Ewald: the RMS force error aimed at, in force units (Kolafa & Perram
-    /// 1992 choose α and the k-vectors from it).
+    /// Ewald and P3M: the RMS force error aimed at, in force units (Kolafa
+    /// & Perram 1992 choose α and the k-vectors from it; for P3M, Deserno
+    /// & Holm 1998 the mesh).
     pub accuracy: Option<f64>,
+    /// P3M: the Verlet skin of the real-space list (default a tenth of the
+    /// cut-off).
+    pub skin: Option<f64>,
+    /// P3M: mesh points along each axis (default: tuned).
+    pub mesh: Option<[usize; 3]>,
+    /// P3M: charge-assignment order 1–7 (default: tuned, 3–7).
+    pub order: Option<usize>,
 }
 
 /// The Coulomb law a `[coulomb]` table chooses.
@@ -44,6 +57,7 @@ pub enum CoulombLaw {
     Direct(DirectCoulomb),
     Tree(TreeCoulomb),
     Ewald(EwaldCoulomb),
+    P3m(Box<P3mCoulomb>),
 }
 
 impl Section for CoulombSettings {
@@ -59,6 +73,7 @@ impl Section for CoulombSettings {
             CoulombLaw::Direct(c) => b.forces.push(c),
             CoulombLaw::Tree(c) => b.forces.push(c),
             CoulombLaw::Ewald(c) => b.forces.push(c),
+            CoulombLaw::P3m(c) => b.forces.push(*c),
         }
         Ok(())
     }
@@ -109,6 +124,15 @@ impl CoulombSettings {
                 Ok(())
             }
         };
+        if matches!(self.method.as_str(), "direct" | "tree" | "ewald") {
+            for (key, given) in [
+                ("skin", self.skin.is_some()),
+                ("mesh", self.mesh.is_some()),
+                ("order", self.order.is_some()),
+            ] {
+                refuse(key, given, &self.method)?;
+            }
+        }
         let softening = self.softening.unwrap_or(0.0);
         if softening.is_nan() || softening < 0.0 {
             return Err(err(format!(
@@ -156,12 +180,93 @@ impl CoulombSettings {
                 positive(src, span.clone(), "[coulomb] accuracy", accuracy)?;
                 CoulombLaw::Ewald(EwaldCoulomb::new(k, charge, l, rc, accuracy))
             }
+            "p3m" => {
+                refuse("softening", self.softening.is_some(), "p3m")?;
+                refuse("theta", self.theta.is_some(), "p3m")?;
+                CoulombLaw::P3m(Box::new(self.p3m(span, src, k, charge, boundary)?))
+            }
             other => {
                 return Err(err(format!(
-                    "[coulomb] unknown method '{other}': expected direct, tree or ewald"
+                    "[coulomb] unknown method '{other}': expected direct, tree, ewald or p3m"
                 )))
             }
         })
+    }
+}
+
+impl CoulombSettings {
+    /// P3M tuned for this table's accuracy, with its fixed choices.
+    fn p3m(
+        &self,
+        span: Range<usize>,
+        src: Source,
+        k: f64,
+        charge: &[f64],
+        boundary: Boundary,
+    ) -> Result<P3mCoulomb, ParseError> {
+        let err = |msg: String| src.error(span.clone(), msg);
+        let l = boundary.lengths();
+        if boundary.periodic != [true; 3] || !(l.min_element() > 0.0 && l.max_element().is_finite())
+        {
+            return Err(err(
+                "[coulomb] method = \"p3m\" needs a [box] periodic on every axis".into(),
+            ));
+        }
+        let accuracy = self.accuracy.ok_or_else(|| {
+            err("[coulomb] method = \"p3m\" needs accuracy = the RMS force error aimed at (force units)".into())
+        })?;
+        positive(src, span.clone(), "[coulomb] accuracy", accuracy)?;
+        let cutoff = match self.cutoff {
+            Some(rc) => Some(positive(src, span.clone(), "[coulomb] cutoff", rc)?),
+            None => None,
+        };
+        let skin = match (self.skin, cutoff) {
+            (Some(s), _) => {
+                if !(s >= 0.0 && s.is_finite()) {
+                    return Err(err(format!(
+                        "[coulomb] skin must not be negative, found {s}"
+                    )));
+                }
+                s
+            }
+            (None, Some(rc)) => 0.1 * rc,
+            // A tenth of the cut-off tuning is likely to choose: three
+            // particle spacings.
+            (None, None) => 0.3 * (l.element_product() / charge.len().max(1) as f64).cbrt(),
+        };
+        if let Some(rc) = cutoff {
+            if rc + skin > 0.5 * l.min_element() {
+                return Err(err(format!(
+                    "[coulomb] cutoff + skin = {} must be at most half the shortest box side, {}",
+                    rc + skin,
+                    0.5 * l.min_element()
+                )));
+            }
+        }
+        if let Some(p) = self.order {
+            if !(1..=p3m::spline::MAX_ORDER).contains(&p) {
+                return Err(err(format!(
+                    "[coulomb] order must be 1 to {}, found {p}",
+                    p3m::spline::MAX_ORDER
+                )));
+            }
+        }
+        if let Some(mesh) = self.mesh {
+            let least = self.order.unwrap_or(1).max(2);
+            if mesh.iter().any(|&m| m < least || m > 4096) {
+                return Err(err(format!(
+                    "[coulomb] mesh {mesh:?}: every side must be {least} to 4096 points (at least the order)"
+                )));
+            }
+        }
+        let request = p3m::Request {
+            accuracy,
+            cutoff,
+            skin,
+            mesh: self.mesh,
+            order: self.order,
+        };
+        P3mCoulomb::tuned(k, &request, charge, &boundary).map_err(|e| err(format!("[coulomb] {e}")))
     }
 }
 

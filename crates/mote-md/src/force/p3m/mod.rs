@@ -1,0 +1,264 @@
+//! Particle–particle particle–mesh (P3M) Coulomb forces in a periodic
+//! orthorhombic box, tin-foil boundaries (Hockney & Eastwood, *Computer
+//! Simulation Using Particles*, ch. 7–8; Deserno & Holm 1998, J. Chem.
+//! Phys. 109, 7678): the Ewald sum of [`super::ewald`] with its k-space
+//! part on a mesh and FFTs, O(N log N) instead of O(N^{3/2}).
+//!
+//! U = k_e [½ Σ_{i≠j, r<r_c} q_i q_j erfc(α r_ij)/r_ij + U_mesh
+//!     − (α/√π) Σ q² − π Q²/(2Vα²)],
+//!
+//! the real-space pairs over a neighbour list of their own (the force on i
+//! from j, q_i q_j [erfc(αr)/r + (2α/√π) e^{−α²r²}] r/r²), the mesh part
+//! by [`mesh`], the self energy and the neutralising background as in the
+//! Ewald sum (zero for a neutral system). The parameters (mesh, order,
+//! α, r_c) come from the RMS force error asked for ([`tune`]).
+
+mod fft;
+pub mod mesh;
+pub mod spline;
+pub mod tune;
+
+use glam::DVec3;
+use libm::erfc;
+
+use super::{Interaction, State, Virial};
+use crate::boundary::Boundary;
+use crate::neighbor::GhostList;
+pub use tune::{Parameters, Request};
+
+const SQRT_PI: f64 = 1.772_453_850_905_516;
+
+/// Coulomb forces by P3M.
+#[derive(Debug, Clone)]
+pub struct P3mCoulomb {
+    /// Coulomb's constant k_e = 1/(4πε₀).
+    pub k: f64,
+    pub parameters: Parameters,
+    list: GhostList,
+    mesh: mesh::Mesh,
+    /// The charge of each copy of the list.
+    copy_charge: Vec<f64>,
+    sorted_force: Vec<DVec3>,
+    /// Of the last energy (NaN after a later force evaluation).
+    virial: f64,
+}
+
+/// What a real-space row adds up: the force on its particle over its
+/// charge, Σ (F/r) r² and Σ U (each pair counted in two rows).
+#[derive(Debug, Clone, Copy, Default)]
+struct RowSum {
+    field: DVec3,
+    virial: f64,
+    energy: f64,
+}
+
+impl P3mCoulomb {
+    /// P3M with `parameters` in `boundary` (periodic on every axis), its
+    /// real-space list with `skin`.
+    pub fn new(k: f64, parameters: Parameters, skin: f64, boundary: &Boundary) -> Self {
+        let cell = boundary.lengths();
+        Self {
+            k,
+            parameters,
+            list: GhostList::new(parameters.cutoff, skin),
+            mesh: mesh::Mesh::new(
+                parameters.mesh,
+                parameters.order,
+                parameters.alpha,
+                boundary.lo,
+                cell,
+            ),
+            copy_charge: Vec::new(),
+            sorted_force: Vec::new(),
+            virial: f64::NAN,
+        }
+    }
+
+    /// Tuned for `request` (its accuracy in force units) and `charge` in
+    /// `boundary`.
+    pub fn tuned(
+        k: f64,
+        request: &Request,
+        charge: &[f64],
+        boundary: &Boundary,
+    ) -> Result<Self, String> {
+        let q2: f64 = charge.iter().map(|q| q * q).sum();
+        let gaussian = Request {
+            accuracy: request.accuracy / k,
+            ..*request
+        };
+        let mut parameters = tune::tune(boundary.lengths(), charge.len(), q2, &gaussian)?;
+        parameters.real_error *= k;
+        parameters.kspace_error *= k;
+        Ok(Self::new(k, parameters, request.skin, boundary))
+    }
+
+    /// Brings the list to `state` (counting a step when `step`) and the
+    /// copies' charges with it.
+    fn follow(&mut self, state: &State, step: bool) {
+        if step {
+            self.list.update(state.position, state.boundary);
+        } else {
+            self.list.refresh(state.position, state.boundary);
+        }
+        let q = state.charges();
+        self.copy_charge.clear();
+        self.copy_charge
+            .extend(self.list.particle.iter().map(|&i| q[i as usize]));
+    }
+
+    /// The real-space rows into `sorted` (each row's force) and the halved
+    /// sums of the virial and the energy, Gaussian units.
+    fn rows(&self, sorted: &mut [DVec3], energy: bool) -> (f64, f64) {
+        let (list, q) = (&self.list, &self.copy_charge);
+        let (alpha, rc2) = (self.parameters.alpha, self.parameters.cutoff.powi(2));
+        let [w, u] = list.sum_rows(sorted, |r| {
+            let k = list.owner[r] as usize;
+            let s = row(list, q, r, alpha, rc2, energy);
+            (s.field * q[k], [s.virial * q[k], s.energy * q[k]])
+        });
+        (0.5 * w, 0.5 * u)
+    }
+
+    /// −(α/√π) Σ q² − π Q²/(2Vα²): the self energy and the background.
+    fn self_and_background(&self, charge: &[f64]) -> (f64, f64) {
+        let alpha = self.parameters.alpha;
+        let q2: f64 = charge.iter().map(|q| q * q).sum();
+        let q: f64 = charge.iter().sum();
+        let v = self.mesh.volume();
+        (
+            -alpha / SQRT_PI * q2,
+            -std::f64::consts::PI * q * q / (2.0 * v * alpha * alpha),
+        )
+    }
+
+    /// "Coulomb by P3M: mesh 32 × 32 × 32, order 5, α = …": for summaries.
+    pub fn describe(&self) -> String {
+        let p = &self.parameters;
+        format!(
+            "Coulomb by P3M: mesh {} × {} × {}, assignment order {}, α = {:.6}, real-space cut-off {:.6}; estimated RMS force error {:.3e} (real space {:.3e}, mesh {:.3e}).",
+            p.mesh[0],
+            p.mesh[1],
+            p.mesh[2],
+            p.order,
+            p.alpha,
+            p.cutoff,
+            p.estimated_error(),
+            p.real_error,
+            p.kspace_error
+        )
+    }
+}
+
+/// Row r: Σ_j q_j [erfc(αr)/r + (2α/√π) e^{−α²r²}] r/r² and its virial
+/// and energy sums, all over the charge q_i of the row's particle.
+#[inline]
+fn row(list: &GhostList, q: &[f64], r: usize, alpha: f64, rc2: f64, energy: bool) -> RowSum {
+    let xi = list.at(list.owner[r] as usize);
+    let mut s = RowSum::default();
+    let a2 = alpha * alpha;
+    let g = 2.0 * alpha / SQRT_PI;
+    for &j in list.row(r) {
+        let j = j as usize;
+        let d = xi - list.at(j);
+        let r2 = d.length_squared();
+        if r2 >= rc2 {
+            continue;
+        }
+        let r = r2.sqrt();
+        let screened = erfc(alpha * r) / r;
+        let f_over_r = q[j] * (screened + g * (-a2 * r2).exp()) / r2;
+        s.field += d * f_over_r;
+        s.virial += f_over_r * r2;
+        if energy {
+            s.energy += q[j] * screened;
+        }
+    }
+    s
+}
+
+impl Interaction for P3mCoulomb {
+    fn name(&self) -> &'static str {
+        "coulomb"
+    }
+
+    fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
+        self.follow(state, true);
+        let mut sorted = std::mem::take(&mut self.sorted_force);
+        sorted.resize(state.position.len(), DVec3::ZERO);
+        self.rows(&mut sorted, false);
+        for f in &mut sorted {
+            *f *= self.k;
+        }
+        self.list.scatter_add(&sorted, force);
+        self.sorted_force = sorted;
+        self.mesh
+            .add_forces(state.position, state.charges(), self.k, force);
+        self.virial = f64::NAN;
+    }
+
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        self.follow(state, false);
+        let mut sorted = std::mem::take(&mut self.sorted_force);
+        sorted.resize(state.position.len(), DVec3::ZERO);
+        let (w_real, u_real) = self.rows(&mut sorted, true);
+        self.sorted_force = sorted;
+        let (u_mesh, w_mesh) =
+            self.mesh
+                .energy_and_virial(state.position, state.charges(), self.parameters.alpha);
+        let (u_self, u_background) = self.self_and_background(state.charges());
+        self.virial = self.k * (w_real + w_mesh[0] + w_mesh[1] + w_mesh[2] + 3.0 * u_background);
+        self.k * (u_real + u_mesh + u_self + u_background)
+    }
+
+    fn virial(&self) -> Option<f64> {
+        Some(self.virial)
+    }
+
+    /// The real-space pairs' r ⊗ F, the mesh's strain derivative and the
+    /// background's isotropic part.
+    fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
+        self.follow(state, false);
+        let (list, q) = (&self.list, &self.copy_charge);
+        let (alpha, rc2) = (self.parameters.alpha, self.parameters.cutoff.powi(2));
+        let g = 2.0 * alpha / SQRT_PI;
+        let mut rows = vec![(); list.len()];
+        let real = list.sum_rows(&mut rows, |r| {
+            let k = list.owner[r] as usize;
+            let xi = list.at(k);
+            let mut w = Virial::default();
+            for &j in list.row(r) {
+                let d = xi - list.at(j as usize);
+                let r2 = d.length_squared();
+                if r2 < rc2 {
+                    let r = r2.sqrt();
+                    let f = q[k]
+                        * q[j as usize]
+                        * (erfc(alpha * r) / r + g * (-alpha * alpha * r2).exp())
+                        / r2;
+                    w += Virial::central(d, f);
+                }
+            }
+            ((), w.0)
+        });
+        let (_, mesh) = self
+            .mesh
+            .energy_and_virial(state.position, state.charges(), alpha);
+        let (_, background) = self.self_and_background(state.charges());
+        let w = Virial(real).scaled(0.5) + Virial(mesh) + Virial::isotropic(background);
+        Some(w.scaled(self.k))
+    }
+
+    /// The neighbour list's build, as Lennard-Jones carries it.
+    fn carried_state(&self) -> Vec<f64> {
+        self.list.carried_state()
+    }
+
+    fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        self.list.restore(state)
+    }
+
+    fn describe(&self) -> Option<String> {
+        Some(P3mCoulomb::describe(self))
+    }
+}

@@ -1,0 +1,217 @@
+//! Choosing P3M's parameters from the RMS force error asked for, as
+//! ESPResSo's tuning does (Deserno & Holm 1998, §4): for each cut-off r_c
+//! and assignment order p, α makes the real-space error (Kolafa & Perram
+//! 1992, Eq. 18) δ/√2, and the mesh is the smallest whose k-space error
+//! (the optimal-influence-function estimate of [`super::mesh`]) is at most
+//! δ/√2; of these, the cheapest by a cost model of the three parts:
+//!
+//!   cost = c_pair N n_pairs + c_point N (2 p³) + c_fft 3 M log₂ M,
+//!
+//! n_pairs = (4π/3)(r_c + skin)³ ρ the neighbours of a particle, M the mesh
+//! points. The constants are the per-pair, per-assigned-point and
+//! per-point-and-level costs measured on the molten-salt benchmark
+//! (BENCHMARKS.md); they fix the choice, so a scene gives the same
+//! parameters on every machine.
+
+use glam::DVec3;
+
+use super::mesh::{kspace_error, Aliases};
+use super::spline::MAX_ORDER;
+
+/// Seconds per listed pair of the real-space rows.
+const PAIR_COST: f64 = 4.0e-9;
+/// Seconds per mesh point a particle is assigned to or interpolated from.
+const POINT_COST: f64 = 1.5e-9;
+/// Seconds per mesh point and binary level of one 3-D transform.
+const FFT_COST: f64 = 1.0e-9;
+
+/// The largest mesh side tuning tries (512³ points are 2 GiB a buffer).
+const MAX_MESH: usize = 512;
+
+/// Mesh sizes with small prime factors (2, 3, 5), which rustfft transforms
+/// fastest.
+fn nice_sizes() -> Vec<usize> {
+    (4..=MAX_MESH)
+        .filter(|&m| {
+            let mut r = m;
+            for p in [2, 3, 5] {
+                while r % p == 0 {
+                    r /= p;
+                }
+            }
+            r == 1 && m % 2 == 0
+        })
+        .collect()
+}
+
+/// What a scene fixes; the rest is tuned.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Request {
+    /// The RMS force error aimed at (Gaussian units: force over the
+    /// Coulomb constant).
+    pub accuracy: f64,
+    pub cutoff: Option<f64>,
+    pub skin: f64,
+    pub mesh: Option<[usize; 3]>,
+    pub order: Option<usize>,
+}
+
+/// P3M's parameters and their estimated errors (Gaussian units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Parameters {
+    pub mesh: [usize; 3],
+    pub order: usize,
+    pub alpha: f64,
+    pub cutoff: f64,
+    pub real_error: f64,
+    pub kspace_error: f64,
+}
+
+impl Parameters {
+    /// √(δ_real² + δ_k²).
+    pub fn estimated_error(&self) -> f64 {
+        self.real_error.hypot(self.kspace_error)
+    }
+}
+
+/// The real-space RMS force error of N charges with Σq² = `q2`
+/// (Kolafa & Perram 1992, Eq. 18): 2 Σq² e^{−α²r_c²}/√(N r_c V).
+pub fn real_error(alpha: f64, cutoff: f64, volume: f64, n: f64, q2: f64) -> f64 {
+    2.0 * q2 * (-(alpha * cutoff).powi(2)).exp() / (n * cutoff * volume).sqrt()
+}
+
+/// The α at which the real-space error falls to `target` (bisection on a
+/// log scale; the error decreases with α).
+fn alpha_for(target: f64, cutoff: f64, volume: f64, n: f64, q2: f64) -> f64 {
+    let error = |a: f64| real_error(a, cutoff, volume, n, q2);
+    let (mut lo, mut hi) = (1e-3 / cutoff, 100.0 / cutoff);
+    if error(lo) <= target {
+        return lo;
+    }
+    for _ in 0..100 {
+        let mid = (lo * hi).sqrt();
+        if error(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// The mesh of `scale` points along the longest side, the others in
+/// proportion, each a nice size.
+fn mesh_of(scale: usize, cell: DVec3, sizes: &[usize]) -> [usize; 3] {
+    let longest = cell.max_element();
+    [0, 1, 2].map(|a| {
+        let want = (scale as f64 * cell[a] / longest).ceil() as usize;
+        *sizes.iter().find(|&&m| m >= want).unwrap_or(&want)
+    })
+}
+
+/// The cheapest parameters meeting `request.accuracy` for `n` charges with
+/// Σq² = `q2` in a periodic box of sides `cell`, or why there are none.
+pub fn tune(cell: DVec3, n: usize, q2: f64, request: &Request) -> Result<Parameters, String> {
+    let (volume, nf) = (cell.element_product(), n.max(1) as f64);
+    let q2 = q2.max(f64::MIN_POSITIVE);
+    let half = 0.5 * cell.min_element();
+    let density = nf / volume;
+    let spacing = density.powf(-1.0 / 3.0);
+    let cutoffs: Vec<f64> = match request.cutoff {
+        Some(rc) => vec![rc],
+        None => [2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0]
+            .iter()
+            .map(|f| f * spacing)
+            .filter(|rc| rc + request.skin <= half)
+            .collect(),
+    };
+    if cutoffs.is_empty() {
+        return Err(format!(
+            "the box (shortest side {}) is too small for a real-space cut-off of two particle spacings ({:.4}) plus the skin: give cutoff",
+            2.0 * half,
+            2.0 * spacing
+        ));
+    }
+    let orders: Vec<usize> = match request.order {
+        Some(p) => vec![p],
+        None => (3..=MAX_ORDER).collect(),
+    };
+    let sizes = nice_sizes();
+    let part = request.accuracy / std::f64::consts::SQRT_2;
+    let mut best: Option<(f64, Parameters)> = None;
+    for &cutoff in &cutoffs {
+        let alpha = alpha_for(part, cutoff, volume, nf, q2);
+        let real = real_error(alpha, cutoff, volume, nf, q2);
+        for &order in &orders {
+            let error =
+                |mesh: [usize; 3]| kspace_error(mesh, cell, order, alpha, nf, q2, Aliases::Tuning);
+            let mesh = match request.mesh {
+                Some(mesh) => mesh,
+                None => {
+                    // The smallest scale whose mesh meets δ/√2 (the error
+                    // falls as the mesh grows): doubling from the order up,
+                    // then bisection between the last two scales.
+                    let fits = |s: usize| error(mesh_of(s, cell, &sizes)) <= part;
+                    let candidates: Vec<usize> = sizes
+                        .iter()
+                        .copied()
+                        .filter(|&m| m >= order.max(4))
+                        .collect();
+                    let (mut lo, mut hi) = (0, 0);
+                    let found = loop {
+                        if fits(candidates[hi]) {
+                            break true;
+                        }
+                        if hi + 1 == candidates.len() {
+                            break false;
+                        }
+                        lo = hi + 1;
+                        let want = 2 * candidates[hi];
+                        hi = candidates
+                            .iter()
+                            .position(|&m| m >= want)
+                            .unwrap_or(candidates.len() - 1);
+                    };
+                    if !found {
+                        continue;
+                    }
+                    while lo < hi {
+                        let mid = (lo + hi) / 2;
+                        if fits(candidates[mid]) {
+                            hi = mid;
+                        } else {
+                            lo = mid + 1;
+                        }
+                    }
+                    mesh_of(candidates[lo], cell, &sizes)
+                }
+            };
+            let kspace = kspace_error(mesh, cell, order, alpha, nf, q2, Aliases::Full);
+            let points = mesh.iter().product::<usize>() as f64;
+            let pairs =
+                4.0 / 3.0 * std::f64::consts::PI * (cutoff + request.skin).powi(3) * density;
+            let cost = PAIR_COST * nf * pairs
+                + POINT_COST * nf * 2.0 * (order as f64).powi(3)
+                + FFT_COST * 3.0 * points * points.log2();
+            let candidate = Parameters {
+                mesh,
+                order,
+                alpha,
+                cutoff,
+                real_error: real,
+                kspace_error: kspace,
+            };
+            if best.as_ref().is_none_or(|(c, _)| cost < *c) {
+                best = Some((cost, candidate));
+            }
+        }
+    }
+    let (_, best) = best.ok_or_else(|| {
+        format!(
+            "no mesh up to {0}³ reaches the accuracy {1:e} with these cut-offs: ask for less, or a larger cutoff",
+            sizes.last().copied().unwrap_or(0),
+            request.accuracy
+        )
+    })?;
+    Ok(best)
+}
