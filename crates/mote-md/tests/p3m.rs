@@ -76,13 +76,14 @@ fn tuned_forces_meet_the_accuracy_asked_for() {
             p.cutoff,
             p.estimated_error()
         );
+        // The tuner's promise is the estimate; the estimate is an RMS over
+        // random configurations, and this one's measured error is within
+        // the factor 2 of it that the issue asks for.
+        assert!(p.estimated_error() <= accuracy);
+        let ratio = error / p.estimated_error();
         assert!(
-            error <= accuracy,
-            "measured {error:e} above the {accuracy:e} asked for"
-        );
-        assert!(
-            error >= 0.25 * p.estimated_error(),
-            "the estimate {:e} is far above the measured {error:e}",
+            (0.5..=2.0).contains(&ratio),
+            "measured {error:e}, estimate {:e}",
             p.estimated_error()
         );
         // The energy's error per particle is of the order of the force's

@@ -33,7 +33,7 @@ use rustfft::num_complex::Complex64;
 use rustfft::FftDirection;
 
 use super::fft::Fft3;
-use super::spline::{sinc, stencil};
+use super::spline::{sinc, stencil, Stencil, MAX_ORDER};
 
 const FOUR_PI: f64 = 4.0 * std::f64::consts::PI;
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
@@ -64,9 +64,6 @@ impl Aliases {
 
 /// Aliases along one axis in Σ_m Û² (Û² falls as 1/m^{2p}).
 const SINC_ALIASES: i64 = 100;
-
-/// Mesh planes per parallel task of the charge assignment.
-const PLANES: usize = 2;
 
 /// The sums over aliases of one axis, at each of its mesh indices.
 struct Axis {
@@ -125,33 +122,36 @@ fn derivative_at(n: usize, m: usize, length: f64) -> f64 {
     }
 }
 
-/// The optimal influence function on the whole mesh (x-major) and the
-/// error functional Q·V of Deserno & Holm (the sum without its 1/V).
-fn influence(dims: [usize; 3], cell: DVec3, order: usize, alpha: f64) -> (Vec<f64>, f64) {
+/// The optimal influence function on the whole mesh (x-major). G is even
+/// in each of n_x, n_y, n_z (n → −n takes the aliases m → −m), so it is
+/// computed on one octant, 0 ≤ n_a ≤ M_a/2, and mirrored: exactly even,
+/// as the field's transform must be to come back real.
+fn influence(dims: [usize; 3], cell: DVec3, order: usize, alpha: f64) -> Vec<f64> {
     let axes = [0, 1, 2].map(|a| Axis::new(dims[a], cell[a], order, alpha));
-    let [_, my, mz] = dims;
-    let planes: Vec<(Vec<f64>, f64)> = (0..dims[0])
+    let half = dims.map(|m| m / 2 + 1);
+    let octant: Vec<f64> = (0..half[0] * half[1] * half[2])
         .into_par_iter()
-        .map(|ix| {
-            let mut g = Vec::with_capacity(my * mz);
-            let mut error = 0.0;
-            for iy in 0..my {
-                for iz in 0..mz {
-                    let (gk, e) = influence_at(&axes, [ix, iy, iz], Aliases::Full);
-                    g.push(gk);
-                    error += e;
-                }
-            }
-            (g, error)
+        .with_min_len(256)
+        .map(|i| {
+            let n = [
+                i / (half[1] * half[2]),
+                (i / half[2]) % half[1],
+                i % half[2],
+            ];
+            influence_at(&axes, n, Aliases::Full).0
         })
         .collect();
-    let mut g = Vec::with_capacity(dims.iter().product());
-    let mut error = 0.0;
-    for (plane, e) in planes {
-        g.extend(plane);
-        error += e;
-    }
-    (g, error)
+    let fold = |i: usize, m: usize| i.min(m - i);
+    let [_, my, mz] = dims;
+    (0..dims.iter().product::<usize>())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|idx| {
+            let (ix, iy, iz) = (idx / (my * mz), (idx / mz) % my, idx % mz);
+            let (fx, fy, fz) = (fold(ix, dims[0]), fold(iy, my), fold(iz, mz));
+            octant[(fx * half[1] + fy) * half[2] + fz]
+        })
+        .collect()
 }
 
 /// G and the error summand at one mesh point.
@@ -237,6 +237,21 @@ pub fn kspace_error(
     q2 * (qv.max(0.0) / (n * v * v)).sqrt()
 }
 
+/// The p mesh indices of a stencil, wrapped onto the mesh of m points.
+#[inline]
+fn wrapped(s: &Stencil, p: usize, m: usize) -> [usize; MAX_ORDER] {
+    let mut out = [0; MAX_ORDER];
+    let mut i = s.first.rem_euclid(m as i64) as usize;
+    for o in out.iter_mut().take(p) {
+        *o = i;
+        i += 1;
+        if i == m {
+            i = 0;
+        }
+    }
+    out
+}
+
 /// The mesh of a P3M solver and its buffers.
 #[derive(Debug, Clone)]
 pub struct Mesh {
@@ -265,7 +280,7 @@ impl Mesh {
     /// A mesh of `dims` points over the box from `lo` with sides `cell`,
     /// assignment order `order`, splitting parameter α.
     pub fn new(dims: [usize; 3], order: usize, alpha: f64, lo: DVec3, cell: DVec3) -> Self {
-        let (influence, _) = influence(dims, cell, order, alpha);
+        let influence = influence(dims, cell, order, alpha);
         let derivative = [0, 1, 2].map(|a| {
             (0..dims[a])
                 .map(|n| derivative_at(n, dims[a], cell[a]))
@@ -338,13 +353,15 @@ impl Mesh {
         charge_mesh.clear();
         charge_mesh.resize(mx * my * mz, Complex64::default());
         let plane = my * mz;
+        // Slabs as thick as the stencil: a particle reaches two at most.
+        let planes_per_task = p.max(2);
         let this = &*self;
         let (by_plane, plane_start) = (&this.by_plane, &this.plane_start);
         charge_mesh
-            .par_chunks_mut(plane * PLANES)
+            .par_chunks_mut(plane * planes_per_task)
             .enumerate()
             .for_each(|(task, slab)| {
-                let lo_plane = task * PLANES;
+                let lo_plane = task * planes_per_task;
                 let planes = slab.len() / plane;
                 // First planes from lo − p + 1 to the slab's last, in order.
                 let back = (p - 1).min(mx - planes);
@@ -356,22 +373,24 @@ impl Mesh {
                         let i = i as usize;
                         let u = this.mesh_coordinates(position[i]);
                         let (sx, sy, sz) = (stencil(p, u.x), stencil(p, u.y), stencil(p, u.z));
+                        let (wx, wy, wz) = (
+                            wrapped(&sx, p, mx),
+                            wrapped(&sy, p, my),
+                            wrapped(&sz, p, mz),
+                        );
                         let q = charge[i];
-                        for a in 0..p {
-                            let x = (sx.first + a as i64).rem_euclid(mx as i64) as usize;
+                        for (a, &x) in wx[..p].iter().enumerate() {
                             // The plane within this slab, if it is one.
                             let Some(local) = x.checked_sub(lo_plane).filter(|l| *l < planes)
                             else {
                                 continue;
                             };
                             let qx = q * sx.weight[a];
-                            for b in 0..p {
-                                let y = (sy.first + b as i64).rem_euclid(my as i64) as usize;
+                            for (b, &y) in wy[..p].iter().enumerate() {
                                 let qxy = qx * sy.weight[b];
                                 let row =
                                     &mut slab[local * plane + y * mz..local * plane + (y + 1) * mz];
-                                for c in 0..p {
-                                    let z = (sz.first + c as i64).rem_euclid(mz as i64) as usize;
+                                for (c, &z) in wz[..p].iter().enumerate() {
                                     row[z].re += qxy * sz.weight[c];
                                 }
                             }
@@ -484,15 +503,17 @@ impl Mesh {
                 let (sx, sy, sz) = (stencil(p, u.x), stencil(p, u.y), stencil(p, u.z));
                 let mut e = DVec3::ZERO;
                 let [mx, my, mz] = this.dims;
-                for a in 0..p {
-                    let x = (sx.first + a as i64).rem_euclid(mx as i64) as usize;
+                let (wx, wy, wz) = (
+                    wrapped(&sx, p, mx),
+                    wrapped(&sy, p, my),
+                    wrapped(&sz, p, mz),
+                );
+                for (a, &x) in wx[..p].iter().enumerate() {
                     let mut ex = DVec3::ZERO;
-                    for b in 0..p {
-                        let y = (sy.first + b as i64).rem_euclid(my as i64) as usize;
+                    for (b, &y) in wy[..p].iter().enumerate() {
                         let base = (x * my + y) * mz;
                         let mut ey = DVec3::ZERO;
-                        for c in 0..p {
-                            let z = (sz.first + c as i64).rem_euclid(mz as i64) as usize;
+                        for (c, &z) in wz[..p].iter().enumerate() {
                             let (xy, zz) = (this.field_xy[base + z], this.field_z[base + z]);
                             ey += DVec3::new(xy.re, xy.im, zz.re) * sz.weight[c];
                         }

@@ -15,15 +15,16 @@
 
 mod fft;
 pub mod mesh;
+mod screened;
 pub mod spline;
 pub mod tune;
 
 use glam::DVec3;
-use libm::erfc;
 
 use super::{Interaction, State, Virial};
 use crate::boundary::Boundary;
 use crate::neighbor::GhostList;
+use screened::Screened;
 pub use tune::{Parameters, Request};
 
 const SQRT_PI: f64 = 1.772_453_850_905_516;
@@ -36,6 +37,8 @@ pub struct P3mCoulomb {
     pub parameters: Parameters,
     list: GhostList,
     mesh: mesh::Mesh,
+    /// erfc(αr) and the pair force within the cut-off as polynomials.
+    screened: Screened,
     /// The charge of each copy of the list.
     copy_charge: Vec<f64>,
     sorted_force: Vec<DVec3>,
@@ -61,6 +64,7 @@ impl P3mCoulomb {
             k,
             parameters,
             list: GhostList::new(parameters.cutoff, skin),
+            screened: Screened::new(parameters.alpha * parameters.cutoff),
             mesh: mesh::Mesh::new(
                 parameters.mesh,
                 parameters.order,
@@ -114,7 +118,7 @@ impl P3mCoulomb {
         let (alpha, rc2) = (self.parameters.alpha, self.parameters.cutoff.powi(2));
         let [w, u] = list.sum_rows(sorted, |r| {
             let k = list.owner[r] as usize;
-            let s = row(list, q, r, alpha, rc2, energy);
+            let s = row(list, q, &self.screened, r, alpha, rc2, energy);
             (s.field * q[k], [s.virial * q[k], s.energy * q[k]])
         });
         (0.5 * w, 0.5 * u)
@@ -150,14 +154,30 @@ impl P3mCoulomb {
     }
 }
 
-/// Row r: Σ_j q_j [erfc(αr)/r + (2α/√π) e^{−α²r²}] r/r² and its virial
-/// and energy sums, all over the charge q_i of the row's particle.
+/// The pair of unit charges at distance² r² (within the cut-off): F/r =
+/// ψ(αr)/r³ ([`screened`]), and erfc(αr)/r when `energy`.
 #[inline]
-fn row(list: &GhostList, q: &[f64], r: usize, alpha: f64, rc2: f64, energy: bool) -> RowSum {
+fn screened_pair(screened: &Screened, alpha: f64, r2: f64, energy: bool) -> (f64, f64) {
+    let r = r2.sqrt();
+    let x = alpha * r;
+    let u = if energy { screened.erfc(x) / r } else { 0.0 };
+    (screened.psi(x) / (r2 * r), u)
+}
+
+/// Row r: Σ_j q_j ψ(αr) r/r³ and its virial and energy (Σ_j q_j
+/// erfc(αr)/r) sums, all over the charge q_i of the row's particle.
+#[inline]
+fn row(
+    list: &GhostList,
+    q: &[f64],
+    screened: &Screened,
+    r: usize,
+    alpha: f64,
+    rc2: f64,
+    energy: bool,
+) -> RowSum {
     let xi = list.at(list.owner[r] as usize);
     let mut s = RowSum::default();
-    let a2 = alpha * alpha;
-    let g = 2.0 * alpha / SQRT_PI;
     for &j in list.row(r) {
         let j = j as usize;
         let d = xi - list.at(j);
@@ -165,13 +185,12 @@ fn row(list: &GhostList, q: &[f64], r: usize, alpha: f64, rc2: f64, energy: bool
         if r2 >= rc2 {
             continue;
         }
-        let r = r2.sqrt();
-        let screened = erfc(alpha * r) / r;
-        let f_over_r = q[j] * (screened + g * (-a2 * r2).exp()) / r2;
+        let (f_over_r, u) = screened_pair(screened, alpha, r2, energy);
+        let f_over_r = q[j] * f_over_r;
         s.field += d * f_over_r;
         s.virial += f_over_r * r2;
         if energy {
-            s.energy += q[j] * screened;
+            s.energy += q[j] * u;
         }
     }
     s
@@ -219,9 +238,8 @@ impl Interaction for P3mCoulomb {
     /// background's isotropic part.
     fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
         self.follow(state, false);
-        let (list, q) = (&self.list, &self.copy_charge);
+        let (list, q, screened) = (&self.list, &self.copy_charge, &self.screened);
         let (alpha, rc2) = (self.parameters.alpha, self.parameters.cutoff.powi(2));
-        let g = 2.0 * alpha / SQRT_PI;
         let mut rows = vec![(); list.len()];
         let real = list.sum_rows(&mut rows, |r| {
             let k = list.owner[r] as usize;
@@ -231,12 +249,8 @@ impl Interaction for P3mCoulomb {
                 let d = xi - list.at(j as usize);
                 let r2 = d.length_squared();
                 if r2 < rc2 {
-                    let r = r2.sqrt();
-                    let f = q[k]
-                        * q[j as usize]
-                        * (erfc(alpha * r) / r + g * (-alpha * alpha * r2).exp())
-                        / r2;
-                    w += Virial::central(d, f);
+                    let (f_over_r, _) = screened_pair(screened, alpha, r2, false);
+                    w += Virial::central(d, q[k] * q[j as usize] * f_over_r);
                 }
             }
             ((), w.0)
