@@ -23,7 +23,8 @@ use glam::DVec3;
 
 use super::{Interaction, State, Virial};
 use crate::boundary::Boundary;
-use crate::neighbor::GhostList;
+use crate::neighbor::{Copy4, GhostList};
+use mote_geom::lanes::{self, Lanes};
 use screened::Screened;
 pub use tune::{Parameters, Request};
 
@@ -118,7 +119,11 @@ impl P3mCoulomb {
         let (alpha, rc2) = (self.parameters.alpha, self.parameters.cutoff.powi(2));
         let [w, u] = list.sum_rows(sorted, |r| {
             let k = list.owner[r] as usize;
-            let s = row(list, q, &self.screened, r, alpha, rc2, energy);
+            let s = if energy {
+                row_lanes::<true>(list, q, &self.screened, r, alpha, rc2)
+            } else {
+                row_lanes::<false>(list, q, &self.screened, r, alpha, rc2)
+            };
             (s.field * q[k], [s.virial * q[k], s.energy * q[k]])
         });
         (0.5 * w, 0.5 * u)
@@ -165,9 +170,10 @@ fn screened_pair(screened: &Screened, alpha: f64, r2: f64, energy: bool) -> (f64
 }
 
 /// Row r: Σ_j q_j ψ(αr) r/r³ and its virial and energy (Σ_j q_j
-/// erfc(αr)/r) sums, all over the charge q_i of the row's particle.
-#[inline]
-fn row(
+/// erfc(αr)/r) sums, all over the charge q_i of the row's particle, one
+/// neighbour at a time: the reference [`row_lanes`] is tested against.
+#[cfg(test)]
+fn row_reference(
     list: &GhostList,
     q: &[f64],
     screened: &Screened,
@@ -274,5 +280,114 @@ impl Interaction for P3mCoulomb {
 
     fn describe(&self) -> Option<String> {
         Some(P3mCoulomb::describe(self))
+    }
+}
+
+/// Row r eight neighbours at a time on [`Lanes`] (every CPU): the pair of
+/// [`row`] lane by lane, its series' coefficients gathered per lane; lanes
+/// beyond the cut-off (and the row's padding) evaluate the pair at the
+/// cut-off and are multiplied by zero.
+#[inline]
+fn row_lanes<const ENERGY: bool>(
+    list: &GhostList,
+    q: &[f64],
+    screened: &Screened,
+    r: usize,
+    alpha: f64,
+    rc2: f64,
+) -> RowSum {
+    let k = list.owner[r] as usize;
+    let records = Copy4::records(&list.position);
+    let [xi, yi, zi, _] = list.position[k].0;
+    let zero = Lanes::splat(0.0);
+    let (mut fx, mut fy, mut fz, mut w, mut u) = (zero, zero, zero, zero, zero);
+    lanes::in_eights(list.row(r), k as u32, |index, pad| {
+        let [xj, yj, zj] = lanes::gather_xyz(records, index);
+        let (dx, dy, dz) = (
+            Lanes::splat(xi) - xj,
+            Lanes::splat(yi) - yj,
+            Lanes::splat(zi) - zj,
+        );
+        let d2 = dx * dx + dy * dy + dz * dz;
+        let inside = (d2 + pad).select_within(rc2, 1.0, 0.0);
+        // Outside lanes at the cut-off: every lane indexes the series.
+        let r2 = d2.zip(inside, |d2, m| if m > 0.0 { d2 } else { rc2 });
+        let distance = r2.sqrt();
+        let x = distance * alpha;
+        let qj = Lanes(index.map(|j| q[j as usize]));
+        let weight = qj * inside;
+        let f = screened.psi_lanes(x) / (r2 * distance) * weight;
+        fx = fx + f * dx;
+        fy = fy + f * dy;
+        fz = fz + f * dz;
+        w = w + f * r2;
+        if ENERGY {
+            u = u + screened.erfc_lanes(x) / distance * weight;
+        }
+    });
+    RowSum {
+        field: DVec3::new(fx.sum(), fy.sum(), fz.sum()),
+        virial: w.sum(),
+        energy: u.sum(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The eight-lane rows against the one-neighbour-at-a-time reference.
+    #[test]
+    fn lane_rows_match_the_reference() {
+        let cell = DVec3::splat(9.0);
+        let boundary = Boundary::periodic(DVec3::ZERO, cell);
+        let n = 600;
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let pos: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(next(), next(), next()) * cell)
+            .collect();
+        let q: Vec<f64> = (0..n)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let request = Request {
+            accuracy: 1e-5,
+            skin: 0.3,
+            ..Request::default()
+        };
+        let mut p3m = P3mCoulomb::tuned(1.0, &request, &q, &boundary).unwrap();
+        let v = vec![DVec3::ZERO; n];
+        let m = vec![1.0; n];
+        let state = State::new(&pos, &v, &m, 0.0)
+            .with_charges(&q)
+            .in_box(&boundary);
+        p3m.follow(&state, false);
+        let (alpha, rc2) = (p3m.parameters.alpha, p3m.parameters.cutoff.powi(2));
+        for r in 0..p3m.list.len() {
+            let a = row_lanes::<true>(&p3m.list, &p3m.copy_charge, &p3m.screened, r, alpha, rc2);
+            let b = row_reference(
+                &p3m.list,
+                &p3m.copy_charge,
+                &p3m.screened,
+                r,
+                alpha,
+                rc2,
+                true,
+            );
+            let scale = b.field.length().max(1.0);
+            assert!(
+                (a.field - b.field).length() < 1e-13 * scale,
+                "row {r}: {:?} vs {:?}",
+                a.field,
+                b.field
+            );
+            assert!((a.energy - b.energy).abs() < 1e-13 * b.energy.abs().max(1.0));
+            assert!((a.virial - b.virial).abs() < 1e-13 * b.virial.abs().max(1.0));
+        }
     }
 }

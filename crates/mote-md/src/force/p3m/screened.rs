@@ -11,6 +11,7 @@
 //! reaches its speed by linear tables in r², accurate to about 1e-6).
 
 use libm::erfc;
+use mote_geom::lanes::Lanes;
 
 /// Points (and coefficients) per interval.
 const NODES: usize = 8;
@@ -68,6 +69,27 @@ impl Series {
         }
         t * b1 - b2 + c[0]
     }
+
+    /// The series at eight points x (each within the table).
+    #[inline(always)]
+    fn at_lanes(&self, x: Lanes) -> Lanes {
+        let scaled = x * PER_UNIT;
+        let k = scaled
+            .0
+            .map(|s| (s as usize).min(self.coefficients.len() - 1));
+        let t = Lanes(std::array::from_fn(|l| {
+            2.0 * (scaled.0[l] - k[l] as f64) - 1.0
+        }));
+        let two_t = t * 2.0;
+        let (mut b1, mut b2) = (Lanes::splat(0.0), Lanes::splat(0.0));
+        for m in (1..NODES).rev() {
+            let c = Lanes(k.map(|k| self.coefficients[k][m]));
+            let b0 = two_t * b1 - b2 + c;
+            b2 = b1;
+            b1 = b0;
+        }
+        t * b1 - b2 + Lanes(k.map(|k| self.coefficients[k][0]))
+    }
 }
 
 /// erfc and ψ on [0, X].
@@ -82,7 +104,8 @@ pub struct Screened {
 impl Screened {
     /// Covering x ∈ [0, `limit`].
     pub fn new(limit: f64) -> Self {
-        let intervals = (limit * PER_UNIT).ceil().max(1.0) as usize;
+        // One interval past X, so that x = X itself is inside.
+        let intervals = (limit * PER_UNIT).floor() as usize + 1;
         Self {
             limit: intervals as f64 / PER_UNIT,
             erfc: Series::new(intervals, erfc),
@@ -106,6 +129,18 @@ impl Screened {
         }
         let (k, t) = Self::locate(x);
         self.psi.at(k, t)
+    }
+
+    /// ψ at eight points in [0, X] (clamped to the table).
+    #[inline(always)]
+    pub fn psi_lanes(&self, x: Lanes) -> Lanes {
+        self.psi.at_lanes(x)
+    }
+
+    /// erfc at eight points in [0, X] (clamped to the table).
+    #[inline(always)]
+    pub fn erfc_lanes(&self, x: Lanes) -> Lanes {
+        self.erfc.at_lanes(x)
     }
 
     /// erfc(x) for x ≥ 0.

@@ -19,7 +19,7 @@ use super::mesh::{kspace_error, Aliases};
 use super::spline::MAX_ORDER;
 
 /// Seconds per listed pair of the real-space rows.
-const PAIR_COST: f64 = 1.2e-8;
+const PAIR_COST: f64 = 5.0e-9;
 /// Seconds per mesh point a particle is assigned to or interpolated from.
 const POINT_COST: f64 = 1.9e-9;
 /// Seconds per mesh point and binary level of one 3-D transform.
