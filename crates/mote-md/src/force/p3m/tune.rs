@@ -121,7 +121,7 @@ pub fn tune(cell: DVec3, n: usize, q2: f64, request: &Request) -> Result<Paramet
     let spacing = density.powf(-1.0 / 3.0);
     let cutoffs: Vec<f64> = match request.cutoff {
         Some(rc) => vec![rc],
-        None => [2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0]
+        None => [2.5, 3.0, 3.5, 4.0, 5.0]
             .iter()
             .map(|f| f * spacing)
             .filter(|rc| rc + request.skin <= half)
@@ -129,9 +129,9 @@ pub fn tune(cell: DVec3, n: usize, q2: f64, request: &Request) -> Result<Paramet
     };
     if cutoffs.is_empty() {
         return Err(format!(
-            "the box (shortest side {}) is too small for a real-space cut-off of two particle spacings ({:.4}) plus the skin: give cutoff",
+            "the box (shortest side {}) is too small for a real-space cut-off of 2.5 particle spacings ({:.4}) plus the skin: give cutoff",
             2.0 * half,
-            2.0 * spacing
+            2.5 * spacing
         ));
     }
     let orders: Vec<usize> = match request.order {
