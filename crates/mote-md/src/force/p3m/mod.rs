@@ -94,8 +94,11 @@ impl P3mCoulomb {
         };
         let mut parameters = tune::tune(boundary.lengths(), charge.len(), q2, &gaussian)?;
         parameters.real_error *= k;
-        parameters.kspace_error *= k;
-        Ok(Self::new(k, parameters, request.skin, boundary))
+        let mut solver = Self::new(k, parameters, request.skin, boundary);
+        // The estimate stated: with every alias G sums, on the mesh itself.
+        solver.parameters.kspace_error =
+            k * solver.mesh.estimated_error(charge.len().max(1) as f64, q2);
+        Ok(solver)
     }
 
     /// Brings the list to `state` (counting a step when `step`) and the

@@ -220,28 +220,19 @@ pub fn tune(cell: DVec3, n: usize, q2: f64, request: &Request) -> Result<Paramet
                     alpha,
                     cutoff,
                     real_error: real_error(alpha, cutoff, volume, nf, q2),
-                    kspace_error: 0.0,
+                    // Tuning's estimate; the solver states the full one.
+                    kspace_error: error(mesh),
                 };
                 best = Some((cost, candidate));
             }
         }
     }
-    let (_, mut best) = best.ok_or_else(|| {
+    let (_, best) = best.ok_or_else(|| {
         format!(
             "no mesh up to {0}³ reaches the accuracy {1:e} with these cut-offs: ask for less, or a larger cutoff",
             sizes.last().copied().unwrap_or(0),
             request.accuracy
         )
     })?;
-    // The estimate stated, with every alias that G sums.
-    best.kspace_error = kspace_error(
-        best.mesh,
-        cell,
-        best.order,
-        best.alpha,
-        nf,
-        q2,
-        Aliases::Full,
-    );
     Ok(best)
 }
