@@ -67,8 +67,8 @@ pub struct Ewald {
     pub kspace_error: f64,
 }
 
-/// Kolafa–Perram RMS real-space force error for charges.
-fn charge_real_error(alpha: f64, rc: f64, l: f64, n: f64, q2: f64) -> f64 {
+/// Kolafa–Perram RMS real-space force error for charges (L³ = V).
+pub(crate) fn charge_real_error(alpha: f64, rc: f64, l: f64, n: f64, q2: f64) -> f64 {
     2.0 * q2 * (-(alpha * rc).powi(2)).exp() / (n * rc * l.powi(3)).sqrt()
 }
 
@@ -96,7 +96,7 @@ fn dipole_kspace_error(alpha: f64, nmax: i32, l: f64, n: f64, m2: f64) -> f64 {
 
 /// The α ∈ (0, 100/r_c] at which the decreasing `error(α)` falls to
 /// `accuracy` (bisection on a log scale).
-fn solve_alpha(accuracy: f64, rc: f64, error: impl Fn(f64) -> f64) -> f64 {
+pub(crate) fn solve_alpha(accuracy: f64, rc: f64, error: impl Fn(f64) -> f64) -> f64 {
     let (mut lo, mut hi) = (1e-3 / rc, 100.0 / rc);
     if error(lo) <= accuracy {
         return lo;

@@ -17,6 +17,7 @@ use glam::DVec3;
 
 use super::mesh::{kspace_error, Aliases};
 use super::spline::MAX_ORDER;
+use crate::force::ewald::{charge_real_error, solve_alpha};
 
 /// Seconds per listed pair of the real-space rows.
 const PAIR_COST: f64 = 5.0e-9;
@@ -77,28 +78,15 @@ impl Parameters {
 }
 
 /// The real-space RMS force error of N charges with Σq² = `q2`
-/// (Kolafa & Perram 1992, Eq. 18): 2 Σq² e^{−α²r_c²}/√(N r_c V).
+/// (Kolafa & Perram 1992, Eq. 18), the Ewald sum's:
+/// 2 Σq² e^{−α²r_c²}/√(N r_c V).
 pub fn real_error(alpha: f64, cutoff: f64, volume: f64, n: f64, q2: f64) -> f64 {
-    2.0 * q2 * (-(alpha * cutoff).powi(2)).exp() / (n * cutoff * volume).sqrt()
+    charge_real_error(alpha, cutoff, volume.cbrt(), n, q2)
 }
 
-/// The α at which the real-space error falls to `target` (bisection on a
-/// log scale; the error decreases with α).
+/// The α at which the real-space error falls to `target`.
 fn alpha_for(target: f64, cutoff: f64, volume: f64, n: f64, q2: f64) -> f64 {
-    let error = |a: f64| real_error(a, cutoff, volume, n, q2);
-    let (mut lo, mut hi) = (1e-3 / cutoff, 100.0 / cutoff);
-    if error(lo) <= target {
-        return lo;
-    }
-    for _ in 0..100 {
-        let mid = (lo * hi).sqrt();
-        if error(mid) > target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
+    solve_alpha(target, cutoff, |a| real_error(a, cutoff, volume, n, q2))
 }
 
 /// The mesh of `scale` points along the longest side, the others in
