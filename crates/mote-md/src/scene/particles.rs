@@ -861,6 +861,21 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
             &s.props.template(),
             rng,
         );
+        // Every `[[fcc]]` sets the periodic box: two (a rock-salt pair,
+        // half a cell apart) must agree on its sides, else one would be
+        // dropped silently.
+        if let Some(first) = fcc_box {
+            let (a, b) = (first.lengths(), lat.1.lengths());
+            if (a - b).abs().max_element() > 1e-9 * a.max_element() {
+                return Err(err(
+                    spec.span(),
+                    format!(
+                        "this [[fcc]] makes a box of {} × {} × {}, an earlier one {} × {} × {}: every [[fcc]] sets the periodic box, so they must agree (same cells and density)",
+                        b.x, b.y, b.z, a.x, a.y, a.z
+                    ),
+                ));
+            }
+        }
         fcc_box = Some(lat.1);
         for p in lat.0 {
             inits.push(p);
