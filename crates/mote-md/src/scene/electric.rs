@@ -43,7 +43,7 @@ pub struct CoulombSettings {
     /// & Holm 1998 the mesh).
     pub accuracy: Option<f64>,
     /// P3M: the Verlet skin of the real-space list (default a tenth of the
-    /// cut-off).
+    /// cut-off given, else 0.3 mean particle spacings).
     pub skin: Option<f64>,
     /// P3M: mesh points along each axis (default: tuned).
     pub mesh: Option<[usize; 3]>,
