@@ -287,7 +287,7 @@ impl Interaction for P3mCoulomb {
 }
 
 /// Row r eight neighbours at a time on [`Lanes`] (every CPU): the pair of
-/// [`row`] lane by lane, its series' coefficients gathered per lane; lanes
+/// [`screened_pair`] lane by lane (tested against `row_reference`), its series' coefficients gathered per lane; lanes
 /// beyond the cut-off (and the row's padding) evaluate the pair at the
 /// cut-off and are multiplied by zero.
 #[inline]
