@@ -22,6 +22,7 @@ mod lj_eos;
 mod magnet;
 mod oscillator;
 mod p3m;
+mod p3m_dipoles;
 mod plist_twin;
 mod pressure;
 mod rigid_contacts;

@@ -4,7 +4,7 @@
 //! energy and pressure, momentum, and the same bits on any thread count.
 
 use mote_md::force::ewald::Ewald;
-use mote_md::force::p3m::mesh::{kspace_error, Aliases};
+use mote_md::force::p3m::influence::{kspace_error, Aliases, Kernel};
 use mote_md::force::p3m::{P3mCoulomb, Parameters, Request};
 use mote_md::{Boundary, DVec3, Interaction, State};
 use rand::{Rng, SeedableRng};
@@ -111,7 +111,16 @@ fn mesh_error_matches_the_estimate_across_orders_and_meshes() {
                 alpha,
                 cutoff,
                 real_error: 0.0,
-                kspace_error: kspace_error([m; 3], cell, order, alpha, n, n, Aliases::Full),
+                kspace_error: kspace_error(
+                    Kernel::Charge,
+                    [m; 3],
+                    cell,
+                    order,
+                    alpha,
+                    n,
+                    n,
+                    Aliases::Full,
+                ),
             };
             let mut solver = P3mCoulomb::new(1.0, parameters, 0.3, &boundary);
             let (_, f) = p3m(&mut solver, &pos, &q, &boundary);

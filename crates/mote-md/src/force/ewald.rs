@@ -78,7 +78,7 @@ fn charge_kspace_error(alpha: f64, nmax: i32, l: f64, n: f64, q2: f64) -> f64 {
         * (-(std::f64::consts::PI * k / (alpha * l)).powi(2)).exp()
 }
 
-fn dipole_real_error(alpha: f64, rc: f64, l: f64, n: f64, m2: f64) -> f64 {
+pub(crate) fn dipole_real_error(alpha: f64, rc: f64, l: f64, n: f64, m2: f64) -> f64 {
     let a2 = (alpha * rc).powi(2);
     let c = 4.0 * a2 * a2 + 6.0 * a2 + 3.0;
     let d = 8.0 * a2 * a2 * a2 + 20.0 * a2 * a2 + 30.0 * a2 + 15.0;

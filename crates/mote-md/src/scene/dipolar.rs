@@ -1,6 +1,6 @@
 //! `[dipolar]`: magnetic dipole–dipole forces and torques between particles
 //! with a `dipole` (004 Eq. 8): all pairs, pairs within a cut-off (with a
-//! reaction field and WCA repulsion in the same loop), or Ewald sums;
+//! reaction field and WCA repulsion in the same loop), Ewald sums, or P3M;
 //! `[magnetic_field]`: the applied field H (Zeeman, 004 Eq. 10).
 
 use std::ops::Range;
@@ -10,13 +10,14 @@ use serde::Deserialize;
 
 use mote_io::ParseError;
 
-use super::electric::{ewald_box, positive};
+use super::electric::{ewald_box, positive, P3mKeys};
 use super::gravity::direct;
 use super::{Build, Scene, Section};
 use crate::force::dipolar::{
     vacuum_permeability, AppliedField, DipoleDipole, PairRepulsion, Zeeman,
 };
 use crate::force::ewald::EwaldDipoles;
+use crate::force::p3m::P3mDipoles;
 
 /// `[dipolar]`: magnetic dipole–dipole forces and torques (004 Eq. 8)
 /// between particles with a `dipole`, optionally with WCA repulsion.
@@ -25,18 +26,27 @@ use crate::force::ewald::EwaldDipoles;
 pub struct DipolarSettings {
     /// μ₀ (default: the unit system's; 4π in LJ units).
     pub mu0: Option<f64>,
-    /// `direct` (default: all pairs, or pairs within `cutoff`) or `ewald`
-    /// (Ewald summation with tin-foil boundaries in a cubic periodic box).
+    /// `direct` (default: all pairs, or pairs within `cutoff`), `ewald`
+    /// (Ewald summation with tin-foil boundaries in a cubic periodic box)
+    /// or `p3m` (the Ewald sum's k-space part on a mesh: any orthorhombic
+    /// periodic box, O(N log N)).
     #[serde(default = "direct")]
     pub method: String,
     /// Cut-off with the minimum image (periodic boxes); absent: all pairs.
-    /// With Ewald: the real-space cut-off (default half the box).
+    /// With Ewald: the real-space cut-off (default half the box); with
+    /// P3M: tuned when not given.
     pub cutoff: Option<f64>,
-    /// Ewald only: the RMS force error aimed at, in force units (Wang & Holm
-    /// 2001, Eqs. 38 and 46, choose α and the k-vectors).
+    /// Ewald and P3M: the RMS force error aimed at, in force units (Wang &
+    /// Holm 2001, Eqs. 38 and 46, choose α and the k-vectors; for P3M,
+    /// Cerdà et al. 2008 the mesh).
     pub accuracy: Option<f64>,
-    /// Verlet skin of the cut-off list (default 0.3).
+    /// Verlet skin of the cut-off list (default 0.3; P3M: a tenth of the
+    /// cut-off given, else 0.3 mean particle spacings).
     pub skin: Option<f64>,
+    /// P3M: mesh points along each axis (default: tuned).
+    pub mesh: Option<[usize; 3]>,
+    /// P3M: assignment order 1–7 (default: tuned, 3–7).
+    pub order: Option<usize>,
     /// Relative permeability of the reaction field beyond the cut-off;
     /// `"conducting"` for ε_RF = ∞ (absent: none).
     pub reaction_field: Option<toml::Value>,
@@ -97,28 +107,61 @@ impl Section for DipolarSettings {
                 *m = DVec3::new(s * phi.cos(), s * phi.sin(), u) * len;
             }
         }
-        match self.method.as_str() {
+        let method = self.method.as_str();
+        let summed = matches!(method, "ewald" | "p3m");
+        let keys: &[(&str, bool)] = match method {
+            "ewald" => &[
+                ("skin", self.skin.is_some()),
+                ("reaction_field", self.reaction_field.is_some()),
+                ("wca", self.wca.is_some()),
+                ("mesh", self.mesh.is_some()),
+                ("order", self.order.is_some()),
+            ],
+            "p3m" => &[
+                ("reaction_field", self.reaction_field.is_some()),
+                ("wca", self.wca.is_some()),
+            ],
+            _ => &[
+                ("mesh", self.mesh.is_some()),
+                ("order", self.order.is_some()),
+            ],
+        };
+        for (key, given) in keys {
+            if *given {
+                return Err(err(
+                    span.clone(),
+                    format!(
+                        "[dipolar] {key} does not apply to method = \"{method}\"{}",
+                        if *key == "wca" {
+                            " (add [lennard_jones] wca = true beside it)"
+                        } else if !summed {
+                            " (it is a key of method = \"p3m\")"
+                        } else {
+                            ""
+                        }
+                    ),
+                ));
+            }
+        }
+        match method {
             "direct" => {}
+            "p3m" => {
+                let keys = P3mKeys {
+                    accuracy: self.accuracy,
+                    cutoff: self.cutoff,
+                    skin: self.skin,
+                    mesh: self.mesh,
+                    order: self.order,
+                };
+                let dipole = &b.particles.dipole;
+                let request = keys.request("dipolar", span.clone(), src, dipole.len(), boundary)?;
+                let k = mu0 / (4.0 * std::f64::consts::PI);
+                let p3m = P3mDipoles::tuned(k, &request, dipole, &boundary)
+                    .map_err(|e| err(span.clone(), format!("[dipolar] {e}")))?;
+                b.forces.push(p3m);
+                return Ok(());
+            }
             "ewald" => {
-                for (key, given) in [
-                    ("skin", self.skin.is_some()),
-                    ("reaction_field", self.reaction_field.is_some()),
-                    ("wca", self.wca.is_some()),
-                ] {
-                    if given {
-                        return Err(err(
-                            span.clone(),
-                            format!(
-                                "[dipolar] {key} does not apply to method = \"ewald\"{}",
-                                if key == "wca" {
-                                    " (add [lennard_jones] wca = true beside it)"
-                                } else {
-                                    ""
-                                }
-                            ),
-                        ));
-                    }
-                }
                 let l = ewald_box(src, span.clone(), boundary, "dipolar")?;
                 let rc = self.cutoff.unwrap_or(0.5 * l);
                 let accuracy = self.accuracy.ok_or_else(|| {
@@ -143,20 +186,20 @@ impl Section for DipolarSettings {
             other => {
                 return Err(err(
                     span.clone(),
-                    format!("[dipolar] unknown method '{other}': expected direct or ewald"),
+                    format!("[dipolar] unknown method '{other}': expected direct, ewald or p3m"),
                 ))
             }
         }
         if self.accuracy.is_some() {
             return Err(err(
                 span.clone(),
-                "[dipolar] accuracy needs method = \"ewald\"".into(),
+                "[dipolar] accuracy needs method = \"ewald\" or \"p3m\"".into(),
             ));
         }
         if v.cutoff.is_none() && boundary.periodic.iter().any(|p| *p) {
             return Err(err(
                 span.clone(),
-                "[dipolar] without cutoff sums every pair over open space, and the [box] is periodic: give cutoff = r_c (the minimum image, with a reaction field) or method = \"ewald\"".into(),
+                "[dipolar] without cutoff sums every pair over open space, and the [box] is periodic: give cutoff = r_c (the minimum image, with a reaction field), method = \"ewald\" or method = \"p3m\"".into(),
             ));
         }
         let mut pair = match v.cutoff {

@@ -204,27 +204,66 @@ impl CoulombSettings {
         charge: &[f64],
         boundary: Boundary,
     ) -> Result<P3mCoulomb, ParseError> {
+        let keys = P3mKeys {
+            accuracy: self.accuracy,
+            cutoff: self.cutoff,
+            skin: self.skin,
+            mesh: self.mesh,
+            order: self.order,
+        };
+        let request = keys.request("coulomb", span.clone(), src, charge.len(), boundary)?;
+        P3mCoulomb::tuned(k, &request, charge, &boundary)
+            .map_err(|e| src.error(span, format!("[coulomb] {e}")))
+    }
+}
+
+/// The keys of a P3M table (`[coulomb]` or `[dipolar]` with
+/// method = "p3m").
+pub(crate) struct P3mKeys {
+    pub accuracy: Option<f64>,
+    pub cutoff: Option<f64>,
+    pub skin: Option<f64>,
+    pub mesh: Option<[usize; 3]>,
+    pub order: Option<usize>,
+}
+
+impl P3mKeys {
+    /// What tuning is asked for `n` sources in `boundary`, or why the
+    /// table cannot be run.
+    pub(crate) fn request(
+        &self,
+        table: &str,
+        span: Range<usize>,
+        src: Source,
+        n: usize,
+        boundary: Boundary,
+    ) -> Result<p3m::Request, ParseError> {
         let err = |msg: String| src.error(span.clone(), msg);
         let l = boundary.lengths();
         if boundary.periodic != [true; 3] || !(l.min_element() > 0.0 && l.max_element().is_finite())
         {
-            return Err(err(
-                "[coulomb] method = \"p3m\" needs a [box] periodic on every axis".into(),
-            ));
+            return Err(err(format!(
+                "[{table}] method = \"p3m\" needs a [box] periodic on every axis"
+            )));
         }
         let accuracy = self.accuracy.ok_or_else(|| {
-            err("[coulomb] method = \"p3m\" needs accuracy = the RMS force error aimed at (force units)".into())
+            err(format!("[{table}] method = \"p3m\" needs accuracy = the RMS force error aimed at (force units)"))
         })?;
-        positive(src, span.clone(), "[coulomb] accuracy", accuracy)?;
+        positive(src, span.clone(), &format!("[{table}] accuracy"), accuracy)?;
         let cutoff = match self.cutoff {
-            Some(rc) => Some(positive(src, span.clone(), "[coulomb] cutoff", rc)?),
+            Some(rc) => Some(positive(
+                src,
+                span.clone(),
+                &format!("[{table}] cutoff"),
+                rc,
+            )?),
             None => None,
         };
         let skin = match (self.skin, cutoff) {
             (Some(s), _) => {
                 if !(s >= 0.0 && s.is_finite()) {
                     return Err(err(format!(
-                        "[coulomb] skin must not be negative, found {s}"
+                        "[{table}] skin must not be negative, found {s}"
                     )));
                 }
                 s
@@ -232,12 +271,12 @@ impl CoulombSettings {
             (None, Some(rc)) => 0.1 * rc,
             // A tenth of the cut-off tuning is likely to choose: three
             // particle spacings.
-            (None, None) => 0.3 * (l.element_product() / charge.len().max(1) as f64).cbrt(),
+            (None, None) => 0.3 * (l.element_product() / n.max(1) as f64).cbrt(),
         };
         if let Some(rc) = cutoff {
             if rc + skin > 0.5 * l.min_element() {
                 return Err(err(format!(
-                    "[coulomb] cutoff + skin = {} must be at most half the shortest box side, {}",
+                    "[{table}] cutoff + skin = {} must be at most half the shortest box side, {}",
                     rc + skin,
                     0.5 * l.min_element()
                 )));
@@ -246,7 +285,7 @@ impl CoulombSettings {
         if let Some(p) = self.order {
             if !(1..=p3m::spline::MAX_ORDER).contains(&p) {
                 return Err(err(format!(
-                    "[coulomb] order must be 1 to {}, found {p}",
+                    "[{table}] order must be 1 to {}, found {p}",
                     p3m::spline::MAX_ORDER
                 )));
             }
@@ -255,18 +294,17 @@ impl CoulombSettings {
             let least = self.order.unwrap_or(1).max(2);
             if mesh.iter().any(|&m| m < least || m > 4096) {
                 return Err(err(format!(
-                    "[coulomb] mesh {mesh:?}: every side must be {least} to 4096 points (at least the order)"
+                    "[{table}] mesh {mesh:?}: every side must be {least} to 4096 points (at least the order)"
                 )));
             }
         }
-        let request = p3m::Request {
+        Ok(p3m::Request {
             accuracy,
             cutoff,
             skin,
             mesh: self.mesh,
             order: self.order,
-        };
-        P3mCoulomb::tuned(k, &request, charge, &boundary).map_err(|e| err(format!("[coulomb] {e}")))
+        })
     }
 }
 

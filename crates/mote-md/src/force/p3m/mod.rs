@@ -12,8 +12,17 @@
 //! by [`mesh`], the self energy and the neutralising background as in the
 //! Ewald sum (zero for a neutral system). The parameters (mesh, order,
 //! α, r_c) come from the RMS force error asked for ([`tune`]).
+//!
+//! Point dipoles have their own solver, [`P3mDipoles`] ([`dipolar`], its
+//! mesh in [`dipole_mesh`]), on the same mesh geometry (`grid`: binning,
+//! spreading, interpolation, FFTs), influence functions ([`influence`])
+//! and tuning.
 
+pub mod dipolar;
+pub mod dipole_mesh;
 mod fft;
+mod grid;
+pub mod influence;
 pub mod mesh;
 mod screened;
 pub mod spline;
@@ -24,9 +33,10 @@ use glam::DVec3;
 use super::{Interaction, State, Virial};
 use crate::boundary::Boundary;
 use crate::neighbor::{Copy4, GhostList};
+pub use dipolar::P3mDipoles;
 use mote_geom::lanes::{self, Lanes};
 use screened::Screened;
-pub use tune::{Parameters, Request};
+pub use tune::{Parameters, Request, Source};
 
 const SQRT_PI: f64 = 1.772_453_850_905_516;
 
@@ -92,7 +102,12 @@ impl P3mCoulomb {
             accuracy: request.accuracy / k,
             ..*request
         };
-        let mut parameters = tune::tune(boundary.lengths(), charge.len(), q2, &gaussian)?;
+        let mut parameters = tune::tune(
+            boundary.lengths(),
+            charge.len(),
+            Source::Charges { q2 },
+            &gaussian,
+        )?;
         parameters.real_error *= k;
         let mut solver = Self::new(k, parameters, request.skin, boundary);
         // The estimate stated: with every alias G sums, on the mesh itself.

@@ -1,30 +1,90 @@
 //! Choosing P3M's parameters from the RMS force error asked for, as
-//! ESPResSo's tuning does (Deserno & Holm 1998, §4): for each cut-off r_c
-//! and assignment order p, α makes the real-space error (Kolafa & Perram
-//! 1992, Eq. 18) δ/√2, and the mesh is the smallest whose k-space error
-//! (the optimal-influence-function estimate of [`super::mesh`]) is at most
-//! δ/√2; of these, the cheapest by a cost model of the three parts:
+//! ESPResSo's tuning does (Deserno & Holm 1998, §4; Cerdà et al. 2008 for
+//! dipoles): for each cut-off r_c and assignment order p, α makes the
+//! real-space error δ/√2 (Kolafa & Perram 1992, Eq. 18 for charges; Wang &
+//! Holm 2001, Eq. 33 for dipoles), and the mesh is the smallest whose
+//! k-space error (the optimal-influence-function estimate of
+//! [`super::influence`]) is at most δ/√2; of these, the cheapest by a cost
+//! model of the three parts:
 //!
-//!   cost = c_pair N n_pairs + c_point N (2 p³) + c_fft 3 M log₂ M,
+//!   cost = c_pair N n_pairs + c_point N (2 p³) + c_fft n_fft M log₂ M,
 //!
 //! n_pairs = (4π/3)(r_c + skin)³ ρ the neighbours of a particle, M the mesh
-//! points. The constants are the per-pair, per-assigned-point and
-//! per-point-and-level costs measured on the molten-salt benchmark
-//! (BENCHMARKS.md); they fix the choice, so a scene gives the same
-//! parameters on every machine.
+//! points, n_fft the 3-D transforms of a force evaluation (3 for charges,
+//! 7 for dipoles). The constants are the per-pair, per-assigned-point and
+//! per-point-and-level costs measured on the molten-salt and dipolar-fluid
+//! benchmarks (BENCHMARKS.md); they fix the choice, so a scene gives the
+//! same parameters on every machine.
 
 use glam::DVec3;
 
-use super::mesh::{kspace_error, Aliases};
+use super::influence::{kspace_error, Aliases, Kernel};
 use super::spline::MAX_ORDER;
-use crate::force::ewald::{charge_real_error, solve_alpha};
+use crate::force::ewald::{charge_real_error, dipole_real_error, solve_alpha};
 
-/// Seconds per listed pair of the real-space rows.
-const PAIR_COST: f64 = 5.0e-9;
-/// Seconds per mesh point a particle is assigned to or interpolated from.
-const POINT_COST: f64 = 1.9e-9;
 /// Seconds per mesh point and binary level of one 3-D transform.
 const FFT_COST: f64 = 0.6e-9;
+
+/// What the mesh carries: charges or point dipoles, with the sum of their
+/// squares (Σq² or Σμ²) the error estimates scale with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Source {
+    Charges { q2: f64 },
+    Dipoles { m2: f64 },
+}
+
+impl Source {
+    /// Σs², at least the smallest positive number.
+    fn strength(self) -> f64 {
+        match self {
+            Source::Charges { q2 } => q2,
+            Source::Dipoles { m2 } => m2,
+        }
+        .max(f64::MIN_POSITIVE)
+    }
+
+    /// The influence function whose error bounds the forces.
+    pub fn kernel(self) -> Kernel {
+        match self {
+            Source::Charges { .. } => Kernel::Charge,
+            Source::Dipoles { .. } => Kernel::DipoleForce,
+        }
+    }
+
+    /// Seconds per listed pair of the real-space rows.
+    fn pair_cost(self) -> f64 {
+        match self {
+            Source::Charges { .. } => 5.0e-9,
+            Source::Dipoles { .. } => 12.0e-9,
+        }
+    }
+
+    /// Seconds per mesh point a particle is assigned to or interpolated
+    /// from (dipoles: three components out, nine back).
+    fn point_cost(self) -> f64 {
+        match self {
+            Source::Charges { .. } => 1.9e-9,
+            Source::Dipoles { .. } => 5.7e-9,
+        }
+    }
+
+    /// 3-D transforms per force evaluation.
+    fn transforms(self) -> f64 {
+        match self {
+            Source::Charges { .. } => 3.0,
+            Source::Dipoles { .. } => 7.0,
+        }
+    }
+
+    /// The real-space RMS force error of N sources in a box of `volume`.
+    pub fn real_error(self, alpha: f64, cutoff: f64, volume: f64, n: f64) -> f64 {
+        let l = volume.cbrt();
+        match self {
+            Source::Charges { .. } => charge_real_error(alpha, cutoff, l, n, self.strength()),
+            Source::Dipoles { .. } => dipole_real_error(alpha, cutoff, l, n, self.strength()),
+        }
+    }
+}
 
 /// The largest mesh side tuning tries (512³ points are 2 GiB a buffer).
 const MAX_MESH: usize = 512;
@@ -77,16 +137,9 @@ impl Parameters {
     }
 }
 
-/// The real-space RMS force error of N charges with Σq² = `q2`
-/// (Kolafa & Perram 1992, Eq. 18), the Ewald sum's:
-/// 2 Σq² e^{−α²r_c²}/√(N r_c V).
-pub fn real_error(alpha: f64, cutoff: f64, volume: f64, n: f64, q2: f64) -> f64 {
-    charge_real_error(alpha, cutoff, volume.cbrt(), n, q2)
-}
-
 /// The α at which the real-space error falls to `target`.
-fn alpha_for(target: f64, cutoff: f64, volume: f64, n: f64, q2: f64) -> f64 {
-    solve_alpha(target, cutoff, |a| real_error(a, cutoff, volume, n, q2))
+fn alpha_for(source: Source, target: f64, cutoff: f64, volume: f64, n: f64) -> f64 {
+    solve_alpha(target, cutoff, |a| source.real_error(a, cutoff, volume, n))
 }
 
 /// The mesh of `scale` points along the longest side, the others in
@@ -99,11 +152,17 @@ fn mesh_of(scale: usize, cell: DVec3, sizes: &[usize]) -> [usize; 3] {
     })
 }
 
-/// The cheapest parameters meeting `request.accuracy` for `n` charges with
-/// Σq² = `q2` in a periodic box of sides `cell`, or why there are none.
-pub fn tune(cell: DVec3, n: usize, q2: f64, request: &Request) -> Result<Parameters, String> {
+/// The cheapest parameters meeting `request.accuracy` for `n` charges or
+/// dipoles (`source`) in a periodic box of sides `cell`, or why there are
+/// none.
+pub fn tune(
+    cell: DVec3,
+    n: usize,
+    source: Source,
+    request: &Request,
+) -> Result<Parameters, String> {
     let (volume, nf) = (cell.element_product(), n.max(1) as f64);
-    let q2 = q2.max(f64::MIN_POSITIVE);
+    let s2 = source.strength();
     let half = 0.5 * cell.min_element();
     let density = nf / volume;
     let spacing = density.powf(-1.0 / 3.0);
@@ -133,19 +192,29 @@ pub fn tune(cell: DVec3, n: usize, q2: f64, request: &Request) -> Result<Paramet
     // mesh of `points`.
     let particle_cost = |cutoff: f64, order: usize| {
         let pairs = 4.0 / 3.0 * std::f64::consts::PI * (cutoff + request.skin).powi(3) * density;
-        PAIR_COST * nf * pairs + POINT_COST * nf * 2.0 * (order as f64).powi(3)
+        source.pair_cost() * nf * pairs + source.point_cost() * nf * 2.0 * (order as f64).powi(3)
     };
     let fft_cost = |mesh: [usize; 3]| {
         let points = mesh.iter().product::<usize>() as f64;
-        FFT_COST * 3.0 * points * points.log2()
+        FFT_COST * source.transforms() * points * points.log2()
     };
     // High orders first: they need the smallest meshes, so a good choice
     // is found early and larger meshes are not tried past its cost.
     for &order in orders.iter().rev() {
         for &cutoff in &cutoffs {
-            let alpha = alpha_for(part, cutoff, volume, nf, q2);
-            let error =
-                |mesh: [usize; 3]| kspace_error(mesh, cell, order, alpha, nf, q2, Aliases::Tuning);
+            let alpha = alpha_for(source, part, cutoff, volume, nf);
+            let error = |mesh: [usize; 3]| {
+                kspace_error(
+                    source.kernel(),
+                    mesh,
+                    cell,
+                    order,
+                    alpha,
+                    nf,
+                    s2,
+                    Aliases::Tuning,
+                )
+            };
             // What is left for the mesh before this choice costs more
             // than the best so far.
             let budget =
@@ -207,7 +276,7 @@ pub fn tune(cell: DVec3, n: usize, q2: f64, request: &Request) -> Result<Paramet
                     order,
                     alpha,
                     cutoff,
-                    real_error: real_error(alpha, cutoff, volume, nf, q2),
+                    real_error: source.real_error(alpha, cutoff, volume, nf),
                     // Tuning's estimate; the solver states the full one.
                     kspace_error: error(mesh),
                 };
