@@ -114,6 +114,51 @@ def test_p3m_coulomb_from_python_gives_the_bits_of_mote_run(tmp_path):
     assert np.abs(sim.velocities.sum(axis=0) - momentum).max() < 1e-10
 
 
+DIPOLAR_FLUID = """
+title = "Dipolar fluid, 256 particles, P3M"
+units = "lj"
+seed = 4
+
+[run]
+integrator = "leapfrog"
+dt = 0.002
+steps = 30
+
+[lennard_jones]
+wca = true
+
+[dipolar]
+method = "p3m"
+accuracy = 1e-3
+random_orientation = true
+
+[[fcc]]
+cells = [4, 4, 4]
+density = 0.7
+kt = 1.0
+radius = 0.5
+dipole = [0.0, 0.0, 1.2]
+
+[output]
+observables_every = 10
+trajectory_every = 0
+"""
+
+
+def test_p3m_dipoles_from_python_give_the_bits_of_mote_run(tmp_path):
+    sim = mote.Simulation.from_toml(DIPOLAR_FLUID)
+    sim.run()
+    out = mote.run(DIPOLAR_FLUID, output=tmp_path)
+    assert out["ending"] == "finished"
+    assert any("Dipolar by P3M: mesh" in line for line in out["summary"])
+    table = csv_columns(tmp_path / "observables.csv")
+    obs = sim.observables
+    assert np.array_equal(table["potential_energy"], obs["potential"])
+    assert np.array_equal(table["kinetic_energy"], obs["kinetic"])
+    # The dipoles turned: the moment is no longer the start's.
+    assert not np.array_equal(table["Mz"], np.full_like(table["Mz"], table["Mz"][0]))
+
+
 def test_with_output_a_simulation_writes_what_mote_run_writes(tmp_path):
     """A stepped Simulation given a folder writes mote run's files there,
     byte for byte, in chunks and with callbacks; without one it writes none,

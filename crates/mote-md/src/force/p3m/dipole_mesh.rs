@@ -120,19 +120,24 @@ impl DipoleMesh {
         self.grid.transform(&mut z, FftDirection::Forward);
         let mut divergence = std::mem::take(&mut self.divergence);
         divergence.resize(xy.len(), Complex64::default());
-        let grid = &self.grid;
-        let [dx, dy, dz] = &grid.derivative;
+        let [mx, my, mz] = self.grid.dims;
+        let [dx, dy, dz] = &self.grid.derivative;
         divergence
-            .par_iter_mut()
-            .with_min_len(4096)
+            .par_chunks_mut(mz)
             .enumerate()
-            .for_each(|(idx, s)| {
-                let [ix, iy, iz] = grid.indices(idx);
-                // M̂_x = (Z(k) + Z(−k)*)/2, M̂_y = (Z(k) − Z(−k)*)/2i.
-                let (zk, zm) = (xy[idx], xy[grid.mirror(idx)].conj());
-                let mx = (zk + zm) * 0.5;
-                let my = (zk - zm) * Complex64::new(0.0, -0.5);
-                *s = mx * dx[ix] + my * dy[iy] + z[idx] * dz[iz];
+            .for_each(|(line, s)| {
+                let (ix, iy) = (line / my, line % my);
+                // The line of −k: (−n_x, −n_y) and z reversed.
+                let mirror = ((mx - ix) % mx * my + (my - iy) % my) * mz;
+                let base = line * mz;
+                for (iz, s) in s.iter_mut().enumerate() {
+                    // M̂_x = (Z(k) + Z(−k)*)/2, M̂_y = (Z(k) − Z(−k)*)/2i.
+                    let zk = xy[base + iz];
+                    let zm = xy[mirror + (mz - iz) % mz].conj();
+                    let m_x = (zk + zm) * 0.5;
+                    let m_y = (zk - zm) * Complex64::new(0.0, -0.5);
+                    *s = m_x * dx[ix] + m_y * dy[iy] + z[base + iz] * dz[iz];
+                }
             });
         self.moment_xy = xy;
         self.moment_z = z;
@@ -166,36 +171,39 @@ impl DipoleMesh {
         for m in &mut self.packed[..meshes] {
             m.resize(points, Complex64::default());
         }
-        let grid = &self.grid;
-        let [dx, dy, dz] = &grid.derivative;
+        let [_, my, mz] = self.grid.dims;
+        let [dx, dy, dz] = &self.grid.derivative;
         let (s, gf, ge) = (&self.divergence, &self.g_force, &self.g_energy);
         let [p0, p1, p2, p3, p4] = &mut self.packed;
         let i = Complex64::i();
-        p0.par_iter_mut()
-            .zip(p1.par_iter_mut())
-            .zip(p2.par_iter_mut())
-            .with_min_len(4096)
+        p0.par_chunks_mut(mz)
+            .zip(p1.par_chunks_mut(mz))
+            .zip(p2.par_chunks_mut(mz))
             .enumerate()
-            .for_each(|(idx, ((xx_yy, zz_xy), xz_yz))| {
-                let [ix, iy, iz] = grid.indices(idx);
-                let (kx, ky, kz) = (dx[ix], dy[iy], dz[iz]);
-                // −i G_F S/V: times D_a D_b, the spectrum of ∂_b H_a.
-                let t = s[idx] * Complex64::new(0.0, -gf[idx] / v);
-                *xx_yy = t * (kx * kx) + i * t * (ky * ky);
-                *zz_xy = t * (kz * kz) + i * t * (kx * ky);
-                *xz_yz = t * (kx * kz) + i * t * (ky * kz);
+            .for_each(|(line, ((xx_yy, zz_xy), xz_yz))| {
+                let (kx, ky) = (dx[line / my], dy[line % my]);
+                for iz in 0..mz {
+                    let (idx, kz) = (line * mz + iz, dz[iz]);
+                    // −i G_F S/V: times D_a D_b, the spectrum of ∂_b H_a.
+                    let t = s[idx] * Complex64::new(0.0, -gf[idx] / v);
+                    xx_yy[iz] = t * (kx * kx) + i * t * (ky * ky);
+                    zz_xy[iz] = t * (kz * kz) + i * t * (kx * ky);
+                    xz_yz[iz] = t * (kx * kz) + i * t * (ky * kz);
+                }
             });
         if field {
-            p3.par_iter_mut()
-                .zip(p4.par_iter_mut())
-                .with_min_len(4096)
+            p3.par_chunks_mut(mz)
+                .zip(p4.par_chunks_mut(mz))
                 .enumerate()
-                .for_each(|(idx, (hxy, hz))| {
-                    let [ix, iy, iz] = grid.indices(idx);
-                    // −G_E S/V: times D_a, the spectrum of H_a.
-                    let h = s[idx] * (-ge[idx] / v);
-                    *hxy = h * dx[ix] + i * h * dy[iy];
-                    *hz = h * dz[iz];
+                .for_each(|(line, (hxy, hz))| {
+                    let (kx, ky) = (dx[line / my], dy[line % my]);
+                    for iz in 0..mz {
+                        let idx = line * mz + iz;
+                        // −G_E S/V: times D_a, the spectrum of H_a.
+                        let h = s[idx] * (-ge[idx] / v);
+                        hxy[iz] = h * kx + i * h * ky;
+                        hz[iz] = h * dz[iz];
+                    }
                 });
         }
         for m in 0..meshes {

@@ -125,14 +125,6 @@ impl Grid {
         [idx / (my * mz), (idx / mz) % my, idx % mz]
     }
 
-    /// The point of −k for the point of k.
-    #[inline]
-    pub fn mirror(&self, idx: usize) -> usize {
-        let [mx, my, mz] = self.dims;
-        let [ix, iy, iz] = self.indices(idx);
-        (((mx - ix) % mx) * my + (my - iy) % my) * mz + (mz - iz) % mz
-    }
-
     /// The wave vector of mesh point `idx`, 2π n'/L with signed indices.
     #[inline]
     pub fn wave_vector(&self, idx: usize) -> DVec3 {
