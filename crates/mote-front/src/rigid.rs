@@ -217,6 +217,7 @@ impl EngineRun for RigidRun {
         for (name, f) in &last.wall_forces {
             summary.push(format!("  force on wall {name}: {f}"));
         }
+        summary.extend(d.frbi.descriptions());
         if self.pressure {
             summary.push(format!(
                 "Pressure {:.6e} at the end (molecular virial: the bodies' centres, as LAMMPS's fix rigid).",

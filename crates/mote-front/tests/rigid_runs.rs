@@ -167,6 +167,51 @@ fn toning_nip_example_runs_and_writes_nip_csv() {
     }
 }
 
+/// The toning nip with its conducting planes summed by P3M on the doubled
+/// cell (`[rigid.planes] method = "p3m"`): the tuned mesh is told in the
+/// summary, and the run follows the Ewald one — its charges' forces agree
+/// to the accuracy asked for (δ = 10⁻¹¹ N, the toner feels ~10⁻⁸ N), so
+/// over 40 steps the energies differ by less than N δ times the bodies'
+/// spacing (800 bodies in 9.3·10⁻¹² m³: 2.3·10⁻⁵ m).
+#[test]
+fn toning_nip_runs_with_p3m_between_the_planes() {
+    let ewald_text = example("toning-nip.toml");
+    assert!(ewald_text.contains("[rigid.planes]\n"));
+    let p3m_text = ewald_text.replace("[rigid.planes]\n", "[rigid.planes]\nmethod = \"p3m\"\n");
+    let energies = |name: &str, text: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let o = run(
+            name,
+            text,
+            dir.path(),
+            RunOptions {
+                steps: Some(40),
+                ..RunOptions::default()
+            },
+        );
+        let table = mote_io::csv::read_table(&dir.path().join("observables.csv")).unwrap();
+        let potential = table.column("potential_energy").unwrap().to_vec();
+        (o.summary, potential)
+    };
+    let (said, with_p3m) = energies("nip-p3m.toml", &p3m_text);
+    assert!(
+        said.iter().any(|l| l
+            .starts_with("Between conducting planes, on the doubled cell: Coulomb by P3M: mesh")),
+        "{said:?}"
+    );
+    let (said, with_ewald) = energies("nip-ewald.toml", &ewald_text);
+    assert!(
+        said.iter()
+            .any(|l| l.starts_with("Coulomb between conducting planes by Ewald")),
+        "{said:?}"
+    );
+    let bound = 800.0 * 1.0e-11 * 2.3e-5;
+    for (a, b) in with_p3m.iter().zip(&with_ewald) {
+        println!("U: P3M {a:e}, Ewald {b:e}, difference {:e}", a - b);
+        assert!((a - b).abs() <= bound, "P3M {a} against Ewald {b}");
+    }
+}
+
 /// The development itself: 10⁴ steps (0.5 ms; about a minute in release):
 /// toner develops onto the image, hardly onto the background.
 /// `cargo test --release -p mote-front --test front rigid_runs::toning_nip -- --ignored --nocapture`

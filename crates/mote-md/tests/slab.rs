@@ -5,6 +5,7 @@
 //! and forces against finite differences of the energy.
 
 use mote_md::force::ewald::Ewald;
+use mote_md::force::p3m::Request;
 use mote_md::force::slab::ConductingPlanes;
 use mote_md::DVec3;
 use rand::{Rng, SeedableRng};
@@ -50,7 +51,7 @@ fn wide_planes(charge: &[f64], potential: [f64; 2]) -> ConductingPlanes {
 fn one_charge_feels_its_images_as_the_trigamma_closed_form() {
     // F_z = −k q²/(4h²) [ψ₁(a) − ψ₁(1 − a)], a = z/h (Jackson problem 3.20).
     let q = [1.5];
-    let planes = wide_planes(&q, [0.0, 0.0]);
+    let mut planes = wide_planes(&q, [0.0, 0.0]);
     for a in [0.05, 0.2, 0.37, 0.5, 0.81, 0.96] {
         let pos = [DVec3::new(2.0, 3.0, a)];
         let mut f = [DVec3::ZERO];
@@ -94,7 +95,7 @@ fn image_series_force(r1: DVec3, r2: DVec3, h: f64, m: i64) -> DVec3 {
 fn two_charges_match_the_image_series() {
     let h = 1.0;
     let q = [1.0, -0.7];
-    let planes = wide_planes(&q, [0.0, 0.0]);
+    let mut planes = wide_planes(&q, [0.0, 0.0]);
     for (r1, r2) in [
         (DVec3::new(3.0, 3.0, 0.3), DVec3::new(3.4, 2.9, 0.55)),
         (DVec3::new(1.0, 2.0, 0.1), DVec3::new(1.05, 2.02, 0.15)),
@@ -135,7 +136,7 @@ fn random_charges(n: usize, lateral: [f64; 2], h: f64, seed: u64) -> (Vec<DVec3>
 fn forces_are_minus_the_energy_gradient() {
     let (lateral, h) = ([2.0, 1.5], 1.0);
     let (pos, q) = random_charges(12, lateral, h, 3);
-    let planes = ConductingPlanes::new(K, h, lateral, [0.3, -1.2], &q, 0.75, 1e-11);
+    let mut planes = ConductingPlanes::new(K, h, lateral, [0.3, -1.2], &q, 0.75, 1e-11);
     let mut f = vec![DVec3::ZERO; pos.len()];
     planes.evaluate(&pos, &q, Some(&mut f));
     let dx = 1e-6;
@@ -164,7 +165,7 @@ fn the_planes_take_the_reaction_of_every_force_on_the_charges() {
     let (lateral, h) = ([1.6, 1.2], 1.0);
     let (pos, q) = random_charges(10, lateral, h, 11);
     for potential in [[0.0, 0.0], [0.0, 2.5], [-1.0, 0.4]] {
-        let planes = ConductingPlanes::new(K, h, lateral, potential, &q, 0.6, 1e-12);
+        let mut planes = ConductingPlanes::new(K, h, lateral, potential, &q, 0.6, 1e-12);
         let mut f = vec![DVec3::ZERO; pos.len()];
         planes.evaluate(&pos, &q, Some(&mut f));
         let total: DVec3 = f.iter().copied().sum();
@@ -329,4 +330,60 @@ steps = 1
             .contains("[box] lo = [...], hi = [...], periodic = [...]"),
         "{e}"
     );
+}
+
+/// P3M on the doubled cell against Ewald on it (converged far past it):
+/// forces and energies of random charges between planes at a bias, to
+/// the accuracy asked for; the forces without the energy are the same.
+#[test]
+fn p3m_on_the_doubled_cell_matches_ewald() {
+    let (h, lateral) = (5.0, [9.0, 8.0]);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(41);
+    let n = 300;
+    let pos: Vec<DVec3> = (0..n)
+        .map(|_| {
+            DVec3::new(
+                rng.gen::<f64>() * lateral[0],
+                rng.gen::<f64>() * lateral[1],
+                0.1 + rng.gen::<f64>() * (h - 0.2),
+            )
+        })
+        .collect();
+    let q: Vec<f64> = (0..n)
+        .map(|i| if i % 3 == 0 { -2.0 } else { 1.0 })
+        .collect();
+    let potential = [0.5, -1.5];
+    let mut exact = ConductingPlanes::new(K, h, lateral, potential, &q, 4.0, 1e-10);
+    let mut f_ref = vec![DVec3::ZERO; n];
+    let u_ref = exact.evaluate(&pos, &q, Some(&mut f_ref));
+    for accuracy in [1e-3, 1e-4] {
+        let request = Request {
+            accuracy,
+            skin: 0.3,
+            ..Request::default()
+        };
+        let mut planes =
+            ConductingPlanes::with_p3m(K, h, lateral, potential, &q, &request).unwrap();
+        println!("{}", planes.describe());
+        let mut f = vec![DVec3::ZERO; n];
+        let u = planes.evaluate(&pos, &q, Some(&mut f));
+        let rms = (f
+            .iter()
+            .zip(&f_ref)
+            .map(|(a, b)| (*a - *b).length_squared())
+            .sum::<f64>()
+            / n as f64)
+            .sqrt();
+        println!(
+            "δ = {accuracy:e}: RMS force error {rms:.3e}; U {:.8} vs Ewald {:.8}",
+            u.total(),
+            u_ref.total()
+        );
+        assert!(rms < accuracy, "RMS force error {rms:e}");
+        assert!((u.bias - u_ref.bias).abs() < 1e-12 * u_ref.bias.abs());
+        assert!((u.images - u_ref.images).abs() < accuracy * n as f64);
+        let mut g = vec![DVec3::ZERO; n];
+        planes.add_forces(&pos, &q, &mut g);
+        assert_eq!(f, g);
+    }
 }

@@ -791,6 +791,51 @@ fn killed_toning_nip_resumes_bit_for_bit() {
     }
 }
 
+/// The toning nip with P3M between its planes (`[rigid.planes] method =
+/// "p3m"`) resumes bit for bit too: the checkpoint holds the P3M
+/// real-space list's build beside the held forces, so the resumed run
+/// sums its pairs in the same order.
+#[test]
+fn killed_toning_nip_with_p3m_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/rigid/toning-nip.toml"
+    );
+    let text = std::fs::read_to_string(example)
+        .unwrap()
+        .replace("[rigid.planes]\n", "[rigid.planes]\nmethod = \"p3m\"\n");
+    assert!(text.contains("method = \"p3m\""));
+    std::fs::write(dir.path().join("nip-p3m.toml"), text).unwrap();
+    let args = [
+        "run",
+        "nip-p3m.toml",
+        "--steps",
+        "600",
+        "--checkpoint-every",
+        "100",
+        "--threads",
+        "1",
+    ];
+    let (whole, at_kill, resumed) = whole_killed_resumed(dir.path(), &args, 200);
+    assert_eq!(resumed.step, whole.step);
+    // [length of the held part, the held part, the list's build].
+    assert!(
+        at_kill.carried.iter().any(|(_, v)| {
+            let held = v.first().copied().unwrap_or(0.0) as usize;
+            held % 4 == 1 && v.len() > 1 + held + 1
+        }),
+        "no P3M list in the checkpoint"
+    );
+    for file in ["observables.csv", "nip.csv", "trajectory.xyz"] {
+        assert!(
+            same_file(dir.path(), file),
+            "{file} differs (killed at {})",
+            at_kill.step
+        );
+    }
+}
+
 /// Runs own their folders: a checkpoint left in a folder by an older run is
 /// refused once a newer run has written there (nothing trimmed); a copy of a
 /// checkpoint resumes in its run's folder, saying where, and is refused once

@@ -21,7 +21,9 @@
 //! z = 0 and z = h exactly. The method is [`Ewald`] on the doubled cell, to
 //! a requested RMS force error: O(N^{3/2}) per evaluation, every image
 //! and every lateral copy included, rather than an image series cut off
-//! after n terms whose tail falls only as 1/n² for the force.
+//! after n terms whose tail falls only as 1/n² for the force — or P3M
+//! ([`P3mCoulomb`]) on the same doubled cell, O(N log N), for the toning
+//! nip at scale ([`ConductingPlanes::with_p3m`]).
 //!
 //! **Energy and forces.** The electrostatic energy of the charges at fixed
 //! potentials is U = ½ E_doubled + Σ q_i φ_bias(z_i), half the doubled
@@ -45,6 +47,21 @@
 use glam::DVec3;
 
 use super::ewald::Ewald;
+use super::p3m::{P3mCoulomb, Request};
+use super::{Interaction, State};
+use crate::boundary::Boundary;
+
+/// How the doubled cell's charges are summed.
+#[derive(Debug, Clone)]
+enum DoubledCell {
+    Ewald(Ewald),
+    /// P3M over the doubled cell z ∈ [−h, h) (the charges at z, their
+    /// mirrors at −z).
+    P3m {
+        solver: Box<P3mCoulomb>,
+        cell: Boundary,
+    },
+}
 
 /// Two conducting planes z = 0 and z = h held at potentials, with the
 /// charges between them periodic along x and y.
@@ -58,7 +75,7 @@ pub struct ConductingPlanes {
     pub lateral: [f64; 2],
     /// Potentials (V₀, V_h) of the planes z = 0 and z = h.
     pub potential: [f64; 2],
-    ewald: Ewald,
+    sum: DoubledCell,
 }
 
 /// What one evaluation gives.
@@ -98,13 +115,83 @@ impl ConductingPlanes {
             gap,
             lateral,
             potential,
-            ewald,
+            sum: DoubledCell::Ewald(ewald),
         }
     }
 
-    /// The Ewald parameters of the doubled cell.
-    pub fn ewald(&self) -> &Ewald {
-        &self.ewald
+    /// The planes of [`ConductingPlanes::new`] with the doubled cell summed
+    /// by P3M, tuned for its 2N charges (q_i and their mirrors −q_i) to
+    /// `request` (its accuracy in force units, with k); or why it cannot be.
+    pub fn with_p3m(
+        k: f64,
+        gap: f64,
+        lateral: [f64; 2],
+        potential: [f64; 2],
+        charge: &[f64],
+        request: &Request,
+    ) -> Result<Self, String> {
+        let cell = Boundary::periodic(
+            DVec3::new(0.0, 0.0, -gap),
+            DVec3::new(lateral[0], lateral[1], gap),
+        );
+        let doubled: Vec<f64> = charge
+            .iter()
+            .copied()
+            .chain(charge.iter().map(|q| -q))
+            .collect();
+        let solver = P3mCoulomb::tuned(k, request, &doubled, &cell)?;
+        Ok(Self {
+            k,
+            gap,
+            lateral,
+            potential,
+            sum: DoubledCell::P3m {
+                solver: Box::new(solver),
+                cell,
+            },
+        })
+    }
+
+    /// The Ewald parameters of the doubled cell, where Ewald sums it.
+    pub fn ewald(&self) -> Option<&Ewald> {
+        match &self.sum {
+            DoubledCell::Ewald(e) => Some(e),
+            DoubledCell::P3m { .. } => None,
+        }
+    }
+
+    /// How the doubled cell is summed, with its parameters: for summaries.
+    pub fn describe(&self) -> String {
+        match &self.sum {
+            DoubledCell::Ewald(e) => format!(
+                "Coulomb between conducting planes by Ewald on the doubled cell: α = {:.6}, real-space cut-off {:.6}, k-vectors to n_max = {}; estimated RMS force error {:.3e}.",
+                e.alpha,
+                e.r_cut,
+                e.n_max,
+                self.k * e.real_error.hypot(e.kspace_error)
+            ),
+            DoubledCell::P3m { solver, .. } => format!(
+                "Between conducting planes, on the doubled cell: {}",
+                solver.describe()
+            ),
+        }
+    }
+
+    /// The P3M list's build, for checkpoints (empty with Ewald).
+    pub fn carried_state(&self) -> Vec<f64> {
+        match &self.sum {
+            DoubledCell::Ewald(_) => Vec::new(),
+            DoubledCell::P3m { solver, .. } => solver.carried_state(),
+        }
+    }
+
+    /// Restores [`ConductingPlanes::carried_state`].
+    pub fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        match &mut self.sum {
+            DoubledCell::Ewald(_) if state.is_empty() => Ok(()),
+            DoubledCell::Ewald(_) => Err("planes summed by Ewald carry no list".into()),
+            DoubledCell::P3m { solver, .. } => solver.restore_carried_state(state),
+        }
     }
 
     /// The uniform field of the bias, −(V_h − V₀)/h ẑ.
@@ -124,7 +211,7 @@ impl ConductingPlanes {
     /// The energy of the charges at `position` (0 < z < h); their forces
     /// are added to `force` if given.
     pub fn evaluate(
-        &self,
+        &mut self,
         position: &[DVec3],
         charge: &[f64],
         force: Option<&mut [DVec3]>,
@@ -142,23 +229,72 @@ impl ConductingPlanes {
             .zip(charge)
             .map(|(r, q)| q * self.bias_potential(r.z))
             .sum();
-        let images = match force {
-            Some(force) => {
-                let mut f = vec![DVec3::ZERO; 2 * n];
-                let u = self
-                    .ewald
-                    .charges(&doubled_position, &doubled_charge, Some(&mut f));
-                let e = self.bias_field();
-                for ((fi, fd), q) in force.iter_mut().zip(&f[..n]).zip(charge) {
-                    *fi += *fd * self.k + e * *q;
+        let e = self.bias_field();
+        let images = match &mut self.sum {
+            DoubledCell::Ewald(ewald) => match force {
+                Some(force) => {
+                    let mut f = vec![DVec3::ZERO; 2 * n];
+                    let u = ewald.charges(&doubled_position, &doubled_charge, Some(&mut f));
+                    for ((fi, fd), q) in force.iter_mut().zip(&f[..n]).zip(charge) {
+                        *fi += *fd * self.k + e * *q;
+                    }
+                    u
                 }
-                u
+                None => ewald.charges(&doubled_position, &doubled_charge, None),
+            },
+            DoubledCell::P3m { solver, cell } => {
+                let still = vec![DVec3::ZERO; 2 * n];
+                let mass = vec![1.0; 2 * n];
+                let state = State::new(&doubled_position, &still, &mass, 0.0)
+                    .with_charges(&doubled_charge)
+                    .in_box(cell);
+                // The solver's forces and energy carry k already.
+                match force {
+                    Some(force) => {
+                        let mut f = vec![DVec3::ZERO; 2 * n];
+                        solver.add_forces(&state, &mut f);
+                        for ((fi, fd), q) in force.iter_mut().zip(&f[..n]).zip(charge) {
+                            *fi += *fd + e * *q;
+                        }
+                        solver.potential_energy(&state) / self.k
+                    }
+                    None => solver.potential_energy(&state) / self.k,
+                }
             }
-            None => self.ewald.charges(&doubled_position, &doubled_charge, None),
         };
         SlabEnergy {
             images: 0.5 * self.k * images,
             bias,
+        }
+    }
+
+    /// Adds the forces on the charges at `position` (0 < z < h) to `force`,
+    /// without the energy where that costs more (P3M).
+    pub fn add_forces(&mut self, position: &[DVec3], charge: &[f64], force: &mut [DVec3]) {
+        let DoubledCell::P3m { solver, cell } = &mut self.sum else {
+            self.evaluate(position, charge, Some(force));
+            return;
+        };
+        let n = position.len();
+        let doubled_position: Vec<DVec3> = position
+            .iter()
+            .copied()
+            .chain(position.iter().map(|r| DVec3::new(r.x, r.y, -r.z)))
+            .collect();
+        let doubled_charge: Vec<f64> = charge
+            .iter()
+            .copied()
+            .chain(charge.iter().map(|q| -q))
+            .collect();
+        let (still, mass) = (vec![DVec3::ZERO; 2 * n], vec![1.0; 2 * n]);
+        let state = State::new(&doubled_position, &still, &mass, 0.0)
+            .with_charges(&doubled_charge)
+            .in_box(cell);
+        let mut f = vec![DVec3::ZERO; 2 * n];
+        solver.add_forces(&state, &mut f);
+        let e = self.bias_field();
+        for ((fi, fd), q) in force.iter_mut().zip(&f[..n]).zip(charge) {
+            *fi += *fd + e * *q;
         }
     }
 

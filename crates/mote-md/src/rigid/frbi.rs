@@ -235,6 +235,15 @@ impl Frbi {
             .find_map(|it| (**it).as_any().downcast_ref::<T>())
     }
 
+    /// What the interactions that describe themselves say
+    /// ([`BodyInteraction::describe`]), in order.
+    pub fn descriptions(&self) -> Vec<String> {
+        self.interactions
+            .iter()
+            .filter_map(|i| i.describe())
+            .collect()
+    }
+
     /// The interactions, to change their settings between steps.
     pub fn interactions_mut(&mut self) -> &mut [Box<dyn BodyInteraction>] {
         &mut self.interactions

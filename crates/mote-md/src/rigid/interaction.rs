@@ -46,6 +46,11 @@ pub trait BodyInteraction: AsAny + Send + Sync {
     fn virial(&mut self, _view: &BodyView<'_>) -> Option<f64> {
         None
     }
+    /// How it sums, with the parameters it chose (a tuned long-range
+    /// solver's), for the run's summary; `None` for most.
+    fn describe(&self) -> Option<String> {
+        None
+    }
     /// The live viewer's hooks (steering the fields it owns), where this
     /// interaction has any.
     fn viewer_mut(&mut self) -> Option<&mut dyn crate::viewer::ViewerHooks> {

@@ -281,8 +281,8 @@ fn for_each_body(n: usize, wrench: &mut [DE], f: impl Fn(usize) -> DE + Sync + S
 
 /// Coulomb forces between the bodies' charges (at their centres of mass)
 /// between two conducting planes z = z₀ and z = z₀ + h, periodic along
-/// them: every image and the bias field ([`ConductingPlanes`], Ewald on the
-/// doubled cell). Replaces [`Coulomb`], which knows no planes.
+/// them: every image and the bias field ([`ConductingPlanes`], Ewald or
+/// P3M on the doubled cell). Replaces [`Coulomb`], which knows no planes.
 ///
 /// With `every` = n > 1 the charges' forces on one another (with their
 /// images) are summed at every n-th evaluation and held in between (a
@@ -347,7 +347,7 @@ impl BodyInteraction for PlaneCoulomb {
         let held = &mut self.held;
         if held.calls.is_multiple_of(self.every) || held.force.len() != index.len() {
             let mut force = vec![DVec3::ZERO; index.len()];
-            self.planes.evaluate(&position, &charge, Some(&mut force));
+            self.planes.add_forces(&position, &charge, &mut force);
             let bias = self.planes.bias_field();
             held.force = index
                 .iter()
@@ -368,21 +368,47 @@ impl BodyInteraction for PlaneCoulomb {
         self.planes.evaluate(&position, &charge, None).total()
     }
 
+    fn describe(&self) -> Option<String> {
+        Some(self.planes.describe())
+    }
+
     /// The held forces and the evaluation count (so that a resumed run
-    /// refreshes them at the same steps): [calls, (body, fx, fy, fz)…].
+    /// refreshes them at the same steps): [calls, (body, fx, fy, fz)…];
+    /// with P3M, [the length of that, that, the P3M list's build].
     fn carried_state(&self) -> Vec<f64> {
-        if self.every == 1 {
-            return Vec::new();
+        let mut out = Vec::new();
+        if self.every > 1 {
+            let held = &self.held;
+            out.push(held.calls as f64);
+            for (i, f) in &held.force {
+                out.extend([*i as f64, f.x, f.y, f.z]);
+            }
         }
-        let held = &self.held;
-        let mut out = vec![held.calls as f64];
-        for (i, f) in &held.force {
-            out.extend([*i as f64, f.x, f.y, f.z]);
+        if self.planes.ewald().is_some() {
+            return out;
         }
-        out
+        let list = self.planes.carried_state();
+        let mut tagged = vec![out.len() as f64];
+        tagged.extend(out);
+        tagged.extend(list);
+        tagged
     }
 
     fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
+        let state = if self.planes.ewald().is_none() && !state.is_empty() {
+            let held = state[0] as usize;
+            if state[0] != held as f64 || 1 + held > state.len() {
+                return Err(format!(
+                    "{}: a carried state of {} numbers does not fit",
+                    self.name(),
+                    state.len()
+                ));
+            }
+            self.planes.restore_carried_state(&state[1 + held..])?;
+            &state[1..1 + held]
+        } else {
+            state
+        };
         if state.is_empty() {
             return Ok(());
         }

@@ -229,7 +229,7 @@ pub(crate) struct P3mKeys {
 
 impl P3mKeys {
     /// What tuning is asked for `n` sources in `boundary`, or why the
-    /// table cannot be run.
+    /// table cannot be run, at the table.
     pub(crate) fn request(
         &self,
         table: &str,
@@ -238,7 +238,20 @@ impl P3mKeys {
         n: usize,
         boundary: Boundary,
     ) -> Result<p3m::Request, ParseError> {
-        let err = |msg: String| src.error(span.clone(), msg);
+        self.check(table, "cutoff", n, boundary)
+            .map_err(|m| src.error(span, m))
+    }
+
+    /// What tuning is asked for `n` sources in `boundary`, or why the
+    /// table cannot be run; the cut-off is the key `cutoff_key`.
+    pub(crate) fn check(
+        &self,
+        table: &str,
+        cutoff_key: &str,
+        n: usize,
+        boundary: Boundary,
+    ) -> Result<p3m::Request, String> {
+        let err = |msg: String| msg;
         let l = boundary.lengths();
         if boundary.periodic != [true; 3] || !(l.min_element() > 0.0 && l.max_element().is_finite())
         {
@@ -249,14 +262,16 @@ impl P3mKeys {
         let accuracy = self.accuracy.ok_or_else(|| {
             err(format!("[{table}] method = \"p3m\" needs accuracy = the RMS force error aimed at (force units)"))
         })?;
-        positive(src, span.clone(), &format!("[{table}] accuracy"), accuracy)?;
+        let positive = |what: String, value: f64| {
+            if value > 0.0 && value.is_finite() {
+                Ok(value)
+            } else {
+                Err(format!("{what} must be positive, found {value}"))
+            }
+        };
+        positive(format!("[{table}] accuracy"), accuracy)?;
         let cutoff = match self.cutoff {
-            Some(rc) => Some(positive(
-                src,
-                span.clone(),
-                &format!("[{table}] cutoff"),
-                rc,
-            )?),
+            Some(rc) => Some(positive(format!("[{table}] {cutoff_key}"), rc)?),
             None => None,
         };
         let skin = match (self.skin, cutoff) {
@@ -276,7 +291,7 @@ impl P3mKeys {
         if let Some(rc) = cutoff {
             if rc + skin > 0.5 * l.min_element() {
                 return Err(err(format!(
-                    "[{table}] cutoff + skin = {} must be at most half the shortest box side, {}",
+                    "[{table}] {cutoff_key} + skin = {} must be at most half the shortest box side, {}",
                     rc + skin,
                     0.5 * l.min_element()
                 )));

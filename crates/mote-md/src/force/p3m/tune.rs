@@ -166,19 +166,32 @@ pub fn tune(
     let half = 0.5 * cell.min_element();
     let density = nf / volume;
     let spacing = density.powf(-1.0 / 3.0);
+    // 2.5 to 5 particle spacings; in a box too small for those (sparse
+    // sources), fractions of the largest cut-off the box allows.
     let cutoffs: Vec<f64> = match request.cutoff {
         Some(rc) => vec![rc],
-        None => [2.5, 3.0, 3.5, 4.0, 5.0]
-            .iter()
-            .map(|f| f * spacing)
-            .filter(|rc| rc + request.skin <= half)
-            .collect(),
+        None => {
+            let by_spacing: Vec<f64> = [2.5, 3.0, 3.5, 4.0, 5.0]
+                .iter()
+                .map(|f| f * spacing)
+                .filter(|rc| rc + request.skin <= half)
+                .collect();
+            if by_spacing.is_empty() {
+                [0.6, 0.8, 1.0]
+                    .iter()
+                    .map(|f| f * (half - request.skin))
+                    .filter(|rc| *rc > 0.0)
+                    .collect()
+            } else {
+                by_spacing
+            }
+        }
     };
     if cutoffs.is_empty() {
         return Err(format!(
-            "the box (shortest side {}) is too small for a real-space cut-off of 2.5 particle spacings ({:.4}) plus the skin: give cutoff",
+            "the box (shortest side {}) leaves no room for a real-space cut-off beside the skin {}",
             2.0 * half,
-            2.5 * spacing
+            request.skin
         ));
     }
     let orders: Vec<usize> = match request.order {

@@ -75,6 +75,7 @@
 //! accuracy = 1e-12             # RMS force error of the Ewald sum (newtons)
 //! r_cut = 1e-4                 # real-space cut-off (default from the charges' spacing)
 //! every = 1                    # sum the charges' forces every n steps, hold them between
+//! method = "ewald"             # or "p3m" (with optional mesh, order): O(N log N)
 //!
 //! [rigid.latent_image]         # surface charge on a belt over the lower plane
 //! height = 2e-5                # electrical thickness d/ε_r of the photoconductor

@@ -12,11 +12,13 @@ use mote_io::ParseError;
 use serde::Deserialize;
 
 use super::{positive, Clumps, RigidBuild, RigidScene};
+use crate::boundary::Boundary;
 use crate::force::latent::{LatentImage, Patch};
 use crate::force::slab::ConductingPlanes;
 use crate::rigid::bodies::RigidBodies;
 use crate::rigid::magnet::{InducedDipoles, MagneticRoller};
 use crate::rigid::sources::{LatentField, PlaneCoulomb};
+use crate::scene::electric::P3mKeys;
 use crate::scene::Section;
 
 /// `[rigid.roller]`.
@@ -73,8 +75,19 @@ pub struct PlaneSettings {
     pub potential: [f64; 2],
     /// Requested RMS force error.
     pub accuracy: f64,
+    /// The real-space cut-off (Ewald: default 3.5 spacings of the doubled
+    /// cell's charges; P3M: tuned).
     #[serde(default)]
     pub r_cut: Option<f64>,
+    /// How the doubled cell is summed: `"ewald"` (default) or `"p3m"`.
+    #[serde(default)]
+    pub method: Option<String>,
+    /// P3M: mesh points along each axis of the doubled cell (default tuned).
+    #[serde(default)]
+    pub mesh: Option<[usize; 3]>,
+    /// P3M: assignment order 1–7 (default tuned).
+    #[serde(default)]
+    pub order: Option<usize>,
     /// Sum the charges' forces at every n-th step, hold them in between.
     #[serde(default)]
     pub every: Option<u64>,
@@ -226,22 +239,57 @@ fn plane_coulomb(
         .collect();
     let size = hi - lo;
     let largest = size.x.min(size.y).min(2.0 * size.z) / 2.0;
-    // About 3.5 spacings of the doubled cell's 2N charges: some 180
-    // neighbours in reach, on linked cells.
-    let spacing = (2.0 * size.element_product() / (2 * charge.len().max(1)) as f64).cbrt();
-    let r_cut = ps.r_cut.unwrap_or((3.5 * spacing).min(largest));
-    if !positive(r_cut) || r_cut > largest * (1.0 + 1e-12) {
-        return Err(format!("[rigid.planes] r_cut must be > 0 and at most {largest} (half the smallest side of the box doubled along z)"));
-    }
-    let planes = ConductingPlanes::new(
-        ps.coulomb,
-        size.z,
-        [size.x, size.y],
-        ps.potential,
-        &charge,
-        r_cut,
-        ps.accuracy,
-    );
+    let planes = match ps.method.as_deref().unwrap_or("ewald") {
+        "ewald" => {
+            if ps.mesh.is_some() || ps.order.is_some() {
+                return Err("[rigid.planes] mesh and order are keys of method = \"p3m\"".into());
+            }
+            // About 3.5 spacings of the doubled cell's 2N charges: some 180
+            // neighbours in reach, on linked cells.
+            let spacing = (2.0 * size.element_product() / (2 * charge.len().max(1)) as f64).cbrt();
+            let r_cut = ps.r_cut.unwrap_or((3.5 * spacing).min(largest));
+            if !positive(r_cut) || r_cut > largest * (1.0 + 1e-12) {
+                return Err(format!("[rigid.planes] r_cut must be > 0 and at most {largest} (half the smallest side of the box doubled along z)"));
+            }
+            ConductingPlanes::new(
+                ps.coulomb,
+                size.z,
+                [size.x, size.y],
+                ps.potential,
+                &charge,
+                r_cut,
+                ps.accuracy,
+            )
+        }
+        "p3m" => {
+            let keys = P3mKeys {
+                accuracy: Some(ps.accuracy),
+                cutoff: ps.r_cut,
+                skin: None,
+                mesh: ps.mesh,
+                order: ps.order,
+            };
+            let doubled = Boundary::periodic(
+                DVec3::new(0.0, 0.0, -size.z),
+                DVec3::new(size.x, size.y, size.z),
+            );
+            let request = keys.check("rigid.planes", "r_cut", 2 * charge.len(), doubled)?;
+            ConductingPlanes::with_p3m(
+                ps.coulomb,
+                size.z,
+                [size.x, size.y],
+                ps.potential,
+                &charge,
+                &request,
+            )
+            .map_err(|e| format!("[rigid.planes] {e}"))?
+        }
+        other => {
+            return Err(format!(
+                "[rigid.planes] unknown method '{other}': expected ewald or p3m"
+            ))
+        }
+    };
     if ps.every == Some(0) {
         return Err("[rigid.planes] every must be at least 1".into());
     }
