@@ -39,6 +39,7 @@ use crate::domain::{Domain, Halo};
 use crate::neighbor::VerletList;
 use crate::particles::System;
 pub use crate::viewer::ViewerHooks;
+use mote_run::comm::Comm;
 
 /// The parameters of one force evaluation that every interaction reads,
 /// for point particles ([`State::step`]) and rigid bodies
@@ -85,6 +86,10 @@ pub struct State<'a> {
     /// brick, up to date for `position` ([`ForceField`] sets it): an
     /// interaction that decomposes lists its pairs over them.
     pub halo: Option<&'a Halo>,
+    /// The ranks of a decomposed run ([`ForceField`] sets it beside
+    /// `halo`): what an interaction that sums over every particle (a mesh)
+    /// gathers through.
+    pub comm: Option<&'a dyn Comm>,
 }
 
 /// The pairs an interaction lists over a decomposed run's halo: those
@@ -173,6 +178,7 @@ impl<'a> State<'a> {
             boundary: &OPEN_SPACE,
             neighbours: None,
             halo: None,
+            comm: None,
         }
     }
 
@@ -198,6 +204,7 @@ impl<'a> State<'a> {
             boundary: &sys.boundary,
             neighbours: None,
             halo: None,
+            comm: None,
         }
     }
 
@@ -447,6 +454,7 @@ fn sharing<'a>(
     State {
         neighbours: neighbours.as_ref().map(|n| &n.0),
         halo: domain.as_ref().map(|d| d.halo()),
+        comm: domain.as_ref().map(|d| d.comm()),
         ..*state
     }
 }

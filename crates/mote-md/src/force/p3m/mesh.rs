@@ -111,7 +111,23 @@ impl Mesh {
         scale: f64,
         force: &mut [DVec3],
     ) {
-        self.assign(position, charge);
+        self.add_forces_at(position, charge, position, charge, scale, force);
+    }
+
+    /// The field of the charges `source_charge` at `source_position`,
+    /// `scale` q E(r) on the charges `charge` at `position`, added to
+    /// `force` (a decomposed run: every particle's charge, this rank's
+    /// particles' forces).
+    pub fn add_forces_at(
+        &mut self,
+        source_position: &[DVec3],
+        source_charge: &[f64],
+        position: &[DVec3],
+        charge: &[f64],
+        scale: f64,
+        force: &mut [DVec3],
+    ) {
+        self.assign(source_position, source_charge);
         let v = self.volume();
         let [_, my, mz] = self.grid.dims;
         let n = self.charge.len();

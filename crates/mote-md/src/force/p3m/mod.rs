@@ -13,6 +13,13 @@
 //! Ewald sum (zero for a neutral system). The parameters (mesh, order,
 //! α, r_c) come from the RMS force error asked for ([`tune`]).
 //!
+//! In a decomposed run (MPI ranks) the real space lists each rank's
+//! particles over its halo, the ghosts' charges read from every
+//! particle's (the scene's, by id); the mesh is replicated: every rank
+//! gathers every particle's position in id order and makes the whole mesh
+//! as one process does, so the forces are the same bits on any number of
+//! ranks; the mesh energy and the background are counted at rank 0.
+//!
 //! Point dipoles have their own solver, [`P3mDipoles`] ([`dipolar`], its
 //! mesh in [`dipole_mesh`]), on the same mesh geometry (`grid`: binning,
 //! spreading, interpolation, FFTs), influence functions ([`influence`])
@@ -30,11 +37,13 @@ pub mod tune;
 
 use glam::DVec3;
 
-use super::{Interaction, State, Virial};
+use super::{HaloReach, Interaction, State, Virial};
 use crate::boundary::Boundary;
+use crate::domain::Halo;
 use crate::neighbor::{Copy4, GhostList};
 pub use dipolar::P3mDipoles;
 use mote_geom::lanes::{self, Lanes};
+use mote_run::comm::Comm;
 use screened::Screened;
 pub use tune::{Parameters, Request, Source};
 
@@ -52,6 +61,10 @@ pub struct P3mCoulomb {
     screened: Screened,
     /// The charge of each copy of the list.
     copy_charge: Vec<f64>,
+    /// Every particle's charge in id order (the undivided system's, as
+    /// tuning saw it): what a decomposed run's ghosts and mesh read. Empty
+    /// from [`P3mCoulomb::new`], which then runs on one process only.
+    whole_charge: Vec<f64>,
     sorted_force: Vec<DVec3>,
     /// Of the last energy (NaN after a later force evaluation).
     virial: f64,
@@ -84,6 +97,7 @@ impl P3mCoulomb {
                 cell,
             ),
             copy_charge: Vec::new(),
+            whole_charge: Vec::new(),
             sorted_force: Vec::new(),
             virial: f64::NAN,
         }
@@ -110,24 +124,65 @@ impl P3mCoulomb {
         )?;
         parameters.real_error *= k;
         let mut solver = Self::new(k, parameters, request.skin, boundary);
+        solver.whole_charge = charge.to_vec();
         // The estimate stated: with every alias G sums, on the mesh itself.
         solver.parameters.kspace_error =
             k * solver.mesh.estimated_error(charge.len().max(1) as f64, q2);
         Ok(solver)
     }
 
-    /// Brings the list to `state` (counting a step when `step`) and the
-    /// copies' charges with it.
+    /// Brings the list to `state` (counting a step when `step`; over the
+    /// halo in a decomposed run) and the copies' charges with it.
     fn follow(&mut self, state: &State, step: bool) {
-        if step {
-            self.list.update(state.position, state.boundary);
-        } else {
-            self.list.refresh(state.position, state.boundary);
-        }
-        let q = state.charges();
         self.copy_charge.clear();
-        self.copy_charge
-            .extend(self.list.particle.iter().map(|&i| q[i as usize]));
+        match state.halo {
+            Some(halo) => {
+                self.list.follow_halo(halo, state.boundary);
+                let n = halo.id.len();
+                let whole = &self.whole_charge;
+                self.copy_charge.extend(self.list.particle.iter().map(|&i| {
+                    let i = i as usize;
+                    let id = if i < n {
+                        halo.id[i]
+                    } else {
+                        halo.ghosts[i - n].id
+                    };
+                    whole[id as usize]
+                }));
+            }
+            None => {
+                if step {
+                    self.list.update(state.position, state.boundary);
+                } else {
+                    self.list.refresh(state.position, state.boundary);
+                }
+                let q = state.charges();
+                self.copy_charge
+                    .extend(self.list.particle.iter().map(|&i| q[i as usize]));
+            }
+        }
+    }
+
+    /// Every particle's position and charge in id order, where the mesh
+    /// is made from them: a decomposed run gathers them to every rank
+    /// ([`whole_positions`]), one process has them.
+    fn sources<'s>(
+        whole_charge: &'s [f64],
+        state: &'s State,
+    ) -> (std::borrow::Cow<'s, [DVec3]>, &'s [f64]) {
+        match (state.halo, state.comm) {
+            (Some(halo), Some(comm)) => (
+                whole_positions(state.position, halo, comm, whole_charge.len()).into(),
+                whole_charge,
+            ),
+            _ => (state.position.into(), state.charges()),
+        }
+    }
+
+    /// Whether this evaluation counts the terms of the whole system (the
+    /// mesh energy, the background): at one process, or rank 0.
+    fn counts_the_whole(state: &State) -> bool {
+        state.comm.is_none_or(|c| c.rank() == 0)
     }
 
     /// The real-space rows into `sorted` (each row's force) and the halved
@@ -147,16 +202,33 @@ impl P3mCoulomb {
         (0.5 * w, 0.5 * u)
     }
 
-    /// −(α/√π) Σ q² − π Q²/(2Vα²): the self energy and the background.
-    fn self_and_background(&self, charge: &[f64]) -> (f64, f64) {
+    /// −(α/√π) Σ q² over `charge` (this rank's) and, with the total
+    /// charge Q (at one process or rank 0), the neutralising background
+    /// −π Q²/(2Vα²).
+    fn self_and_background(&self, charge: &[f64], total: Option<f64>) -> (f64, f64) {
         let alpha = self.parameters.alpha;
         let q2: f64 = charge.iter().map(|q| q * q).sum();
-        let q: f64 = charge.iter().sum();
+        let q = total.unwrap_or(0.0);
         let v = self.mesh.volume();
         (
             -alpha / SQRT_PI * q2,
             -std::f64::consts::PI * q * q / (2.0 * v * alpha * alpha),
         )
+    }
+
+    /// The mesh energy and virial and the total charge Q, where this
+    /// evaluation counts them ([`P3mCoulomb::counts_the_whole`]); zeros
+    /// and `None` at the other ranks, which still take part in the gather.
+    fn whole_system_terms(&mut self, state: &State) -> (f64, [f64; 6], Option<f64>) {
+        let (position, charge) = Self::sources(&self.whole_charge, state);
+        if Self::counts_the_whole(state) {
+            let (u, w) = self
+                .mesh
+                .energy_and_virial(&position, charge, self.parameters.alpha);
+            (u, w, Some(charge.iter().sum()))
+        } else {
+            (0.0, [0.0; 6], None)
+        }
     }
 
     /// "Coulomb by P3M: mesh 32 × 32 × 32, order 5, α = …": for summaries.
@@ -175,6 +247,33 @@ impl P3mCoulomb {
             p.kspace_error
         )
     }
+}
+
+/// Every particle's position in id order, at every rank: this rank's
+/// `position` with the halo's ids go to rank 0, which places them and
+/// sends the whole back. The mesh is then made from the same numbers in
+/// the same order as one process makes it, so its bits do not depend on
+/// the ranks (the positions are the ranks' own, unwrapped, as one process
+/// holds them).
+fn whole_positions(position: &[DVec3], halo: &Halo, comm: &dyn Comm, total: usize) -> Vec<DVec3> {
+    let mut send = Vec::with_capacity(4 * position.len());
+    for (id, r) in halo.id.iter().zip(position) {
+        send.push(*id as f64);
+        send.extend(r.to_array());
+    }
+    let parts = comm.gather(&send);
+    let mut placed = Vec::new();
+    if comm.rank() == 0 {
+        placed = vec![0.0; 3 * total];
+        for record in parts.iter().flat_map(|p| p.chunks_exact(4)) {
+            let id = record[0] as usize;
+            placed[3 * id..3 * id + 3].copy_from_slice(&record[1..]);
+        }
+    }
+    comm.broadcast(&placed)
+        .chunks_exact(3)
+        .map(DVec3::from_slice)
+        .collect()
 }
 
 /// The pair of unit charges at distance² r² (within the cut-off): F/r =
@@ -235,8 +334,15 @@ impl Interaction for P3mCoulomb {
         }
         self.list.scatter_add(&sorted, force);
         self.sorted_force = sorted;
-        self.mesh
-            .add_forces(state.position, state.charges(), self.k, force);
+        let (source_position, source_charge) = Self::sources(&self.whole_charge, state);
+        self.mesh.add_forces_at(
+            &source_position,
+            source_charge,
+            state.position,
+            state.charges(),
+            self.k,
+            force,
+        );
         self.virial = f64::NAN;
     }
 
@@ -246,10 +352,8 @@ impl Interaction for P3mCoulomb {
         sorted.resize(state.position.len(), DVec3::ZERO);
         let (w_real, u_real) = self.rows(&mut sorted, true);
         self.sorted_force = sorted;
-        let (u_mesh, w_mesh) =
-            self.mesh
-                .energy_and_virial(state.position, state.charges(), self.parameters.alpha);
-        let (u_self, u_background) = self.self_and_background(state.charges());
+        let (u_mesh, w_mesh, whole) = self.whole_system_terms(state);
+        let (u_self, u_background) = self.self_and_background(state.charges(), whole);
         self.virial = self.k * (w_real + w_mesh[0] + w_mesh[1] + w_mesh[2] + 3.0 * u_background);
         self.k * (u_real + u_mesh + u_self + u_background)
     }
@@ -279,12 +383,27 @@ impl Interaction for P3mCoulomb {
             }
             ((), w.0)
         });
-        let (_, mesh) = self
-            .mesh
-            .energy_and_virial(state.position, state.charges(), alpha);
-        let (_, background) = self.self_and_background(state.charges());
+        let (_, mesh, whole) = self.whole_system_terms(state);
+        let (_, background) = self.self_and_background(state.charges(), whole);
         let w = Virial(real).scaled(0.5) + Virial(mesh) + Virial::isotropic(background);
         Some(w.scaled(self.k))
+    }
+
+    /// Decomposed over ranks when tuned for a scene's charges: the real
+    /// space over the halo, the mesh made on every rank from every
+    /// particle (gathered in id order), the forces of this rank's.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        (!self.whole_charge.is_empty()).then_some(HaloReach {
+            cutoff: self.list.cutoff,
+            skin: self.list.skin,
+            every: self.list.every,
+            moments: false,
+            motion: false,
+        })
+    }
+
+    fn take_restored_list(&mut self) -> Option<(u64, Vec<DVec3>)> {
+        self.list.take_restored()
     }
 
     /// The neighbour list's build, as Lennard-Jones carries it.
