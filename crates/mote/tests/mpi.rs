@@ -1,9 +1,9 @@
 //! `mote run` across the ranks of `mpirun` (built with the `mpi` feature:
 //! `cargo test -p mote --features mpi --test mpi`; `.ci/run` installs
 //! OpenMPI and runs it). A Lennard-Jones liquid decomposed over 2, 3 and 4
-//! ranks, a molten salt with P3M Coulomb on 2, 3 and 4, and a granular
-//! bed on 2 and 3, write the trajectory of one process byte for byte; one
-//! rank
+//! ranks, a molten salt with P3M Coulomb and a dipolar fluid with P3M
+//! dipoles on 2, 3 and 4, and a granular bed on 2 and 3, write the
+//! trajectory of one process byte for byte; one rank
 //! writes exactly what the plain build writes; what does not decompose yet
 //! is refused, once, with its name.
 
@@ -163,40 +163,80 @@ observables_every = 25
 trajectory_every = 50
 "#;
 
+/// A dipolar fluid of 512 particles turning as they move, dipoles by P3M
+/// beside WCA cores, in a box long enough for four bricks along x.
+const DIPOLAR_FLUID: &str = r#"
+title = "dipolar fluid on ranks"
+units = "lj"
+seed = 4
+
+[run]
+integrator = "leapfrog"
+dt = 0.002
+steps = 100
+
+[lennard_jones]
+wca = true
+
+[dipolar]
+method = "p3m"
+accuracy = 1e-3
+random_orientation = true
+
+[[fcc]]
+cells = [8, 4, 4]
+density = 0.7
+kt = 1.0
+radius = 0.5
+dipole = [0.0, 0.0, 1.2]
+
+[output]
+observables_every = 25
+trajectory_every = 50
+"#;
+
 /// P3M on ranks: the real space over each rank's halo, the mesh made on
-/// every rank from every ion (gathered in id order), so the forces — and
-/// the trajectory — are one process's, byte for byte, on 2, 3 and 4 ranks;
-/// the energies (summed over the ranks) to round-off.
+/// every rank from every particle (gathered in id order), so the forces —
+/// and the trajectory — are one process's, byte for byte, on 2, 3 and 4
+/// ranks; the energies (summed over the ranks) to round-off. For charges
+/// (a molten salt) and for dipoles (a dipolar fluid, with torques).
 #[test]
-fn a_molten_salt_with_p3m_on_two_three_and_four_ranks_writes_one_process_trajectory() {
+fn p3m_on_two_three_and_four_ranks_writes_one_process_trajectory() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("salt.toml"), SALT).unwrap();
-    let one = plain(&["run", "salt.toml", "-o", "one"], dir.path());
-    assert!(one.status.success(), "{}", text(&one.stderr));
-    assert!(text(&one.stdout).contains("Coulomb by P3M: mesh"));
-    let read = |run: &str, file: &str| std::fs::read(dir.path().join(run).join(file)).unwrap();
-    let expected = table(&dir.path().join("one/observables.csv"));
-    for ranks in [2, 3, 4] {
-        let run = format!("np{ranks}");
-        let o = mpirun(ranks, &["run", "salt.toml", "-o", &run], dir.path());
-        assert!(
-            o.status.success(),
-            "{ranks} ranks: {}{}",
-            text(&o.stderr),
-            text(&o.stdout)
-        );
-        assert!(
-            read("one", "trajectory.xyz") == read(&run, "trajectory.xyz"),
-            "the trajectory on {ranks} ranks differs from one process's"
-        );
-        let got = table(&dir.path().join(&run).join("observables.csv"));
-        assert_eq!(got.len(), expected.len());
-        for (g, e) in got.iter().zip(&expected) {
-            for (a, b) in g.iter().zip(e) {
-                assert!(
-                    (a - b).abs() <= 1e-9 * b.abs().max(1e-3),
-                    "{ranks} ranks: {a} against {b}"
-                );
+    for (name, scene, said) in [
+        ("salt", SALT, "Coulomb by P3M: mesh"),
+        ("fluid", DIPOLAR_FLUID, "Dipolar by P3M: mesh"),
+    ] {
+        let file = format!("{name}.toml");
+        std::fs::write(dir.path().join(&file), scene).unwrap();
+        let one_dir = format!("{name}-one");
+        let one = plain(&["run", &file, "-o", &one_dir], dir.path());
+        assert!(one.status.success(), "{}", text(&one.stderr));
+        assert!(text(&one.stdout).contains(said), "{}", text(&one.stdout));
+        let read = |run: &str, f: &str| std::fs::read(dir.path().join(run).join(f)).unwrap();
+        let expected = table(&dir.path().join(&one_dir).join("observables.csv"));
+        for ranks in [2, 3, 4] {
+            let run = format!("{name}-np{ranks}");
+            let o = mpirun(ranks, &["run", &file, "-o", &run], dir.path());
+            assert!(
+                o.status.success(),
+                "{name} on {ranks} ranks: {}{}",
+                text(&o.stderr),
+                text(&o.stdout)
+            );
+            assert!(
+                read(&one_dir, "trajectory.xyz") == read(&run, "trajectory.xyz"),
+                "{name}: the trajectory on {ranks} ranks differs from one process's"
+            );
+            let got = table(&dir.path().join(&run).join("observables.csv"));
+            assert_eq!(got.len(), expected.len());
+            for (g, e) in got.iter().zip(&expected) {
+                for (a, b) in g.iter().zip(e) {
+                    assert!(
+                        (a - b).abs() <= 1e-9 * b.abs().max(1e-3),
+                        "{name} on {ranks} ranks: {a} against {b}"
+                    );
+                }
             }
         }
     }

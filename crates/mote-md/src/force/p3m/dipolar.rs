@@ -15,6 +15,12 @@
 //! the Ewald sum's ([`super::dipole_mesh`]). Mesh, order, α and r_c come
 //! from the RMS force error asked for ([`super::tune`], Cerdà et al.'s
 //! estimate for the mesh, Wang & Holm's Eq. 33 for the real space).
+//!
+//! On MPI ranks it decomposes as [`super::P3mCoulomb`] does: the real
+//! space over the halo (the ghosts' moments forwarded with them), the mesh
+//! made on every rank from every particle's position and moment gathered
+//! in id order, so forces and torques are the same bits on any number of
+//! ranks.
 
 use glam::DVec3;
 
@@ -22,7 +28,7 @@ use super::dipole_mesh::{AtParticle, DipoleMesh};
 use super::screened::DipolarScreened;
 use super::tune::{self, Parameters, Request, Source};
 use crate::boundary::Boundary;
-use crate::force::{Interaction, Spin, State};
+use crate::force::{HaloReach, Interaction, Spin, State};
 use crate::neighbor::{Copy4, GhostList};
 use mote_geom::lanes::{self, Lanes};
 
@@ -43,6 +49,10 @@ pub struct P3mDipoles {
     at_particle: Vec<AtParticle>,
     /// W = 3U of the last energy (NaN after a later force evaluation).
     virial: f64,
+    /// The particles of the undivided system (as tuning saw them): a
+    /// decomposed run gathers that many. Zero from [`P3mDipoles::new`],
+    /// which then runs on one process only.
+    total: usize,
 }
 
 /// What a real-space row adds up.
@@ -74,6 +84,7 @@ impl P3mDipoles {
             rows: Vec::new(),
             at_particle: Vec::new(),
             virial: f64::NAN,
+            total: 0,
         }
     }
 
@@ -94,6 +105,7 @@ impl P3mDipoles {
         let mut parameters = tune::tune(boundary.lengths(), dipole.len(), source, &gaussian)?;
         parameters.real_error *= k;
         let mut solver = Self::new(k, parameters, request.skin, boundary);
+        solver.total = dipole.len();
         solver.parameters.kspace_error =
             k * solver.mesh.estimated_error(dipole.len().max(1) as f64, m2);
         Ok(solver)
@@ -116,15 +128,41 @@ impl P3mDipoles {
         )
     }
 
-    /// Brings the list to `state` (counting a step when `step`) and the
-    /// copies' moments with it.
+    /// Brings the list to `state` (counting a step when `step`; over the
+    /// halo in a decomposed run) and the copies' moments with it.
     fn follow(&mut self, state: &State, step: bool) {
-        if step {
-            self.list.update(state.position, state.boundary);
-        } else {
-            self.list.refresh(state.position, state.boundary);
+        match state.halo {
+            Some(halo) => {
+                self.list.follow_halo(halo, state.boundary);
+                self.list
+                    .gather_halo(state.dipole, &halo.moment, &mut self.copy_moment);
+            }
+            None => {
+                if step {
+                    self.list.update(state.position, state.boundary);
+                } else {
+                    self.list.refresh(state.position, state.boundary);
+                }
+                self.list.gather(state.dipole, &mut self.copy_moment);
+            }
         }
-        self.list.gather(state.dipole, &mut self.copy_moment);
+    }
+
+    /// Every particle's position and moment in id order, where the mesh is
+    /// made from them: gathered to every rank in a decomposed run, `None`
+    /// at one process (which has them).
+    fn whole(&self, state: &State) -> Option<(Vec<DVec3>, Vec<DVec3>)> {
+        let (halo, comm) = (state.halo?, state.comm?);
+        let own = state.position.iter().zip(state.dipole).map(|(r, m)| {
+            let (r, m) = (r.to_array(), m.to_array());
+            [r[0], r[1], r[2], m[0], m[1], m[2]]
+        });
+        let all = super::gathered(own, halo, comm, self.total);
+        Some(
+            all.iter()
+                .map(|v| (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5])))
+                .unzip(),
+        )
     }
 
     /// The real-space rows into `self.rows` (by row), and half the sum of
@@ -160,15 +198,29 @@ impl P3mDipoles {
     /// Adds k F_i and, with `torque`, k μ_i × H_i.
     fn evaluate(&mut self, state: &State, force: &mut [DVec3], torque: Option<&mut [DVec3]>) {
         let n = force.len();
-        if state.dipole.len() != n || n == 0 {
+        if state.dipole.len() != n || (n == 0 && state.halo.is_none()) {
             return;
         }
         self.follow(state, true);
         self.real_space(false);
         let mut mesh = std::mem::take(&mut self.at_particle);
         mesh.resize(n, AtParticle::default());
-        self.mesh
-            .forces_and_fields(state.position, state.dipole, torque.is_some(), &mut mesh);
+        match self.whole(state) {
+            Some((position, dipole)) => self.mesh.forces_and_fields_at(
+                &position,
+                &dipole,
+                state.position,
+                state.dipole,
+                torque.is_some(),
+                &mut mesh,
+            ),
+            None => self.mesh.forces_and_fields(
+                state.position,
+                state.dipole,
+                torque.is_some(),
+                &mut mesh,
+            ),
+        }
         let slot = &self.list.slot;
         for i in 0..n {
             force[i] += (self.rows[slot[i] as usize].force + mesh[i].force) * self.k;
@@ -309,12 +361,20 @@ impl Interaction for P3mDipoles {
 
     fn potential_energy(&mut self, state: &State) -> f64 {
         let n = state.position.len();
-        if state.dipole.len() != n || n == 0 {
+        if state.dipole.len() != n || (n == 0 && state.halo.is_none()) {
             return 0.0;
         }
         self.follow(state, false);
         let u_real = self.real_space(true);
-        let u_mesh = self.mesh.energy(state.position, state.dipole);
+        // The mesh energy is the whole system's: counted at rank 0 (every
+        // rank takes part in the gather).
+        let u_mesh = match self.whole(state) {
+            Some((position, dipole)) => match state.comm.map(|c| c.rank()) {
+                Some(0) => self.mesh.energy(&position, &dipole),
+                _ => 0.0,
+            },
+            None => self.mesh.energy(state.position, state.dipole),
+        };
         let (own, exchange) = (self.self_coefficient(), self.mesh.self_correction);
         let u_self: f64 = state
             .dipole
@@ -331,6 +391,24 @@ impl Interaction for P3mDipoles {
     /// for that sum to the accuracy asked for.
     fn virial(&self) -> Option<f64> {
         Some(self.virial)
+    }
+
+    /// Decomposed over ranks when tuned for a scene's dipoles: the real
+    /// space over the halo (the ghosts' moments forwarded with them), the
+    /// mesh made on every rank from every particle's position and moment
+    /// (gathered in id order), the forces and torques of this rank's.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        (self.total > 0).then_some(HaloReach {
+            cutoff: self.list.cutoff,
+            skin: self.list.skin,
+            every: self.list.every,
+            moments: true,
+            motion: false,
+        })
+    }
+
+    fn take_restored_list(&mut self) -> Option<(u64, Vec<DVec3>)> {
+        self.list.take_restored()
     }
 
     /// The neighbour list's build, as Lennard-Jones carries it.

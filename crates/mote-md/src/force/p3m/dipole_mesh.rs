@@ -164,7 +164,23 @@ impl DipoleMesh {
         field: bool,
         out: &mut [AtParticle],
     ) {
-        self.assign(position, dipole);
+        self.forces_and_fields_at(position, dipole, position, dipole, field, out);
+    }
+
+    /// [`DipoleMesh::forces_and_fields`] of the mesh made from the dipoles
+    /// `source_dipole` at `source_position`, at the dipoles `dipole` at
+    /// `position` (a decomposed run: every particle's moments, this rank's
+    /// particles' forces).
+    pub fn forces_and_fields_at(
+        &mut self,
+        source_position: &[DVec3],
+        source_dipole: &[DVec3],
+        position: &[DVec3],
+        dipole: &[DVec3],
+        field: bool,
+        out: &mut [AtParticle],
+    ) {
+        self.assign(source_position, source_dipole);
         let v = self.grid.volume();
         let points = self.grid.points();
         let meshes = if field { 5 } else { 3 };
