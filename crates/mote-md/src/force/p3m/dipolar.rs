@@ -436,13 +436,7 @@ mod tests {
         let cell = DVec3::splat(9.0);
         let boundary = Boundary::periodic(DVec3::ZERO, cell);
         let n = 500;
-        let mut seed = 987654u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = super::super::uniform(987654);
         let pos: Vec<DVec3> = (0..n)
             .map(|_| DVec3::new(next(), next(), next()) * cell)
             .collect();

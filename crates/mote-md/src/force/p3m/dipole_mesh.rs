@@ -109,13 +109,15 @@ impl DipoleMesh {
             std::mem::take(&mut self.moment_xy),
             std::mem::take(&mut self.moment_z),
         );
-        self.grid.spread(
+        self.grid.spread_two(
             position,
-            |i| Complex64::new(dipole[i].x, dipole[i].y),
+            |i| {
+                let m = dipole[i];
+                [Complex64::new(m.x, m.y), Complex64::new(m.z, 0.0)]
+            },
             &mut xy,
+            &mut z,
         );
-        self.grid
-            .spread(position, |i| Complex64::new(dipole[i].z, 0.0), &mut z);
         self.grid.transform(&mut xy, FftDirection::Forward);
         self.grid.transform(&mut z, FftDirection::Forward);
         let mut divergence = std::mem::take(&mut self.divergence);

@@ -192,51 +192,90 @@ impl Grid {
         value: impl Fn(usize) -> V + Sync,
         mesh: &mut Vec<Complex64>,
     ) {
+        self.clear(mesh);
+        let slab = self.slab_points();
+        mesh.par_chunks_mut(slab)
+            .enumerate()
+            .for_each(|(task, a)| self.spread_slab(position, |i| [value(i)], task, [a]));
+    }
+
+    /// [`Grid::spread`] of two values a particle into two meshes, in one
+    /// pass (one stencil a particle for both).
+    pub fn spread_two<V: Spread>(
+        &self,
+        position: &[DVec3],
+        value: impl Fn(usize) -> [V; 2] + Sync,
+        first: &mut Vec<Complex64>,
+        second: &mut Vec<Complex64>,
+    ) {
+        self.clear(first);
+        self.clear(second);
+        let slab = self.slab_points();
+        first
+            .par_chunks_mut(slab)
+            .zip(second.par_chunks_mut(slab))
+            .enumerate()
+            .for_each(|(task, (a, b))| self.spread_slab(position, &value, task, [a, b]));
+    }
+
+    /// `mesh` zeroed at every point.
+    fn clear(&self, mesh: &mut Vec<Complex64>) {
+        mesh.clear();
+        mesh.resize(self.points(), Complex64::default());
+    }
+
+    /// Mesh points per spreading task: slabs of x planes as thick as the
+    /// stencil (a particle reaches two at most).
+    fn slab_points(&self) -> usize {
+        self.order.max(2) * self.dims[1] * self.dims[2]
+    }
+
+    /// Task `task`'s slab of each of K meshes: the particles whose
+    /// stencils reach it, by their stencil's first plane from lo − p + 1
+    /// to the slab's last, in index order within a plane.
+    fn spread_slab<V: Spread, const K: usize>(
+        &self,
+        position: &[DVec3],
+        value: impl Fn(usize) -> [V; K],
+        task: usize,
+        mut slabs: [&mut [Complex64]; K],
+    ) {
         let [mx, my, mz] = self.dims;
         let p = self.order;
         assert_eq!(self.by_plane.len(), position.len(), "binned for these");
-        mesh.clear();
-        mesh.resize(mx * my * mz, Complex64::default());
         let plane = my * mz;
-        // Slabs as thick as the stencil: a particle reaches two at most.
-        let planes_per_task = p.max(2);
+        let lo_plane = task * p.max(2);
+        let planes = slabs[0].len() / plane;
         let (by_plane, plane_start) = (&self.by_plane, &self.plane_start);
-        mesh.par_chunks_mut(plane * planes_per_task)
-            .enumerate()
-            .for_each(|(task, slab)| {
-                let lo_plane = task * planes_per_task;
-                let planes = slab.len() / plane;
-                // First planes from lo − p + 1 to the slab's last, in order.
-                let back = (p - 1).min(mx - planes);
-                for step in 0..back + planes {
-                    let bin = (lo_plane + mx + step - back) % mx;
-                    let members =
-                        &by_plane[plane_start[bin] as usize..plane_start[bin + 1] as usize];
-                    for &i in members {
-                        let i = i as usize;
-                        let at = self.footprint(position[i]);
-                        let [sx, sy, sz] = &at.stencil;
-                        let [wx, wy, wz] = &at.index;
-                        let v = value(i);
-                        for (a, &x) in wx[..p].iter().enumerate() {
-                            // The plane within this slab, if it is one.
-                            let Some(local) = x.checked_sub(lo_plane).filter(|l| *l < planes)
-                            else {
-                                continue;
-                            };
-                            let vx = v.scaled(sx.weight[a]);
-                            for (b, &y) in wy[..p].iter().enumerate() {
-                                let vxy = vx.scaled(sy.weight[b]);
-                                let row =
-                                    &mut slab[local * plane + y * mz..local * plane + (y + 1) * mz];
-                                for (c, &z) in wz[..p].iter().enumerate() {
-                                    vxy.add_to(&mut row[z], sz.weight[c]);
-                                }
+        let back = (p - 1).min(mx - planes);
+        for step in 0..back + planes {
+            let bin = (lo_plane + mx + step - back) % mx;
+            let members = &by_plane[plane_start[bin] as usize..plane_start[bin + 1] as usize];
+            for &i in members {
+                let i = i as usize;
+                let at = self.footprint(position[i]);
+                let [sx, sy, sz] = &at.stencil;
+                let [wx, wy, wz] = &at.index;
+                let v = value(i);
+                for (a, &x) in wx[..p].iter().enumerate() {
+                    // The plane within this slab, if it is one.
+                    let Some(local) = x.checked_sub(lo_plane).filter(|l| *l < planes) else {
+                        continue;
+                    };
+                    for (b, &y) in wy[..p].iter().enumerate() {
+                        let w = sx.weight[a] * sy.weight[b];
+                        let start = local * plane + y * mz;
+                        for (slab, v) in slabs.iter_mut().zip(v) {
+                            let vxy = v.scaled(w);
+                            let row = &mut slab[start..start + mz];
+                            for (c, &z) in wz[..p].iter().enumerate() {
+                                vxy.add_to(&mut row[z], sz.weight[c]);
                             }
                         }
                     }
                 }
-            });
+            }
+        }
     }
 
     /// Σ_j W(r_j − r_i) X_j of each of the K meshes X at every particle

@@ -482,6 +482,18 @@ fn row_lanes<const ENERGY: bool>(
     }
 }
 
+/// Uniform numbers in [0, 1) from `seed` (Knuth's MMIX generator): the
+/// row tests' particles.
+#[cfg(test)]
+pub(super) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -492,13 +504,7 @@ mod tests {
         let cell = DVec3::splat(9.0);
         let boundary = Boundary::periodic(DVec3::ZERO, cell);
         let n = 600;
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(12345);
         let pos: Vec<DVec3> = (0..n)
             .map(|_| DVec3::new(next(), next(), next()) * cell)
             .collect();
