@@ -134,12 +134,8 @@ impl ConductingPlanes {
             DVec3::new(0.0, 0.0, -gap),
             DVec3::new(lateral[0], lateral[1], gap),
         );
-        let doubled: Vec<f64> = charge
-            .iter()
-            .copied()
-            .chain(charge.iter().map(|q| -q))
-            .collect();
-        let solver = P3mCoulomb::tuned(k, request, &doubled, &cell)?;
+        let (_, doubled_charge) = doubled(&[], charge);
+        let solver = P3mCoulomb::tuned(k, request, &doubled_charge, &cell)?;
         Ok(Self {
             k,
             gap,
@@ -217,13 +213,7 @@ impl ConductingPlanes {
         force: Option<&mut [DVec3]>,
     ) -> SlabEnergy {
         let n = position.len();
-        let mirrored = position.iter().map(|r| DVec3::new(r.x, r.y, -r.z));
-        let doubled_position: Vec<DVec3> = position.iter().copied().chain(mirrored).collect();
-        let doubled_charge: Vec<f64> = charge
-            .iter()
-            .copied()
-            .chain(charge.iter().map(|q| -q))
-            .collect();
+        let (doubled_position, doubled_charge) = doubled(position, charge);
         let bias = position
             .iter()
             .zip(charge)
@@ -276,16 +266,7 @@ impl ConductingPlanes {
             return;
         };
         let n = position.len();
-        let doubled_position: Vec<DVec3> = position
-            .iter()
-            .copied()
-            .chain(position.iter().map(|r| DVec3::new(r.x, r.y, -r.z)))
-            .collect();
-        let doubled_charge: Vec<f64> = charge
-            .iter()
-            .copied()
-            .chain(charge.iter().map(|q| -q))
-            .collect();
+        let (doubled_position, doubled_charge) = doubled(position, charge);
         let (still, mass) = (vec![DVec3::ZERO; 2 * n], vec![1.0; 2 * n]);
         let state = State::new(&doubled_position, &still, &mass, 0.0)
             .with_charges(&doubled_charge)
@@ -354,6 +335,20 @@ impl ConductingPlanes {
         }
         out
     }
+}
+
+/// The doubled cell's charges: each charge q at (x, y, z), then its
+/// mirror −q at (x, y, −z).
+fn doubled(position: &[DVec3], charge: &[f64]) -> (Vec<DVec3>, Vec<f64>) {
+    let mirrored = position.iter().map(|r| DVec3::new(r.x, r.y, -r.z));
+    (
+        position.iter().copied().chain(mirrored).collect(),
+        charge
+            .iter()
+            .copied()
+            .chain(charge.iter().map(|q| -q))
+            .collect(),
+    )
 }
 
 /// sinh(k u)/sinh(k h) for 0 ≤ u ≤ h, without overflow:
