@@ -3,7 +3,7 @@
 //! A [`System`] holds the state (particles as a structure of arrays, the
 //! time); a [`ForceField`] is a list of [`Interaction`]s that add forces; an
 //! [`Integrator`] advances the state with a fixed time step; [`Simulation`]
-//! is the single run loop, which hands the state to [`Observer`]s on their
+//! is the single run loop, which hands the state to [`Observer`](mote_run::Observer)s on their
 //! schedule. Settings come from a TOML [`scene`] or an MPPphys particle file.
 
 #![allow(clippy::needless_range_loop)] // index loops over parallel arrays read best in numerical code

@@ -129,8 +129,8 @@ impl Bricks {
         &self.cuts[k]
     }
 
-    /// Moves the planes between the slabs along axis k to `inner` (dims[k]
-    /// − 1 increasing coordinates inside the box).
+    /// Moves the planes between the slabs along axis k to `inner` (`dims[k]
+    /// − 1` increasing coordinates inside the box).
     pub fn shift(&mut self, k: usize, inner: &[f64]) {
         let p = self.dims[k];
         assert_eq!(

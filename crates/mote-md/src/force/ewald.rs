@@ -708,7 +708,7 @@ impl Interaction for EwaldCoulomb {
 
 /// Dipole–dipole interaction of point dipoles in a cubic periodic box by
 /// Ewald summation (tin-foil), with forces and torques τ = μ × H. The
-/// dipoles come from [`Spin::dipole`]; the last ones seen are kept for
+/// dipoles come from [`State::dipole`]; the last ones seen are kept for
 /// [`Interaction::potential_energy`] and for `add_forces` calls without a spin.
 #[derive(Debug, Clone)]
 pub struct EwaldDipoles {

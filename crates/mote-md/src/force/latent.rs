@@ -5,7 +5,7 @@
 //! **A rectangle in open space.** A rectangle x′ ∈ [x₁, x₂], y′ ∈ [y₁, y₂]
 //! of the plane z = 0 with charge density σ has, with X = x − x′,
 //! Y = y − y′, R = (X² + Y² + z²)^{1/2} and the corner sum
-//! [[F]] = F(x−x₁, y−y₁) − F(x−x₁, y−y₂) − F(x−x₂, y−y₁) + F(x−x₂, y−y₂)
+//! \[\[F\]\] = F(x−x₁, y−y₁) − F(x−x₁, y−y₂) − F(x−x₂, y−y₁) + F(x−x₂, y−y₂)
 //! (Durand, *Électrostatique* I (1964); Hummer, J. Chem. Phys. 105, 2004
 //! (1996), Eq. A1):
 //!

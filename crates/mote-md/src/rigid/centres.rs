@@ -14,7 +14,7 @@
 //! The bodies are in open space here, as the interactions below assume;
 //! an interaction that carries contact histories does not belong on the
 //! centres (its histories would advance by the step of the state, which
-//! a body view gives as [`BodyView::dt`]).
+//! a body view gives as its `step.dt`, [`BodyView::step`]).
 
 use std::f64::consts::PI;
 

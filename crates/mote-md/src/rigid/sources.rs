@@ -282,7 +282,7 @@ fn for_each_body(n: usize, wrench: &mut [DE], f: impl Fn(usize) -> DE + Sync + S
 /// Coulomb forces between the bodies' charges (at their centres of mass)
 /// between two conducting planes z = z₀ and z = z₀ + h, periodic along
 /// them: every image and the bias field ([`ConductingPlanes`], Ewald or
-/// P3M on the doubled cell). Replaces [`Coulomb`], which knows no planes.
+/// P3M on the doubled cell). Replaces the open-space Coulomb law ([`DirectCoulomb`](crate::force::DirectCoulomb)), which knows no planes.
 ///
 /// With `every` = n > 1 the charges' forces on one another (with their
 /// images) are summed at every n-th evaluation and held in between (a

@@ -108,7 +108,6 @@ impl Section for DipolarSettings {
             }
         }
         let method = self.method.as_str();
-        let summed = matches!(method, "ewald" | "p3m");
         let keys: &[(&str, bool)] = match method {
             "ewald" => &[
                 ("skin", self.skin.is_some()),
@@ -134,7 +133,7 @@ impl Section for DipolarSettings {
                         "[dipolar] {key} does not apply to method = \"{method}\"{}",
                         if *key == "wca" {
                             " (add [lennard_jones] wca = true beside it)"
-                        } else if !summed {
+                        } else if matches!(*key, "mesh" | "order") {
                             " (it is a key of method = \"p3m\")"
                         } else {
                             ""

@@ -8,7 +8,7 @@
 //!     + U_mesh + Σ_i μ_i·(T − S)·μ_i − (2α³/3√π) Σ μ²],
 //!
 //! k = μ₀/4π, r = r_i − r_j, with B, C (and D for the force) the screened
-//! pair functions of [`super::screened::DipolarScreened`]; the real-space
+//! pair functions of `screened.rs` (`DipolarScreened`); the real-space
 //! force on i is (μ_i·μ_j) C r + [(μ_j·r) μ_i + (μ_i·r) μ_j] C
 //! − (μ_i·r)(μ_j·r) D r and the field at i from j (μ_j·r) C r − μ_j B; the
 //! torque is μ_i × H_i. T − S exchanges the mesh's average self energy for

@@ -77,7 +77,7 @@ impl Section<Clumps> for BodySpec {
 /// end), as a rigid run writes them: one row per sphere with its radius and
 /// body id (a LAMMPS dump's `mol`), and where present the orientation
 /// quaternion and angular velocity. Each body is matched to a template by
-/// its spheres (see [`super::from_file`]); `templates` and `tolerance` are
+/// its spheres (see [`crate::rigid::from_file`]); `templates` and `tolerance` are
 /// this engine's keys, the point particles' (masses, radii, units, box)
 /// are refused: a body's are its template's.
 impl Section<Clumps> for DataSpec {
