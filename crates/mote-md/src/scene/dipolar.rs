@@ -41,7 +41,7 @@ pub struct DipolarSettings {
     /// Cerdà et al. 2008 the mesh).
     pub accuracy: Option<f64>,
     /// Verlet skin of the cut-off list (default 0.3; P3M: a tenth of the
-    /// cut-off given, else 0.3 mean particle spacings).
+    /// cut-off given, else 0.3 mean particle spacings, at most a tenth of the shortest side).
     pub skin: Option<f64>,
     /// P3M: mesh points along each axis (default: tuned).
     pub mesh: Option<[usize; 3]>,

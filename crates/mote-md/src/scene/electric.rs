@@ -43,7 +43,7 @@ pub struct CoulombSettings {
     /// & Holm 1998 the mesh).
     pub accuracy: Option<f64>,
     /// P3M: the Verlet skin of the real-space list (default a tenth of the
-    /// cut-off given, else 0.3 mean particle spacings).
+    /// cut-off given, else 0.3 mean particle spacings, at most a tenth of the shortest side).
     pub skin: Option<f64>,
     /// P3M: mesh points along each axis (default: tuned).
     pub mesh: Option<[usize; 3]>,
@@ -285,8 +285,11 @@ impl P3mKeys {
             }
             (None, Some(rc)) => 0.1 * rc,
             // A tenth of the cut-off tuning is likely to choose: three
-            // particle spacings.
-            (None, None) => 0.3 * (l.element_product() / n.max(1) as f64).cbrt(),
+            // particle spacings; with few sources in the box (a spacing
+            // past the box), a tenth of the largest cut-off it allows.
+            (None, None) => {
+                (0.3 * (l.element_product() / n.max(1) as f64).cbrt()).min(0.1 * l.min_element())
+            }
         };
         if let Some(rc) = cutoff {
             if rc + skin > 0.5 * l.min_element() {
