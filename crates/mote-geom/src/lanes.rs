@@ -187,6 +187,15 @@ pub trait Lane:
     /// Lane l where lane l of `gate` is > 0, else 0 (a lane of a pair at
     /// no distance, or an empty lane, then adds nothing).
     fn where_positive(self, gate: Self) -> Self;
+    /// Lane l of `yes` where lane l of `self` is greater than lane l of
+    /// `bound`, else lane l of `no` (a NaN lane takes `no`): the lane form
+    /// of `if a > b { yes } else { no }`, a blend, never a branch.
+    fn select_above(self, bound: Self, yes: Self, no: Self) -> Self;
+    /// The larger of each lane and `x` (`f64::max` lane by lane).
+    #[inline(always)]
+    fn max(self, x: f64) -> Self {
+        self.map(|a| a.max(x))
+    }
     /// 1/√x, lane by lane, by multiplications alone ([`rsqrt`] of each
     /// lane, all in one straight loop where every lane is a positive
     /// normal number; exactly 1/√x of each lane otherwise).
@@ -225,6 +234,18 @@ macro_rules! lane_width {
             #[inline(always)]
             fn where_positive(self, gate: Self) -> Self {
                 self.zip(gate, |x, g| if g > 0.0 { x } else { 0.0 })
+            }
+            #[inline(always)]
+            fn select_above(self, bound: Self, yes: Self, no: Self) -> Self {
+                let mut out = no.0;
+                // An indexed loop over the fixed lanes, as `zip`: a blend.
+                #[allow(clippy::needless_range_loop)]
+                for l in 0..$n {
+                    if self.0[l] > bound.0[l] {
+                        out[l] = yes.0[l];
+                    }
+                }
+                $lanes(out)
             }
             #[inline(always)]
             fn rsqrt(self) -> Self {
@@ -712,5 +733,145 @@ mod tests {
     fn a_record_beyond_the_slice_is_refused() {
         let records = vec![[0.0; 4]; 20];
         gather_xyz(&records, &[0, 1, 2, 3, 20, 5, 6, 7]);
+    }
+}
+
+/// N three-vectors, one per lane: the lane form of glam's `DVec3`, each
+/// operation glam's, term for term and in its order, so a kernel written
+/// on it gives every lane the bits of the scalar code on `DVec3`.
+#[derive(Debug, Clone, Copy)]
+pub struct V3<L> {
+    pub x: L,
+    pub y: L,
+    pub z: L,
+}
+
+impl<L: Lane> V3<L> {
+    /// Lane l from `f(l)`.
+    #[inline(always)]
+    pub fn from_fn(f: impl Fn(usize) -> glam::DVec3) -> Self {
+        V3 {
+            x: L::from_fn(|l| f(l).x),
+            y: L::from_fn(|l| f(l).y),
+            z: L::from_fn(|l| f(l).z),
+        }
+    }
+
+    /// The first N vectors of `v`, one per lane.
+    #[inline(always)]
+    pub fn of(v: &[glam::DVec3]) -> Self {
+        Self::from_fn(|l| v[l])
+    }
+
+    /// Every lane `v`.
+    #[inline(always)]
+    pub fn splat(v: glam::DVec3) -> Self {
+        V3 {
+            x: L::splat(v.x),
+            y: L::splat(v.y),
+            z: L::splat(v.z),
+        }
+    }
+
+    /// Lane l.
+    #[inline(always)]
+    pub fn lane(self, l: usize) -> glam::DVec3 {
+        glam::DVec3::new(self.x.lane(l), self.y.lane(l), self.z.lane(l))
+    }
+
+    /// Into the first N entries of `out` (fewer where `out` is shorter).
+    #[inline(always)]
+    pub fn write(self, out: &mut [glam::DVec3]) {
+        for (l, o) in out.iter_mut().take(L::N).enumerate() {
+            *o = self.lane(l);
+        }
+    }
+
+    #[inline(always)]
+    #[allow(clippy::should_implement_trait)]
+    pub fn add(self, o: Self) -> Self {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+
+    #[inline(always)]
+    #[allow(clippy::should_implement_trait)]
+    pub fn sub(self, o: Self) -> Self {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+
+    /// −v (glam's `Neg`: the sign of each component flipped).
+    #[inline(always)]
+    #[allow(clippy::should_implement_trait)]
+    pub fn neg(self) -> Self {
+        V3 {
+            x: self.x.map(|a| -a),
+            y: self.y.map(|a| -a),
+            z: self.z.map(|a| -a),
+        }
+    }
+
+    /// Component by component (glam's `DVec3 * DVec3`).
+    #[inline(always)]
+    #[allow(clippy::should_implement_trait)]
+    pub fn mul(self, o: Self) -> Self {
+        V3 {
+            x: self.x * o.x,
+            y: self.y * o.y,
+            z: self.z * o.z,
+        }
+    }
+
+    /// Each component times `s` (glam's `DVec3 * f64`).
+    #[inline(always)]
+    pub fn scale(self, s: L) -> Self {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+
+    /// Each component over `s` (glam's `DVec3 / f64`: three divisions).
+    #[inline(always)]
+    pub fn over(self, s: L) -> Self {
+        V3 {
+            x: self.x / s,
+            y: self.y / s,
+            z: self.z / s,
+        }
+    }
+
+    /// (x·x' + y·y') + z·z', glam's order.
+    #[inline(always)]
+    pub fn dot(self, o: Self) -> L {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// glam's `cross`, term for term.
+    #[inline(always)]
+    pub fn cross(self, o: Self) -> Self {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
+    /// Lane l of `yes` where lane l of `a` > lane l of `b`, else of `no`.
+    #[inline(always)]
+    pub fn select_above(a: L, b: L, yes: Self, no: Self) -> Self {
+        V3 {
+            x: a.select_above(b, yes.x, no.x),
+            y: a.select_above(b, yes.y, no.y),
+            z: a.select_above(b, yes.z, no.z),
+        }
     }
 }

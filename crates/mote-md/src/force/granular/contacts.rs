@@ -14,6 +14,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::batch::{ContactBatch, Spheres};
 use super::history::{block_firsts, split_blocks};
 use super::law::{ContactLaw, History};
 use super::pairs::{ContactPairs, GHOST};
@@ -21,6 +22,9 @@ use crate::boundary::Boundary;
 use crate::domain::Halo;
 use crate::force::{CarriedRows, HaloReach, Interaction, Spin, State, Virial};
 use crate::neighbor::VerletList;
+
+/// The most pairs a batch of the contact loop holds (its rows' pairs).
+const BATCH: usize = 256;
 
 /// Hertz–Mindlin contacts between all spheres (see [`super::law`]).
 ///
@@ -45,6 +49,8 @@ pub struct GranularContacts {
     bodies: Bodies,
     /// The list over a rank's particles and ghosts (decomposed runs).
     halo_list: VerletList,
+    /// Each block's touching pairs, kept between steps for their memory.
+    batches: Vec<ContactBatch>,
     contacts: usize,
     virial: Virial,
 }
@@ -160,6 +166,7 @@ impl GranularContacts {
             inbox: Vec::new(),
             bodies: Bodies::default(),
             halo_list: VerletList::half(2.0 * r_max, skin),
+            batches: Vec::new(),
             contacts: 0,
             virial: Virial::default(),
         }
@@ -312,33 +319,47 @@ impl GranularContacts {
         let image = state.boundary.image();
         let (law, dt) = (&self.law, state.step.dt);
         let blocks = split_blocks(&mut history, &mut touching, &pairs.start, &firsts);
+        self.batches
+            .resize_with(blocks.len(), ContactBatch::default);
         let sums: Vec<(usize, Virial)> = blocks
             .into_par_iter()
             .zip(row_sums)
+            .zip(self.batches.par_iter_mut())
             .enumerate()
-            .map(|(block, ((history, touching), row_sum))| {
+            .map(|(block, (((history, touching), row_sum), batch))| {
                 let (first, base) = (firsts[block], pairs.start[firsts[block]] as usize);
-                let mut count = 0usize;
-                let mut virial = Virial::default();
-                for (a, sum) in (first..).zip(row_sum.iter_mut()) {
-                    let (mut f, mut t) = (DVec3::ZERO, DVec3::ZERO);
-                    let (xa, va, wa, ra, ma) = (
-                        at.position[a],
-                        at.velocity[a],
-                        at.spin[a],
-                        at.radius[a],
-                        at.mass[a],
-                    );
-                    let counts = pairs.counts(a);
-                    for s in pairs.start[a] as usize..pairs.start[a + 1] as usize {
-                        let (k, b) = (s - base, pairs.partner[s] as usize);
-                        let d = image.apply(xa - at.position[b]);
-                        let rb = at.radius[b];
-                        let reach = ra + rb;
-                        let r2 = d.length_squared();
-                        if r2 >= reach * reach {
-                            if touching[k] {
-                                touching[k] = false;
+                let spheres = Spheres {
+                    velocity: at.velocity,
+                    spin: at.spin,
+                    radius: at.radius,
+                    mass: at.mass,
+                };
+                let (mut count, mut virial) = (0usize, Virial::default());
+                let end = first + row_sum.len();
+                // Runs of rows with at most BATCH pairs (or one row), so
+                // that a batch stays in the first-level cache from the
+                // filter through the law to the sums.
+                let mut rows = first..first;
+                while rows.end < end {
+                    rows.start = rows.end;
+                    rows.end += 1;
+                    let from = pairs.start[rows.start] as usize;
+                    while rows.end < end && pairs.start[rows.end + 1] as usize - from <= BATCH {
+                        rows.end += 1;
+                    }
+                    // The touching pairs, in list order; the others'
+                    // histories cleared where they had touched.
+                    batch.clear(pairs.start[rows.end] as usize - from);
+                    for a in rows.clone() {
+                        let (xa, ra) = (at.position[a], at.radius[a]);
+                        for s in pairs.start[a] as usize..pairs.start[a + 1] as usize {
+                            let (k, b) = (s - base, pairs.partner[s] as usize);
+                            let d = image.apply(xa - at.position[b]);
+                            let reach = ra + at.radius[b];
+                            let r2 = d.length_squared();
+                            let now = r2 < reach * reach;
+                            batch.push_if(now, a, b, s, d, r2);
+                            if touching[k] & !now {
                                 history[k] = History::default();
                                 let slot = pairs.inbox_slot[s];
                                 if slot != GHOST {
@@ -346,44 +367,37 @@ impl GranularContacts {
                                     unsafe { inbox.put(slot as usize, (DVec3::ZERO, DVec3::ZERO)) };
                                 }
                             }
-                            continue;
-                        }
-                        touching[k] = true;
-                        let r = r2.sqrt();
-                        let nrm = d / r;
-                        let delta = reach - r;
-                        let (arm_a, arm_b) = (ra - 0.5 * delta, rb - 0.5 * delta);
-                        let wb = at.spin[b];
-                        let v_rel = va - at.velocity[b] - (wa * arm_a + wb * arm_b).cross(nrm);
-                        let mb = at.mass[b];
-                        let c = law.force(
-                            delta,
-                            nrm,
-                            v_rel,
-                            wa - wb,
-                            arm_a,
-                            arm_b,
-                            ra * rb / reach,
-                            ma * mb / (ma + mb),
-                            dt,
-                            &mut history[k],
-                        );
-                        f += c.force;
-                        t += c.torque_i;
-                        let slot = pairs.inbox_slot[s];
-                        if slot != GHOST {
-                            // SAFETY: each pair has its own slot (a
-                            // pair's place in its partner's inbox), so no
-                            // two writes meet, and the slot is within the
-                            // inbox, sized for every slot.
-                            unsafe { inbox.put(slot as usize, (-c.force, c.torque_j)) };
-                        }
-                        if counts {
-                            count += 1;
-                            virial += Virial::pair(d, c.force);
+                            touching[k] = now;
                         }
                     }
-                    *sum = (f, t);
+                    batch.evaluate(law, spheres, dt, history, base);
+                    // Each row's contacts summed in list order.
+                    let mut c = 0;
+                    for a in rows.clone() {
+                        let (mut f, mut t) = (DVec3::ZERO, DVec3::ZERO);
+                        let counts = pairs.counts(a);
+                        while c < batch.len() && batch.ends[c][0] as usize == a {
+                            let (contact, s) = (batch.force[c], batch.entry[c] as usize);
+                            f += contact.force;
+                            t += contact.torque_i;
+                            let slot = pairs.inbox_slot[s];
+                            if slot != GHOST {
+                                // SAFETY: each pair has its own slot (a
+                                // pair's place in its partner's inbox), so
+                                // no two writes meet, and the slot is
+                                // within the inbox, sized for every slot.
+                                unsafe {
+                                    inbox.put(slot as usize, (-contact.force, contact.torque_j))
+                                };
+                            }
+                            if counts {
+                                count += 1;
+                                virial += Virial::pair(batch.separation[c], contact.force);
+                            }
+                            c += 1;
+                        }
+                        row_sum[a - first] = (f, t);
+                    }
                 }
                 (count, virial)
             })

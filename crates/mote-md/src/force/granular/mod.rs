@@ -4,6 +4,7 @@
 //! ([`GranularWalls`]). Physics: seed 000 (Hertz contacts, damping,
 //! friction, adhesion, walls).
 
+pub mod batch;
 pub mod contacts;
 pub mod history;
 pub mod law;
