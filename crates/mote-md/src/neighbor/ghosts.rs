@@ -490,7 +490,7 @@ struct Copy {
 /// `x.len()`. Branch-free: AVX-512 compresses eight indices at a time where
 /// the CPU has it; else an index is written, then kept or not.
 #[inline]
-fn within(
+pub(crate) fn within(
     at: (f64, f64, f64),
     reach2: f64,
     (x, y, z): (&[f64], &[f64], &[f64]),

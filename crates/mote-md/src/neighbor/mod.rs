@@ -118,7 +118,13 @@ impl VerletList {
 
     /// Builds the list from scratch: blocks of particles in parallel, each
     /// filling its rows into one buffer (no allocation per particle),
-    /// every row's partners sorted, the blocks joined in order.
+    /// every row's partners sorted, the blocks joined in order. The
+    /// distances are tested eight at a time over the runs of cells around
+    /// each particle ([`ghosts::within`]: AVX-512 compression, or
+    /// [`Lanes`](mote_geom::lanes::Lanes)), each run shifted by its
+    /// periodic image; a periodic axis of fewer than three cells, where
+    /// one cell holds several images of a particle, takes the minimum
+    /// image pair by pair.
     pub fn build(&mut self, pos: &[DVec3], boundary: &Boundary) {
         const BLOCK: usize = 512;
         let reach = self.cutoff + self.skin;
@@ -128,24 +134,56 @@ impl VerletList {
         let half = self.half;
         let groups = &self.groups;
         let grouped = !groups.is_empty();
+        let wanted = |i: usize, j: usize| {
+            (if half { j > i } else { j != i }) && !(grouped && groups[i] == groups[j])
+        };
+        let shifted = cells.runs_are_images();
         let blocks: Vec<(Vec<u32>, Vec<u32>)> = (0..pos.len().div_ceil(BLOCK))
             .into_par_iter()
             .map(|b| {
                 let rows = b * BLOCK..((b + 1) * BLOCK).min(pos.len());
                 let mut lengths = Vec::with_capacity(rows.len());
                 let mut near: Vec<u32> = Vec::new();
+                // The places a run keeps, in cell order (kept between runs:
+                // no zeroing per run).
+                let mut kept_at: Vec<u32> = Vec::new();
                 for i in rows {
                     let row = near.len();
                     let ri = pos[i];
-                    cells.for_each_run(ri, |js, rs| {
-                        for (&j, &rj) in js.iter().zip(rs) {
-                            let wanted = (if half { j > i } else { j != i })
-                                && !(grouped && groups[i] == groups[j]);
-                            if wanted && image.apply(rj - ri).length_squared() < reach2 {
-                                near.push(j as u32);
+                    if shifted {
+                        let ri = boundary.wrap(ri);
+                        cells.for_each_image_run(ri, |from, to, shift| {
+                            if kept_at.len() < to - from + 8 {
+                                kept_at.resize(to - from + 8, 0);
                             }
-                        }
-                    });
+                            let at = ri - shift;
+                            let kept = ghosts::within(
+                                (at.x, at.y, at.z),
+                                reach2,
+                                (&cells.x[from..to], &cells.y[from..to], &cells.z[from..to]),
+                                from,
+                                usize::MAX,
+                                &mut kept_at,
+                            );
+                            // The kept places → particles, those the list
+                            // wants.
+                            near.extend(
+                                kept_at[..kept]
+                                    .iter()
+                                    .map(|&m| cells.order[m as usize])
+                                    .filter(|&j| wanted(i, j))
+                                    .map(|j| j as u32),
+                            );
+                        });
+                    } else {
+                        cells.for_each_run(ri, |js, rs| {
+                            for (&j, &rj) in js.iter().zip(rs) {
+                                if wanted(i, j) && image.apply(rj - ri).length_squared() < reach2 {
+                                    near.push(j as u32);
+                                }
+                            }
+                        });
+                    }
                     near[row..].sort_unstable();
                     lengths.push((near.len() - row) as u32);
                 }
@@ -181,6 +219,13 @@ pub struct CellGrid {
     first: Vec<usize>,
     /// The positions in that order, so that a scan reads them in a row.
     sorted: Vec<DVec3>,
+    /// Their coordinates wrapped into the box, one array each (for tests
+    /// eight at a time).
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    /// The box's edges (periodic axes; zero on open ones).
+    length: DVec3,
 }
 
 impl CellGrid {
@@ -229,6 +274,14 @@ impl CellGrid {
             order: Vec::new(),
             first: Vec::new(),
             sorted: Vec::new(),
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            length: DVec3::select(
+                glam::BVec3::from(boundary.periodic),
+                boundary.hi - boundary.lo,
+                DVec3::ZERO,
+            ),
         };
         let ncell = dims[0] * dims[1] * dims[2];
         let cell_of: Vec<usize> = pos
@@ -249,6 +302,11 @@ impl CellGrid {
             fill[c] += 1;
         }
         grid.sorted = order.iter().map(|&i| pos[i]).collect();
+        // Wrapped into the box, where the cells put them.
+        let wrapped: Vec<DVec3> = grid.sorted.iter().map(|r| boundary.wrap(*r)).collect();
+        grid.x = wrapped.iter().map(|r| r.x).collect();
+        grid.y = wrapped.iter().map(|r| r.y).collect();
+        grid.z = wrapped.iter().map(|r| r.z).collect();
         grid.order = order;
         grid.first = count;
         grid
@@ -276,6 +334,71 @@ impl CellGrid {
     /// Calls `f(j)` for every particle in the cells around position r.
     pub fn for_each_candidate(&self, r: DVec3, mut f: impl FnMut(usize)) {
         self.for_each_run(r, |js, _| js.iter().for_each(|&j| f(j)));
+    }
+
+    /// Whether each cell around a position is one periodic image of it at
+    /// most: every periodic axis has three cells or more (with fewer, a
+    /// cell holds two images of a particle, and only the minimum image
+    /// pair by pair tells them apart).
+    pub fn runs_are_images(&self) -> bool {
+        (0..3).all(|k| !self.periodic[k] || self.dims[k] >= 3)
+    }
+
+    /// Calls `f(from, to, shift)` for runs `from..to` of the cell order
+    /// (the particles `order[from..to]`, wrapped at `x`, `y`, `z[from..to]`)
+    /// in the cells around position r (wrapped), each with the shift of
+    /// its periodic image: the image of a particle at r_j of the run
+    /// nearest r is r_j + shift. Needs [`CellGrid::runs_are_images`].
+    pub fn for_each_image_run(&self, r: DVec3, mut f: impl FnMut(usize, usize, DVec3)) {
+        let c = self.coords(r);
+        // Along each axis the (at most three) distinct cells and the
+        // image shift of each: −L below the first cell of a periodic
+        // axis, +L above its last.
+        let range = |k: usize| -> ([isize; 3], [f64; 3], usize) {
+            let d = self.dims[k] as isize;
+            let l = self.length[k];
+            if d == 1 {
+                ([0; 3], [0.0; 3], 1)
+            } else if self.periodic[k] {
+                let below = if c[k] == 0 {
+                    (d - 1, -l)
+                } else {
+                    (c[k] - 1, 0.0)
+                };
+                let above = if c[k] == d - 1 {
+                    (0, l)
+                } else {
+                    (c[k] + 1, 0.0)
+                };
+                ([below.0, c[k], above.0], [below.1, 0.0, above.1], 3)
+            } else {
+                let (a, b) = ((c[k] - 1).max(0), (c[k] + 1).min(d - 1));
+                ([a, a + 1, a + 2], [0.0; 3], (b - a + 1) as usize)
+            }
+        };
+        let (xs, ys, zs) = (range(0), range(1), range(2));
+        let cells_x = &xs.0[..xs.2];
+        // x-cells in increasing order without a wrap: one run of memory.
+        let run = cells_x.windows(2).all(|w| w[1] == w[0] + 1);
+        for (&z, &shift_z) in zs.0[..zs.2].iter().zip(&zs.1) {
+            for (&y, &shift_y) in ys.0[..ys.2].iter().zip(&ys.1) {
+                let mut visit = |from: usize, to: usize, shift_x: f64| {
+                    if to > from {
+                        f(from, to, DVec3::new(shift_x, shift_y, shift_z));
+                    }
+                };
+                if run {
+                    let first = self.cell_index([cells_x[0], y, z]);
+                    let last = self.cell_index([cells_x[cells_x.len() - 1], y, z]);
+                    visit(self.first[first], self.first[last + 1], 0.0);
+                } else {
+                    for (&x, &shift_x) in cells_x.iter().zip(&xs.1) {
+                        let cell = self.cell_index([x, y, z]);
+                        visit(self.first[cell], self.first[cell + 1], shift_x);
+                    }
+                }
+            }
+        }
     }
 
     /// Calls `f(js, rs)` for runs of the particles in the cells around
@@ -364,5 +487,83 @@ mod tests {
         grouped.set_groups(&vec![0; 300]);
         assert!(grouped.update(&pos, &boundary));
         assert_eq!((grouped.builds, grouped.neighbors.len()), (builds + 1, 0));
+    }
+
+    /// Every list, built eight distances at a time over runs shifted by
+    /// their periodic images, holds exactly the pairs within reach by the
+    /// minimum image (pair by pair, all pairs), in boxes periodic on every
+    /// axis, on some, on none, and with a periodic axis too short for
+    /// three cells (the pair-by-pair path); positions slightly outside a
+    /// periodic box are found too.
+    #[test]
+    fn lists_hold_exactly_the_pairs_within_reach() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(3);
+        let (lo, hi) = (DVec3::new(-1.0, 0.0, 2.0), DVec3::new(7.0, 5.0, 8.5));
+        for periodic in [
+            [true; 3],
+            [true, true, false],
+            [false; 3],
+            [false, true, true],
+        ] {
+            for short in [false, true] {
+                let mut hi = hi;
+                if short {
+                    // Two cells along y: a cell holds two images.
+                    hi.y = lo.y + 2.5;
+                }
+                let boundary = Boundary {
+                    periodic,
+                    ..Boundary::periodic(lo, hi)
+                };
+                let pos: Vec<DVec3> = (0..700)
+                    .map(|_| {
+                        let u = DVec3::new(rng.gen(), rng.gen(), rng.gen());
+                        // A few a hair outside the box.
+                        lo + (hi - lo) * (u * 1.0002 - 0.0001)
+                    })
+                    .collect();
+                let image = boundary.image();
+                for half in [true, false] {
+                    let mut list = if half {
+                        VerletList::half(0.9, 0.2)
+                    } else {
+                        VerletList::new(0.9, 0.2)
+                    };
+                    list.build(&pos, &boundary);
+                    let reach2 = 1.1f64 * 1.1;
+                    for i in 0..pos.len() {
+                        let want: Vec<u32> = (0..pos.len())
+                            .filter(|&j| if half { j > i } else { j != i })
+                            .filter(|&j| {
+                                let d = boundary.minimum_image(pos[j] - pos[i]);
+                                d.length_squared() < reach2
+                            })
+                            .map(|j| j as u32)
+                            .collect();
+                        let got = list.of(i);
+                        // Only a pair at the reach to round-off may differ.
+                        let at_edge = |j: &u32| {
+                            let d = image.apply(pos[*j as usize] - pos[i]).length_squared();
+                            (d - reach2).abs() < 1e-12
+                        };
+                        let missing: Vec<_> = want
+                            .iter()
+                            .filter(|j| !got.contains(j) && !at_edge(j))
+                            .collect();
+                        let extra: Vec<_> = got
+                            .iter()
+                            .filter(|j| !want.contains(j) && !at_edge(j))
+                            .collect();
+                        assert!(
+                            missing.is_empty() && extra.is_empty(),
+                            "{periodic:?} short {short} half {half} row {i}: missing {missing:?}, extra {extra:?}"
+                        );
+                        assert!(got.windows(2).all(|w| w[0] < w[1]), "rows sorted");
+                    }
+                    assert!(list.neighbors.len() > pos.len(), "{}", list.neighbors.len());
+                }
+            }
+        }
     }
 }

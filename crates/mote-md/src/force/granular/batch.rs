@@ -173,6 +173,115 @@ impl ContactBatch {
     }
 }
 
+/// Contacts whose geometry is formed where they are found (a sphere
+/// against a wall): the law's inputs, one entry each, in the order found.
+#[derive(Debug, Clone, Default)]
+pub struct FormedContacts {
+    /// Each contact's history, `history[slot]` of the caller's store.
+    pub slot: Vec<u32>,
+    pub delta: Vec<f64>,
+    pub normal: Vec<DVec3>,
+    pub v_rel: Vec<DVec3>,
+    pub w_rel: Vec<DVec3>,
+    pub arm: Vec<[f64; 2]>,
+    pub r_eff: Vec<f64>,
+    pub m_eff: Vec<f64>,
+    /// What the law gave each, after [`FormedContacts::evaluate`].
+    pub force: Vec<ContactForce>,
+}
+
+impl FormedContacts {
+    pub fn clear(&mut self) {
+        self.slot.clear();
+        self.delta.clear();
+        self.normal.clear();
+        self.v_rel.clear();
+        self.w_rel.clear();
+        self.arm.clear();
+        self.r_eff.clear();
+        self.m_eff.clear();
+        self.force.clear();
+    }
+
+    pub fn len(&self) -> usize {
+        self.slot.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.slot.is_empty()
+    }
+
+    /// Adds a contact: the arguments of [`ContactLaw::force`], its
+    /// history at `slot`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(
+        &mut self,
+        slot: usize,
+        delta: f64,
+        normal: DVec3,
+        v_rel: DVec3,
+        w_rel: DVec3,
+        arm: [f64; 2],
+        r_eff: f64,
+        m_eff: f64,
+    ) {
+        self.slot.push(slot as u32);
+        self.delta.push(delta);
+        self.normal.push(normal);
+        self.v_rel.push(v_rel);
+        self.w_rel.push(w_rel);
+        self.arm.push(arm);
+        self.r_eff.push(r_eff);
+        self.m_eff.push(m_eff);
+    }
+
+    /// The law for every contact, four at a time ([`force_lanes`], the
+    /// scalar law's bits): fills `force`, advances `history[slot]`.
+    pub fn evaluate(&mut self, law: &ContactLaw, dt: f64, history: &mut [History]) {
+        let n = self.len();
+        self.force.resize(n, ContactForce::default());
+        let mut first = 0;
+        while first < n {
+            let live = (n - first).min(Four::N);
+            let at = |l: usize| first + l.min(live - 1);
+            let scalar = |v: &[f64]| Four::from_fn(|l| v[at(l)]);
+            let vector = |v: &[DVec3]| V3::<Four>::from_fn(|l| v[at(l)]);
+            let slot = |l: usize| self.slot[at(l)] as usize;
+            let mut h = HistoryLanes {
+                shear: V3::from_fn(|l| history[slot(l)].shear),
+                roll: V3::from_fn(|l| history[slot(l)].roll),
+            };
+            let c = force_lanes(
+                law,
+                scalar(&self.delta),
+                vector(&self.normal),
+                vector(&self.v_rel),
+                vector(&self.w_rel),
+                [
+                    Four::from_fn(|l| self.arm[at(l)][0]),
+                    Four::from_fn(|l| self.arm[at(l)][1]),
+                ],
+                scalar(&self.r_eff),
+                scalar(&self.m_eff),
+                dt,
+                &mut h,
+            );
+            for l in 0..live {
+                history[slot(l)] = History {
+                    shear: h.shear.lane(l),
+                    roll: h.roll.lane(l),
+                };
+                self.force[first + l] = ContactForce {
+                    force: c.force.lane(l),
+                    torque_i: c.torque_i.lane(l),
+                    torque_j: c.torque_j.lane(l),
+                };
+            }
+            first += live;
+        }
+    }
+}
+
 /// The histories of `L::N` contacts, one per lane.
 pub struct HistoryLanes<L> {
     pub shear: V3<L>,

@@ -6,6 +6,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::batch::FormedContacts;
 use super::law::{ContactLaw, History};
 use crate::force::{CarriedRows, HaloReach, Interaction, Spin, State, ViewerHooks, Virial};
 
@@ -147,6 +148,8 @@ pub struct GranularWalls {
     touching: Vec<bool>,
     /// The force the particles exert on each wall at the last evaluation.
     wall_force: Vec<DVec3>,
+    /// Each chunk's contacts at the last evaluation (kept for their memory).
+    found: Vec<FormedContacts>,
 }
 
 impl GranularWalls {
@@ -157,6 +160,7 @@ impl GranularWalls {
             history: vec![History::default(); n * walls.len()],
             touching: vec![false; n * walls.len()],
             wall_force: vec![DVec3::ZERO; walls.len()],
+            found: Vec::new(),
             walls,
         }
     }
@@ -192,14 +196,18 @@ impl GranularWalls {
             })
             .collect();
         let planes = &planes;
+        self.found
+            .resize_with(force.len().div_ceil(CHUNK), Default::default);
         let sums: Vec<Vec<DVec3>> = force
             .par_chunks_mut(CHUNK)
             .zip(torque.par_chunks_mut(CHUNK))
             .zip(self.history.par_chunks_mut(CHUNK * n_walls))
             .zip(self.touching.par_chunks_mut(CHUNK * n_walls))
+            .zip(self.found.par_iter_mut())
             .enumerate()
-            .map(|(c, (((f, tq), hist), touching))| {
-                let mut sum = vec![DVec3::ZERO; n_walls];
+            .map(|(c, ((((f, tq), hist), touching), found))| {
+                // The chunk's contacts, in order of particle then wall.
+                found.clear();
                 for k in 0..f.len() {
                     let i = c * CHUNK + k;
                     let x = state.position[i];
@@ -222,22 +230,25 @@ impl GranularWalls {
                         let delta = r - gap;
                         let arm = r - 0.5 * delta;
                         let v_rel = state.velocity[i] - v_wall - (omega[i] * arm).cross(n);
-                        let cf = law.force(
+                        found.push(
+                            slot,
                             delta,
                             n,
                             v_rel,
                             omega[i],
-                            arm,
-                            0.0,
+                            [arm, 0.0],
                             r,
                             state.mass[i],
-                            dt,
-                            &mut hist[slot],
                         );
-                        f[k] += cf.force;
-                        tq[k] += cf.torque_i;
-                        sum[w] -= cf.force;
                     }
+                }
+                found.evaluate(&law, dt, hist);
+                let mut sum = vec![DVec3::ZERO; n_walls];
+                for (&slot, cf) in found.slot.iter().zip(&found.force) {
+                    let (k, w) = (slot as usize / n_walls, slot as usize % n_walls);
+                    f[k] += cf.force;
+                    tq[k] += cf.torque_i;
+                    sum[w] -= cf.force;
                 }
                 sum
             })
