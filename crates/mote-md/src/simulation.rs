@@ -103,8 +103,8 @@ impl Simulation {
             Ok(reach) => reach,
             Err(names) => {
                 return not_yet(&format!(
-                    "{} (Lennard-Jones/WCA, cut-off dipoles, granular contacts and walls, \
-                     applied and uniform fields and damping do)",
+                    "{} (Lennard-Jones/WCA, cut-off dipoles, Coulomb and dipoles by Ewald or \
+                     P3M, granular contacts and walls, applied and uniform fields and damping do)",
                     names.join(", ")
                 ))
             }

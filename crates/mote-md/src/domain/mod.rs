@@ -865,3 +865,37 @@ fn unpack(sys: &mut System, row: &[f64], species: &[String]) -> u64 {
     }
     row[0] as u64
 }
+
+/// Every particle's K numbers in id order, at every rank: this rank's
+/// (`own`, in its particles' order) with the halo's ids go to rank 0,
+/// which places them and sends the whole back. A sum over every particle
+/// (a mesh, a structure factor) made from them is made from the same
+/// numbers in the same order as one process makes it, so its bits do not
+/// depend on the ranks (positions are the ranks' own, unwrapped, as one
+/// process holds them). The long-range solvers' way to the whole system:
+/// P3M's meshes, the Ewald sums.
+pub fn gathered<const K: usize>(
+    own: impl Iterator<Item = [f64; K]>,
+    halo: &Halo,
+    comm: &dyn Comm,
+    total: usize,
+) -> Vec<[f64; K]> {
+    let mut send = Vec::with_capacity((K + 1) * halo.id.len());
+    for (id, values) in halo.id.iter().zip(own) {
+        send.push(*id as f64);
+        send.extend(values);
+    }
+    let parts = comm.gather(&send);
+    let mut placed = Vec::new();
+    if comm.rank() == 0 {
+        placed = vec![0.0; K * total];
+        for record in parts.iter().flat_map(|p| p.chunks_exact(K + 1)) {
+            let id = record[0] as usize;
+            placed[K * id..K * (id + 1)].copy_from_slice(&record[1..]);
+        }
+    }
+    comm.broadcast(&placed)
+        .chunks_exact(K)
+        .map(|c| std::array::from_fn(|k| c[k]))
+        .collect()
+}

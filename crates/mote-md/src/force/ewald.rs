@@ -41,7 +41,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{Interaction, Spin, State, Virial};
+use super::{HaloReach, Interaction, Spin, State, Virial};
 
 /// erfc of musl/fdlibm (relative error below 1e-15 on the whole line), the
 /// one erfc of the workspace; about 30× faster than the series and continued
@@ -329,14 +329,32 @@ impl Ewald {
 
     /// Energy of point charges; forces are added to `force` if given.
     pub fn charges(&self, position: &[DVec3], charge: &[f64], force: Option<&mut [DVec3]>) -> f64 {
-        let n = position.len();
+        self.charges_of(position, charge, Share::Whole, force)
+    }
+
+    /// [`Ewald::charges`] for `share` of the particles: the forces of its
+    /// rows (`force[p]` for row p) and its part of the energy — the real
+    /// space of its rows (each pair half at each end) and their self
+    /// energy, with the reciprocal-space energy and the neutralising
+    /// background where it counts the whole system. The structure factors
+    /// are summed over every particle in index order, so each row's force
+    /// has one process's bits.
+    pub fn charges_of(
+        &self,
+        position: &[DVec3],
+        charge: &[f64],
+        share: Share,
+        force: Option<&mut [DVec3]>,
+    ) -> f64 {
         let (alpha, rc2) = (self.alpha, self.r_cut * self.r_cut);
         let near = RealSpace::new(self, position);
         let v = self.volume();
+        let rows = share.rows(position.len());
         // Real space, parallel over i, each pair seen from both ends.
-        let real: Vec<(f64, DVec3)> = (0..n)
+        let real: Vec<(f64, DVec3)> = (0..rows.len())
             .into_par_iter()
-            .map(|i| {
+            .map(|p| {
+                let i = rows.at(p);
                 let mut u = 0.0;
                 let mut f = DVec3::ZERO;
                 near.visit(self, position, i, |j, r, r2| {
@@ -361,20 +379,26 @@ impl Ewald {
             u_k += a * (s.0 * s.0 + s.1 * s.1);
         }
         u_k *= 4.0 * std::f64::consts::PI / v;
-        let q2: f64 = charge.iter().map(|q| q * q).sum();
-        let q_total: f64 = charge.iter().sum();
+        let q2: f64 = (0..rows.len())
+            .map(|p| charge[rows.at(p)] * charge[rows.at(p)])
+            .sum();
+        let (u_k, q_total) = match share.counts_the_whole() {
+            true => (u_k, charge.iter().sum()),
+            false => (0.0, 0.0),
+        };
         let u_self = -alpha / SQRT_PI * q2
             - std::f64::consts::PI * q_total * q_total / (2.0 * v * alpha * alpha);
         if let Some(force) = force {
             let (m, w) = (self.table_max(), (2 * self.table_max() + 1) as usize);
             let damp: Vec<(f64, DVec3)> = kv.iter().map(|nk| self.damping(nk)).collect();
-            force.par_iter_mut().enumerate().for_each(|(i, fi)| {
+            force.par_iter_mut().enumerate().for_each(|(p, fi)| {
+                let i = rows.at(p);
                 let mut f = DVec3::ZERO;
                 each_phase(&ks.phases, i, w, m, &kv, |idx, c, sn| {
                     let (s, (a, k)) = (ks.structure[idx], damp[idx]);
                     f += k * (a * (sn * s.0 - c * s.1));
                 });
-                *fi += real[i].1 + f * (8.0 * std::f64::consts::PI * charge[i] / v);
+                *fi += real[p].1 + f * (8.0 * std::f64::consts::PI * charge[i] / v);
             });
         }
         real.iter().map(|r| r.0).sum::<f64>() + u_k + u_self
@@ -431,15 +455,30 @@ impl Ewald {
         force: &mut [DVec3],
         field: &mut [DVec3],
     ) -> f64 {
-        let n = position.len();
+        self.dipoles_of(position, dipole, Share::Whole, force, field)
+    }
+
+    /// [`Ewald::dipoles`] for `share` of the particles, as
+    /// [`Ewald::charges_of`]: its rows' forces and fields (`force[p]`,
+    /// `field[p]` for row p), its part of the energy.
+    pub fn dipoles_of(
+        &self,
+        position: &[DVec3],
+        dipole: &[DVec3],
+        share: Share,
+        force: &mut [DVec3],
+        field: &mut [DVec3],
+    ) -> f64 {
         let (alpha, rc2) = (self.alpha, self.r_cut * self.r_cut);
         let a2 = alpha * alpha;
         let near = RealSpace::new(self, position);
         let v = self.volume();
         let pi = std::f64::consts::PI;
-        let real: Vec<(f64, DVec3, DVec3)> = (0..n)
+        let rows = share.rows(position.len());
+        let real: Vec<(f64, DVec3, DVec3)> = (0..rows.len())
             .into_par_iter()
-            .map(|i| {
+            .map(|p| {
+                let i = rows.at(p);
                 let (mut u, mut f, mut h) = (0.0, DVec3::ZERO, DVec3::ZERO);
                 let mi = dipole[i];
                 near.visit(self, position, i, |j, r, r2| {
@@ -470,7 +509,12 @@ impl Ewald {
             u_k += a * (s.0 * s.0 + s.1 * s.1);
         }
         u_k *= 4.0 * pi / v;
-        let m2: f64 = dipole.iter().map(|m| m.length_squared()).sum();
+        if !share.counts_the_whole() {
+            u_k = 0.0;
+        }
+        let m2: f64 = (0..rows.len())
+            .map(|p| dipole[rows.at(p)].length_squared())
+            .sum();
         let self_coeff = 2.0 * alpha * a2 / (3.0 * SQRT_PI);
         let u_self = -self_coeff * m2;
         let (m, w) = (self.table_max(), (2 * self.table_max() + 1) as usize);
@@ -478,17 +522,74 @@ impl Ewald {
             .par_iter_mut()
             .zip(field.par_iter_mut())
             .enumerate()
-            .for_each(|(i, (fi, hi))| {
+            .for_each(|(p, (fi, hi))| {
+                let i = rows.at(p);
                 let (mut f, mut h) = (DVec3::ZERO, DVec3::ZERO);
                 each_phase(&ks.phases, i, w, m, &kv, |idx, c, sn| {
                     let (s, (a, k)) = (ks.structure[idx], damp[idx]);
                     f += k * (a * dipole[i].dot(k) * (sn * s.0 - c * s.1));
                     h -= k * (a * (c * s.0 + sn * s.1));
                 });
-                *fi += real[i].1 + f * (8.0 * pi / v);
-                *hi += real[i].2 + h * (8.0 * pi / v) + dipole[i] * (2.0 * self_coeff);
+                *fi += real[p].1 + f * (8.0 * pi / v);
+                *hi += real[p].2 + h * (8.0 * pi / v) + dipole[i] * (2.0 * self_coeff);
             });
         real.iter().map(|r| r.0).sum::<f64>() + u_k + u_self
+    }
+}
+
+/// Which particles an Ewald evaluation is for: all (one process), or a
+/// rank's (their indices in the whole system, gathered to every rank in
+/// id order by [`crate::domain::gathered`]), one of which counts the
+/// whole system's terms.
+#[derive(Debug, Clone, Copy)]
+pub enum Share<'a> {
+    Whole,
+    Rows {
+        rows: &'a [usize],
+        counts_the_whole: bool,
+    },
+}
+
+impl<'a> Share<'a> {
+    fn rows(self, n: usize) -> Rows<'a> {
+        match self {
+            Share::Whole => Rows::All(n),
+            Share::Rows { rows, .. } => Rows::Some(rows),
+        }
+    }
+
+    fn counts_the_whole(self) -> bool {
+        match self {
+            Share::Whole => true,
+            Share::Rows {
+                counts_the_whole, ..
+            } => counts_the_whole,
+        }
+    }
+}
+
+/// The rows of an evaluation: 0..n, or the listed particles.
+#[derive(Clone, Copy)]
+enum Rows<'a> {
+    All(usize),
+    Some(&'a [usize]),
+}
+
+impl Rows<'_> {
+    fn len(self) -> usize {
+        match self {
+            Rows::All(n) => n,
+            Rows::Some(rows) => rows.len(),
+        }
+    }
+
+    /// The particle of row p.
+    #[inline]
+    fn at(self, p: usize) -> usize {
+        match self {
+            Rows::All(_) => p,
+            Rows::Some(rows) => rows[p],
+        }
     }
 }
 
@@ -676,9 +777,7 @@ impl Interaction for EwaldCoulomb {
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let mut f = vec![DVec3::ZERO; force.len()];
-        let u = self
-            .ewald
-            .charges(state.position, state.charges(), Some(&mut f));
+        let u = self.evaluate(state, Some(&mut f));
         self.last_energy = self.k * u;
         for (a, b) in force.iter_mut().zip(&f) {
             *a += *b * self.k;
@@ -686,7 +785,15 @@ impl Interaction for EwaldCoulomb {
     }
 
     fn potential_energy(&mut self, state: &State) -> f64 {
-        self.k * self.ewald.charges(state.position, state.charges(), None)
+        self.k * self.evaluate(state, None)
+    }
+
+    /// Decomposed over ranks: every rank gathers every particle's position
+    /// and charge in id order and sums the structure factors over them as
+    /// one process does, then the real space and forces of its own
+    /// particles; no ghosts.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        Some(HaloReach::NONE)
     }
 
     /// W = U: the tin-foil Ewald energy of charges is homogeneous of degree
@@ -698,10 +805,95 @@ impl Interaction for EwaldCoulomb {
     }
 
     fn virial_tensor(&mut self, state: &State) -> Option<Virial> {
-        Some(
-            self.ewald
-                .charges_virial(state.position, state.charges())
-                .scaled(self.k),
+        let whole = Whole::charges(state);
+        let w = match whole.counts_the_whole() {
+            true => self.ewald.charges_virial(&whole.position, &whole.value),
+            false => Virial::default(),
+        };
+        Some(w.scaled(self.k))
+    }
+}
+
+impl EwaldCoulomb {
+    /// The energy of this evaluation's share (Gaussian units), the forces
+    /// of its particles into `force`.
+    fn evaluate(&self, state: &State, force: Option<&mut [DVec3]>) -> f64 {
+        let whole = Whole::charges(state);
+        self.ewald
+            .charges_of(&whole.position, &whole.value, whole.share(), force)
+    }
+}
+
+/// Every particle's position and one property in id order, as an Ewald sum
+/// reads them: the state's in one process, gathered to every rank
+/// ([`crate::domain::gathered`]) in a decomposed run, with the rows of
+/// this rank's particles.
+struct Whole<T> {
+    position: Vec<DVec3>,
+    value: Vec<T>,
+    rows: Option<(Vec<usize>, bool)>,
+}
+
+impl<T: Copy> Whole<T> {
+    fn of<const K: usize>(
+        state: &State,
+        own: &[T],
+        pack: impl Fn(DVec3, T) -> [f64; K],
+        unpack: impl Fn(&[f64; K]) -> T,
+    ) -> Self {
+        match (state.halo, state.comm) {
+            (Some(halo), Some(comm)) => {
+                let all = crate::domain::gathered(
+                    state.position.iter().zip(own).map(|(r, v)| pack(*r, *v)),
+                    halo,
+                    comm,
+                    halo.total,
+                );
+                Whole {
+                    position: all.iter().map(|a| DVec3::new(a[0], a[1], a[2])).collect(),
+                    value: all.iter().map(unpack).collect(),
+                    rows: Some((
+                        halo.id.iter().map(|&id| id as usize).collect(),
+                        comm.rank() == 0,
+                    )),
+                }
+            }
+            _ => Whole {
+                position: state.position.to_vec(),
+                value: own.to_vec(),
+                rows: None,
+            },
+        }
+    }
+
+    fn share(&self) -> Share<'_> {
+        match &self.rows {
+            None => Share::Whole,
+            Some((rows, counts_the_whole)) => Share::Rows {
+                rows,
+                counts_the_whole: *counts_the_whole,
+            },
+        }
+    }
+
+    fn counts_the_whole(&self) -> bool {
+        self.share().counts_the_whole()
+    }
+}
+
+impl Whole<f64> {
+    fn charges(state: &State) -> Self {
+        Self::of(state, state.charges(), |r, q| [r.x, r.y, r.z, q], |a| a[3])
+    }
+}
+
+impl Whole<DVec3> {
+    fn dipoles(state: &State) -> Self {
+        Self::of(
+            state,
+            state.dipole,
+            |r, m| [r.x, r.y, r.z, m.x, m.y, m.z],
+            |a| DVec3::new(a[3], a[4], a[5]),
         )
     }
 }
@@ -743,13 +935,17 @@ impl Interaction for EwaldDipoles {
             return;
         }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-        let u = self
-            .ewald
-            .dipoles(state.position, state.dipole, &mut f, &mut h);
+        let u = self.evaluate(state, &mut f, &mut h);
         self.last_energy = self.k * u;
         for (a, b) in force.iter_mut().zip(&f) {
             *a += *b * self.k;
         }
+    }
+
+    /// Decomposed as [`EwaldCoulomb`]: positions and moments gathered in
+    /// id order to every rank, the forces and torques of its own.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        Some(HaloReach::NONE)
     }
 
     fn exerts_torques(&self) -> bool {
@@ -768,9 +964,7 @@ impl Interaction for EwaldDipoles {
             return;
         }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-        let u = self
-            .ewald
-            .dipoles(state.position, state.dipole, &mut f, &mut h);
+        let u = self.evaluate(state, &mut f, &mut h);
         self.last_energy = self.k * u;
         for i in 0..n {
             force[i] += f[i] * self.k;
@@ -784,16 +978,23 @@ impl Interaction for EwaldDipoles {
             return 0.0;
         }
         let (mut f, mut h) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
-        self.k
-            * self
-                .ewald
-                .dipoles(state.position, state.dipole, &mut f, &mut h)
+        self.k * self.evaluate(state, &mut f, &mut h)
     }
 
     /// W = 3U: the tin-foil Ewald energy of fixed dipoles is homogeneous of
     /// degree −3 in all lengths, so W = −dU/dλ at λ = 1 = 3U.
     fn virial(&self) -> Option<f64> {
         Some(3.0 * self.last_energy)
+    }
+}
+
+impl EwaldDipoles {
+    /// The energy of this evaluation's share (reduced units), the forces
+    /// and fields of its particles into `force` and `field`.
+    fn evaluate(&self, state: &State, force: &mut [DVec3], field: &mut [DVec3]) -> f64 {
+        let whole = Whole::dipoles(state);
+        self.ewald
+            .dipoles_of(&whole.position, &whole.value, whole.share(), force, field)
     }
 }
 

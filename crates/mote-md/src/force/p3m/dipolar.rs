@@ -157,7 +157,7 @@ impl P3mDipoles {
             let (r, m) = (r.to_array(), m.to_array());
             [r[0], r[1], r[2], m[0], m[1], m[2]]
         });
-        let all = super::gathered(own, halo, comm, self.total);
+        let all = crate::domain::gathered(own, halo, comm, self.total);
         Some(
             all.iter()
                 .map(|v| (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5])))

@@ -251,41 +251,9 @@ impl P3mCoulomb {
 
 /// Every particle's position in id order, at every rank ([`gathered`]).
 fn whole_positions(position: &[DVec3], halo: &Halo, comm: &dyn Comm, total: usize) -> Vec<DVec3> {
-    gathered(position.iter().map(|r| r.to_array()), halo, comm, total)
+    crate::domain::gathered(position.iter().map(|r| r.to_array()), halo, comm, total)
         .into_iter()
         .map(DVec3::from_array)
-        .collect()
-}
-
-/// Every particle's K numbers in id order, at every rank: this rank's
-/// (`own`, in its particles' order) with the halo's ids go to rank 0,
-/// which places them and sends the whole back. A mesh made from them is
-/// made from the same numbers in the same order as one process makes it,
-/// so its bits do not depend on the ranks (positions are the ranks' own,
-/// unwrapped, as one process holds them).
-pub(super) fn gathered<const K: usize>(
-    own: impl Iterator<Item = [f64; K]>,
-    halo: &Halo,
-    comm: &dyn Comm,
-    total: usize,
-) -> Vec<[f64; K]> {
-    let mut send = Vec::with_capacity((K + 1) * halo.id.len());
-    for (id, values) in halo.id.iter().zip(own) {
-        send.push(*id as f64);
-        send.extend(values);
-    }
-    let parts = comm.gather(&send);
-    let mut placed = Vec::new();
-    if comm.rank() == 0 {
-        placed = vec![0.0; K * total];
-        for record in parts.iter().flat_map(|p| p.chunks_exact(K + 1)) {
-            let id = record[0] as usize;
-            placed[K * id..K * (id + 1)].copy_from_slice(&record[1..]);
-        }
-    }
-    comm.broadcast(&placed)
-        .chunks_exact(K)
-        .map(|c| std::array::from_fn(|k| c[k]))
         .collect()
 }
 
