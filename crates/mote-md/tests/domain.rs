@@ -674,3 +674,99 @@ fn ewald_sums_on_ranks_step_as_one_process_does() {
         assert!(first.potential.abs() > 1.0, "U = {}", first.potential);
     }
 }
+
+/// A 3-D spring lattice (with diagonals) shaken by a Langevin bath in a
+/// box periodic on every axis and long enough for three bricks along x.
+const SPRING_LATTICE: &str = r#"
+units = "lj"
+seed = 8
+
+[run]
+integrator = "leapfrog"
+dt = 0.005
+steps = 400
+
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [18.0, 5.0, 5.0]
+
+[thermostat]
+kind = "langevin"
+kt = 0.3
+gamma = 1.0
+
+[[lattice]]
+n = [16, 4, 4]
+spacing = [1.0, 1.0, 1.0]
+origin = [0.5, 0.5, 0.5]
+mass = 1.0
+springs = { stiffness = 50.0, damping = 0.2, diagonals = true }
+"#;
+
+/// Springs on ranks: each rank evaluates the springs with an end of its
+/// own, the other end's motion from the halo, so a lattice on 2 and 3
+/// ranks moves as in one process, to the bit, and its energy (each spring
+/// at its first end's rank) and pressure agree to round-off.
+#[test]
+fn springs_across_bricks_pull_as_in_one_process() {
+    let run = |comm: Option<Arc<dyn Comm>>| {
+        let mut sim = on_ranks(SPRING_LATTICE, comm, None);
+        let (first, last) = run_for(&mut sim, 400);
+        (whole(sim), first, last)
+    };
+    let (one, first, last) = run(None);
+    let one = one.unwrap();
+    for ranks in [2, 3] {
+        let (many, f, l) = in_process(ranks, |comm| run(Some(comm))).remove(0);
+        let (p, q) = (&one.particles, &many.unwrap().particles);
+        assert!(p.position == q.position, "{ranks} ranks: positions");
+        assert!(p.velocity == q.velocity, "{ranks} ranks: velocities");
+        for (a, e) in [(&f, &first), (&l, &last)] {
+            assert!(
+                (a.potential - e.potential).abs() <= 1e-11 * e.potential.abs().max(1e-9),
+                "{ranks} ranks: U = {} against {}",
+                a.potential,
+                e.potential
+            );
+            assert!((a.pressure - e.pressure).abs() <= 1e-10 * e.pressure.abs().max(1e-6));
+        }
+    }
+    // The bath stretched the springs.
+    assert!(last.potential > 1.0, "U = {}", last.potential);
+}
+
+/// A spring stretched past the halo on ranks: its end's force is not
+/// silently dropped — the state goes non-finite at that particle, and
+/// every rank stops there (one process runs it).
+#[test]
+fn a_spring_longer_than_the_halo_stops_the_run_on_ranks() {
+    let scene = r#"
+units = "lj"
+[run]
+integrator = "leapfrog"
+dt = 0.01
+steps = 5
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [18.0, 5.0, 5.0]
+[[particle]]
+position = [1.0, 2.5, 2.5]
+[[particle]]
+position = [13.0, 2.5, 2.5]
+[[spring]]
+pairs = [[0, 1]]
+stiffness = 0.01
+rest_length = 1.0
+"#;
+    let step = |comm: Option<Arc<dyn Comm>>| {
+        let mut sim = on_ranks(scene, comm, Some([2, 1, 1]));
+        sim.prime(&mut |_| {}).unwrap();
+        sim.advance().unwrap();
+        sim.unstable()
+    };
+    assert_eq!(step(None), None, "one process runs it");
+    for unstable in in_process(2, |comm| step(Some(comm))) {
+        let (id, what) = unstable.expect("every rank stops");
+        assert_eq!(id, 0, "{what}");
+    }
+}

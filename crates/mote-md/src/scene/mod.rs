@@ -288,10 +288,7 @@ impl Scene {
         // The interactions, in the order their forces are summed.
         add(&self.gravity, self, &mut b)?;
         if !made.springs.is_empty() {
-            b.forces.push(SpringNetwork {
-                springs: made.springs,
-                virial: 0.0,
-            });
+            b.forces.push(SpringNetwork::new(made.springs));
         }
         add(&self.field, self, &mut b)?;
         add(&self.damping, self, &mut b)?;
