@@ -104,8 +104,8 @@ impl Simulation {
             Err(names) => {
                 return not_yet(&format!(
                     "{} (Lennard-Jones/WCA, cut-off dipoles, Coulomb and dipoles by Ewald or \
-                     P3M, springs, granular contacts and walls, applied and uniform fields and \
-                     damping do)",
+                     P3M, springs, granular contacts and walls, applied, uniform and electric fields \
+                     and damping do)",
                     names.join(", ")
                 ))
             }

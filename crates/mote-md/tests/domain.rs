@@ -580,7 +580,7 @@ fn the_cut_follows_a_settling_bed() {
 }
 
 /// A molten salt by Ewald beside WCA cores: 512 ions melting from rock
-/// salt in a cubic box.
+/// salt in a cubic box, driven by an applied electric field.
 const EWALD_SALT: &str = r#"
 units = "lj"
 seed = 3
@@ -596,6 +596,9 @@ wca = true
 [coulomb]
 method = "ewald"
 accuracy = 1e-3
+
+[electric_field]
+e = [0.5, 0.0, 0.0]
 
 [[fcc]]
 cells = [4, 4, 4]

@@ -112,6 +112,11 @@ impl Interaction for ElectricField {
         "electric_field"
     }
 
+    /// A force on each charge alone.
+    fn halo_reach(&self) -> Option<super::HaloReach> {
+        Some(super::HaloReach::NONE)
+    }
+
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         let e = self.at(state.step.time);
         for (f, q) in force.iter_mut().zip(state.charges()) {
