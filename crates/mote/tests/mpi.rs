@@ -195,17 +195,59 @@ observables_every = 25
 trajectory_every = 50
 "#;
 
+/// A spring lattice with diagonals shaken by a Langevin bath, long
+/// enough along x for four bricks.
+const SPRINGS: &str = r#"
+title = "springs on ranks"
+units = "lj"
+seed = 8
+
+[run]
+integrator = "leapfrog"
+dt = 0.005
+steps = 100
+
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [18.0, 5.0, 5.0]
+
+[thermostat]
+kind = "langevin"
+kt = 0.3
+gamma = 1.0
+
+[[lattice]]
+n = [16, 4, 4]
+spacing = [1.0, 1.0, 1.0]
+origin = [0.5, 0.5, 0.5]
+mass = 1.0
+springs = { stiffness = 50.0, damping = 0.2, diagonals = true }
+
+[output]
+observables_every = 25
+trajectory_every = 50
+"#;
+
 /// P3M on ranks: the real space over each rank's halo, the mesh made on
 /// every rank from every particle (gathered in id order), so the forces —
 /// and the trajectory — are one process's, byte for byte, on 2, 3 and 4
 /// ranks; the energies (summed over the ranks) to round-off. For charges
-/// (a molten salt) and for dipoles (a dipolar fluid, with torques).
+/// (a molten salt) and for dipoles (a dipolar fluid, with torques); the
+/// same for a salt by Ewald (every rank gathering every particle for the
+/// structure factors) and for springs across bricks (the far end's motion
+/// from the halo).
 #[test]
-fn p3m_on_two_three_and_four_ranks_writes_one_process_trajectory() {
+fn p3m_ewald_and_springs_on_two_three_and_four_ranks_write_one_process_trajectory() {
     let dir = tempfile::tempdir().unwrap();
+    let ewald_salt = SALT
+        .replace("method = \"p3m\"", "method = \"ewald\"")
+        .replace("cells = [8, 4, 4]", "cells = [4, 4, 4]");
+    let springs = SPRINGS.to_string();
     for (name, scene, said) in [
         ("salt", SALT, "Coulomb by P3M: mesh"),
         ("fluid", DIPOLAR_FLUID, "Dipolar by P3M: mesh"),
+        ("ewald", ewald_salt.as_str(), "steps"),
+        ("springs", springs.as_str(), "steps"),
     ] {
         let file = format!("{name}.toml");
         std::fs::write(dir.path().join(&file), scene).unwrap();
