@@ -679,32 +679,8 @@ fn ewald_sums_on_ranks_step_as_one_process_does() {
 }
 
 /// A 3-D spring lattice (with diagonals) shaken by a Langevin bath in a
-/// box periodic on every axis and long enough for three bricks along x.
-const SPRING_LATTICE: &str = r#"
-units = "lj"
-seed = 8
-
-[run]
-integrator = "leapfrog"
-dt = 0.005
-steps = 400
-
-[box]
-lo = [0.0, 0.0, 0.0]
-hi = [18.0, 5.0, 5.0]
-
-[thermostat]
-kind = "langevin"
-kt = 0.3
-gamma = 1.0
-
-[[lattice]]
-n = [16, 4, 4]
-spacing = [1.0, 1.0, 1.0]
-origin = [0.5, 0.5, 0.5]
-mass = 1.0
-springs = { stiffness = 50.0, damping = 0.2, diagonals = true }
-"#;
+/// box periodic on every axis and long enough for bricks along x.
+const SPRING_LATTICE: &str = include_str!("data/spring-lattice.toml");
 
 /// Springs on ranks: each rank evaluates the springs with an end of its
 /// own, the other end's motion from the halo, so a lattice on 2 and 3

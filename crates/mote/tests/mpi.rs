@@ -197,36 +197,7 @@ trajectory_every = 50
 
 /// A spring lattice with diagonals shaken by a Langevin bath, long
 /// enough along x for four bricks.
-const SPRINGS: &str = r#"
-title = "springs on ranks"
-units = "lj"
-seed = 8
-
-[run]
-integrator = "leapfrog"
-dt = 0.005
-steps = 100
-
-[box]
-lo = [0.0, 0.0, 0.0]
-hi = [18.0, 5.0, 5.0]
-
-[thermostat]
-kind = "langevin"
-kt = 0.3
-gamma = 1.0
-
-[[lattice]]
-n = [16, 4, 4]
-spacing = [1.0, 1.0, 1.0]
-origin = [0.5, 0.5, 0.5]
-mass = 1.0
-springs = { stiffness = 50.0, damping = 0.2, diagonals = true }
-
-[output]
-observables_every = 25
-trajectory_every = 50
-"#;
+const SPRINGS: &str = include_str!("../../mote-md/tests/data/spring-lattice.toml");
 
 /// P3M on ranks: the real space over each rank's halo, the mesh made on
 /// every rank from every particle (gathered in id order), so the forces —
@@ -242,7 +213,7 @@ fn p3m_ewald_and_springs_on_two_three_and_four_ranks_write_one_process_trajector
     let ewald_salt = SALT
         .replace("method = \"p3m\"", "method = \"ewald\"")
         .replace("cells = [8, 4, 4]", "cells = [4, 4, 4]");
-    let springs = SPRINGS.to_string();
+    let springs = format!("{SPRINGS}\n[output]\nobservables_every = 25\ntrajectory_every = 50\n");
     for (name, scene, said) in [
         ("salt", SALT, "Coulomb by P3M: mesh"),
         ("fluid", DIPOLAR_FLUID, "Dipolar by P3M: mesh"),

@@ -142,10 +142,7 @@ impl ContactBatch {
             let (wa, wb) = (vector_of(at.spin, 0), vector_of(at.spin, 1));
             let d = V3::<Width>::from_fn(|l| self.separation[at_lane(l)]);
             let r2 = Width::from_fn(|l| self.distance2[at_lane(l)]);
-            let mut h = HistoryLanes {
-                shear: V3::from_fn(|l| history[slot(l)].shear),
-                roll: V3::from_fn(|l| history[slot(l)].roll),
-            };
+            let mut h = HistoryLanes::from_fn(|l| history[slot(l)]);
             let c = contact(
                 law,
                 d,
@@ -158,15 +155,8 @@ impl ContactBatch {
                 &mut h,
             );
             for l in 0..live {
-                history[slot(l)] = History {
-                    shear: h.shear.lane(l),
-                    roll: h.roll.lane(l),
-                };
-                self.force[first + l] = ContactForce {
-                    force: c.force.lane(l),
-                    torque_i: c.torque_i.lane(l),
-                    torque_j: c.torque_j.lane(l),
-                };
+                history[slot(l)] = h.lane(l);
+                self.force[first + l] = c.lane(l);
             }
             first += live;
         }
@@ -247,10 +237,7 @@ impl FormedContacts {
             let scalar = |v: &[f64]| Four::from_fn(|l| v[at(l)]);
             let vector = |v: &[DVec3]| V3::<Four>::from_fn(|l| v[at(l)]);
             let slot = |l: usize| self.slot[at(l)] as usize;
-            let mut h = HistoryLanes {
-                shear: V3::from_fn(|l| history[slot(l)].shear),
-                roll: V3::from_fn(|l| history[slot(l)].roll),
-            };
+            let mut h = HistoryLanes::from_fn(|l| history[slot(l)]);
             let c = force_lanes(
                 law,
                 scalar(&self.delta),
@@ -267,15 +254,8 @@ impl FormedContacts {
                 &mut h,
             );
             for l in 0..live {
-                history[slot(l)] = History {
-                    shear: h.shear.lane(l),
-                    roll: h.roll.lane(l),
-                };
-                self.force[first + l] = ContactForce {
-                    force: c.force.lane(l),
-                    torque_i: c.torque_i.lane(l),
-                    torque_j: c.torque_j.lane(l),
-                };
+                history[slot(l)] = h.lane(l);
+                self.force[first + l] = c.lane(l);
             }
             first += live;
         }
@@ -288,11 +268,43 @@ pub struct HistoryLanes<L> {
     pub roll: V3<L>,
 }
 
+impl<L: Lane> HistoryLanes<L> {
+    /// Lane l from `f(l)`.
+    #[inline(always)]
+    pub fn from_fn(f: impl Fn(usize) -> History) -> Self {
+        HistoryLanes {
+            shear: V3::from_fn(|l| f(l).shear),
+            roll: V3::from_fn(|l| f(l).roll),
+        }
+    }
+
+    /// Lane l.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> History {
+        History {
+            shear: self.shear.lane(l),
+            roll: self.roll.lane(l),
+        }
+    }
+}
+
 /// The force and torques of `L::N` contacts, one per lane.
 pub struct ForceLanes<L> {
     pub force: V3<L>,
     pub torque_i: V3<L>,
     pub torque_j: V3<L>,
+}
+
+impl<L: Lane> ForceLanes<L> {
+    /// Lane l.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> ContactForce {
+        ContactForce {
+            force: self.force.lane(l),
+            torque_i: self.torque_i.lane(l),
+            torque_j: self.torque_j.lane(l),
+        }
+    }
 }
 
 /// One lane's contact geometry, as the sphere loop forms it before
@@ -506,10 +518,7 @@ mod tests {
                     })
                     .collect();
                 let dt = 1e-6;
-                let mut lanes = HistoryLanes {
-                    shear: V3::<L>::from_fn(|l| h[l].shear),
-                    roll: V3::<L>::from_fn(|l| h[l].roll),
-                };
+                let mut lanes = HistoryLanes::<L>::from_fn(|l| h[l]);
                 let r2 = L::from_fn(|l| d[l].length_squared());
                 let c = contact(
                     &law,
