@@ -120,7 +120,7 @@ impl VerletList {
     /// filling its rows into one buffer (no allocation per particle),
     /// every row's partners sorted, the blocks joined in order. The
     /// distances are tested eight at a time over the runs of cells around
-    /// each particle ([`ghosts::within`]: AVX-512 compression, or
+    /// each particle (`within` of the ghost lists: AVX-512 compression, or
     /// [`Lanes`](mote_geom::lanes::Lanes)), each run shifted by its
     /// periodic image; a periodic axis of fewer than three cells, where
     /// one cell holds several images of a particle, takes the minimum

@@ -8,7 +8,10 @@
 //! A step evaluates the rows in parallel blocks: each pair once, its force
 //! and torque summed into its row's particle, those on the partner put in
 //! the partner's inbox; then each particle adds its inbox and its row, in
-//! parallel. No two threads write one place, and the bits depend neither
+//! parallel. Within a block, each run of rows (at most `BATCH` pairs)
+//! first keeps its touching pairs, then applies the law to them four at a
+//! time ([`super::batch`], the scalar law's bits), then sums them in list
+//! order. No two threads write one place, and the bits depend neither
 //! on the threads nor on the ranks.
 
 use glam::DVec3;
