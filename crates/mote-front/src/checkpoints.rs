@@ -28,6 +28,8 @@ fn number<T: std::str::FromStr>(key: &str, v: String) -> Result<T, FrontError> {
 /// `time`), so the resumed run continues the files.
 pub(crate) fn trim_outputs(dir: &Path, step: u64, time: f64) -> Result<(), FrontError> {
     trim_table(&dir.join("observables.csv"), step, time)?;
+    // The particles taken out by outlets (`[[outlet]]`).
+    trim_table(&dir.join("outflow.csv"), step, time)?;
     // A toning nip's table (rigid `[rigid.nip]`), where there is one.
     trim_table(&dir.join("nip.csv"), step, time)?;
     // A packing's windows (by time: the table has no step column).

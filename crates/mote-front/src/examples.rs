@@ -29,6 +29,7 @@ const PARTICLES: &[(&str, &str)] = &[
     scene!("settling", "settling.toml"),
     scene!("column-collapse", "column-collapse.toml"),
     scene!("rotating-drum", "rotating-drum.toml"),
+    scene!("chute-flow", "chute-flow.toml"),
     scene!("plummer", "plummer.toml"),
     scene!("ferrofluid", "ferrofluid.toml"),
 ];

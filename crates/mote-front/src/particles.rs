@@ -21,6 +21,9 @@ pub fn resume_state(
     sim: &mut mote_md::Simulation,
     label: &str,
 ) -> Result<(), FrontError> {
+    // Particles that came and went: the checkpoint's set first.
+    sim.restore_flow(cp)
+        .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
     let sys = &mut sim.system;
     if cp.positions.len() != sys.particles.len() {
         refuse!(
@@ -53,7 +56,14 @@ pub fn resume_state(
     }
     let forces = &mut sim.forces;
     let keys = forces.carried_keys();
-    let matched = mote_io::checkpoint::match_carried(cp, &keys)
+    let interactions_only = Checkpoint {
+        carried: (cp.carried.iter())
+            .filter(|(k, _)| k != mote_md::simulation::FLOW_KEY)
+            .cloned()
+            .collect(),
+        ..Checkpoint::default()
+    };
+    let matched = mote_io::checkpoint::match_carried(&interactions_only, &keys)
         .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
     for (k, values) in matched {
         forces.interactions[k]
@@ -302,6 +312,9 @@ impl EngineRun for PointsRun {
         done: &Done,
     ) -> Result<Vec<String>, FrontError> {
         let mut lines = vec![summary(report, sim, &self.scene, &done.files.dir)];
+        if let Some(flow) = &sim.flow {
+            lines.push(flow.summary(sim.system.particles.len()));
+        }
         // Every rank takes part in the census; rank 0 says it.
         if let Some(domain) = sim.forces.domain.as_ref() {
             if let Some(census) = domain.census() {
@@ -374,6 +387,7 @@ pub(crate) fn table_observers(
                 .dipole
                 .iter()
                 .any(|m| *m != mote_md::DVec3::ZERO),
+            sim.flow.as_ref(),
             append,
         )?;
         // The viewer's first plot: what the dynamics leave to watch.
@@ -388,6 +402,16 @@ pub(crate) fn table_observers(
             csv.suggest_plot(column)?;
         }
         observers.push(Box::new(csv));
+    }
+    // What left through the outlets, particle by particle.
+    if let Some(flow) = sim.flow.as_ref().filter(|f| !f.outlets.is_empty()) {
+        observers.push(Box::new(mote_md::output::OutflowCsv::create(
+            &dir.join("outflow.csv"),
+            provenance,
+            scene.units,
+            flow,
+            append,
+        )?));
     }
     Ok(observers)
 }

@@ -13,6 +13,7 @@ pub mod brownian;
 pub mod domain;
 pub mod eos;
 pub mod error;
+pub mod flow;
 pub mod force;
 pub mod init;
 pub mod integrate;

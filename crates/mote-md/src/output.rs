@@ -27,6 +27,8 @@ pub struct ObservablesCsv {
     tensor: bool,
     walls: usize,
     magnetic: bool,
+    /// Whether particles come and go: the count and the flow's columns.
+    flow: bool,
 }
 
 impl ObservablesCsv {
@@ -41,6 +43,7 @@ impl ObservablesCsv {
         tensor: bool,
         walls: &[String],
         magnetic: bool,
+        flow: Option<&crate::flow::Flow>,
         append: bool,
     ) -> Result<Self, MdError> {
         let [l, t, m, e] = units.labels();
@@ -98,6 +101,15 @@ impl ObservablesCsv {
                 unit_row.push(format!("{m}*{l}/{t}^2"));
             }
         }
+        // Particles held, and in and out by each inserter and outlet.
+        if let Some(flow) = flow {
+            columns.push("N".into());
+            unit_row.push("1".into());
+            for name in flow.column_names() {
+                unit_row.push(if name.starts_with("mass") { m } else { "1" }.into());
+                columns.push(name);
+            }
+        }
         Ok(Self {
             writer: if append {
                 CsvWriter::append(path, columns.len())?
@@ -110,6 +122,7 @@ impl ObservablesCsv {
             tensor,
             walls: walls.len(),
             magnetic,
+            flow: flow.is_some(),
         })
     }
 }
@@ -137,6 +150,10 @@ impl Observer<Simulation> for ObservablesCsv {
             let f = obs.wall_forces.get(k).map_or(DVec3::NAN, |w| w.1);
             row.extend([f.x, f.y, f.z]);
         }
+        if self.flow {
+            row.push(sys.particles.len() as f64);
+            row.extend(sim.flow.as_ref().map(|f| f.columns()).unwrap_or_default());
+        }
         Ok(self.writer.row(&row)?)
     }
 
@@ -158,6 +175,84 @@ impl ObservablesCsv {
     /// conserves none, and names what it watches instead.
     pub fn suggest_plot(&mut self, column: &str) -> Result<(), MdError> {
         Ok(self.writer.comment(&format!("plot: {column}"))?)
+    }
+}
+
+/// outflow.csv: a row per particle taken out (step, time, id, outlet,
+/// mass, charge, radius, position, velocity), written at each flow
+/// event.
+pub struct OutflowCsv {
+    writer: CsvWriter,
+    every: u64,
+}
+
+impl OutflowCsv {
+    /// The table for `flow`'s outlets (named in a comment by their
+    /// numbers in the `outlet` column).
+    pub fn create(
+        path: &Path,
+        provenance: &Provenance,
+        units: UnitSystem,
+        flow: &crate::flow::Flow,
+        append: bool,
+    ) -> Result<Self, MdError> {
+        let [l, t, m, _] = units.labels();
+        let v = format!("{l}/{t}");
+        let columns = [
+            "step", "time", "id", "outlet", "mass", "charge", "radius", "x", "y", "z", "vx", "vy",
+            "vz",
+        ];
+        let units = ["1", t, "1", "1", m, "charge", l, l, l, l, &v, &v, &v];
+        let writer = if append {
+            CsvWriter::append(path, columns.len())?
+        } else {
+            let columns: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
+            let units: Vec<String> = units.iter().map(|c| c.to_string()).collect();
+            let mut w = CsvWriter::create(path, provenance, &columns, &units)?;
+            let names: Vec<String> = (flow.outlets.iter().enumerate())
+                .map(|(k, o)| format!("{k} = {}", o.name))
+                .collect();
+            w.comment(&format!("outlets: {}", names.join(", ")))?;
+            w
+        };
+        Ok(Self {
+            writer,
+            every: flow.every,
+        })
+    }
+}
+
+impl Observer<Simulation> for OutflowCsv {
+    /// Every flow event: the departures of each are there until the next.
+    fn every(&self) -> u64 {
+        self.every
+    }
+
+    fn observe(&mut self, sim: &Simulation, _: &Observables) -> Result<(), MdError> {
+        let Some(flow) = &sim.flow else { return Ok(()) };
+        for d in flow.departed.iter().filter(|d| d.step == sim.system.step) {
+            let row = [
+                d.step as f64,
+                d.time,
+                (d.id + 1) as f64,
+                d.outlet as f64,
+                d.mass,
+                d.charge,
+                d.radius,
+                d.position.x,
+                d.position.y,
+                d.position.z,
+                d.velocity.x,
+                d.velocity.y,
+                d.velocity.z,
+            ];
+            self.writer.row(&row)?;
+        }
+        Ok(())
+    }
+
+    fn files(&self) -> Vec<String> {
+        vec![self.writer.path().display().to_string()]
     }
 }
 
@@ -196,6 +291,8 @@ pub fn frame_of(sys: &System) -> Frame {
         velocities: p.velocity.iter().map(|v| v.to_array()).collect(),
         radii: p.radius.clone(),
         masses: p.mass.clone(),
+        // Ids where particles come and go (written from 1).
+        ids: sys.id.iter().map(|id| id + 1).collect(),
         angular_velocities: nonzero(&p.angular_velocity),
         dipoles: nonzero(&p.dipole),
         ..Frame::default()

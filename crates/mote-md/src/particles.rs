@@ -114,6 +114,10 @@ pub struct System {
     /// The species name of each particle, written in trajectories (empty:
     /// all `X`). Names only: no interaction reads them.
     pub species: Vec<String>,
+    /// Each particle's id, increasing along the particles (empty: particle
+    /// i has id i). Ids stay with particles where particles come and go
+    /// ([`crate::flow`]): the next inserted takes the next unused one.
+    pub id: Vec<u64>,
 }
 
 impl System {
@@ -126,6 +130,7 @@ impl System {
             carried_acceleration: Vec::new(),
             carried_angular_acceleration: Vec::new(),
             species: Vec::new(),
+            id: Vec::new(),
         }
     }
 
@@ -139,12 +144,19 @@ impl System {
             carried_acceleration: Vec::new(),
             carried_angular_acceleration: Vec::new(),
             species: Vec::new(),
+            id: Vec::new(),
         }
+    }
+
+    /// The id of particle i.
+    #[inline]
+    pub fn id_of(&self, i: usize) -> u64 {
+        self.id.get(i).copied().unwrap_or(i as u64)
     }
 
     /// Keeps the particles where `keep` is true, in order, with all they
     /// carry (a decomposed run's particles leaving this rank).
-    pub(crate) fn retain_particles(&mut self, keep: &[bool]) {
+    pub fn retain_particles(&mut self, keep: &[bool]) {
         use crate::domain::retain;
         let p = &mut self.particles;
         retain(&mut p.position, keep);
@@ -167,6 +179,9 @@ impl System {
         }
         if !self.species.is_empty() {
             retain(&mut self.species, keep);
+        }
+        if !self.id.is_empty() {
+            retain(&mut self.id, keep);
         }
     }
 

@@ -31,6 +31,9 @@ pub struct Simulation {
     /// Overdamped Brownian dynamics instead of the inertial `stepper`
     /// (004 Eqs. 14–16); its noise is counter-based like the thermostat's.
     pub brownian: Option<crate::brownian::BrownianStepper>,
+    /// Particles entering and leaving ([`crate::flow`]), after the steps
+    /// its `every` divides.
+    pub flow: Option<crate::flow::Flow>,
     /// Total energy at the first measurement of the current run and the
     /// largest relative departure from it measured since.
     energy_watch: Option<(f64, f64)>,
@@ -58,6 +61,7 @@ impl Simulation {
             thermostat: None,
             seed,
             brownian: None,
+            flow: None,
             energy_watch: None,
             stepping: std::time::Duration::ZERO,
         }
@@ -93,6 +97,9 @@ impl Simulation {
                 "{what} does not run on {ranks} ranks yet: run it on one"
             ))
         };
+        if self.flow.is_some() {
+            return not_yet("inserting and removing particles");
+        }
         if self.stepper.scheme != crate::Integrator::LeapFrog {
             return not_yet(&format!(
                 "the {} integrator (leap-frog does)",
@@ -131,6 +138,21 @@ impl Simulation {
         self.system = domain.scatter(&self.system, restored, &mut self.forces.interactions);
         self.forces.domain = Some(domain);
         Ok(())
+    }
+
+    /// Makes the freshly built system hold the particles a checkpoint's
+    /// flow state names ([`crate::flow::Flow::restore`]), before its
+    /// positions and velocities are put in; nothing without a flow.
+    pub fn restore_flow(&mut self, cp: &mote_io::checkpoint::Checkpoint) -> Result<(), String> {
+        let carried = cp.carried.iter().find(|(k, _)| k == FLOW_KEY);
+        match (&mut self.flow, carried) {
+            (Some(flow), Some((_, state))) => {
+                flow.restore(state, &mut self.system, &mut self.forces)
+            }
+            (None, None) => Ok(()),
+            (Some(_), None) => Err("the checkpoint has no flow state, and the scene inserts or removes particles".into()),
+            (None, Some(_)) => Err("the checkpoint has a flow state, and the scene neither inserts nor removes particles".into()),
+        }
     }
 
     /// The number of particles of the run, on every rank of a decomposed
@@ -189,13 +211,23 @@ impl mote_run::Propagator for Simulation {
         }
         if let Some(t) = self.thermostat {
             let domain = self.forces.domain.as_ref();
+            // The particles' ids, where particles come and go.
+            let ids = std::mem::take(&mut self.system.id);
             let noise = crate::thermostat::Noise {
                 seed: self.seed,
                 step: self.system.step,
-                ids: domain.map_or(&[], |d| &d.halo().id),
+                ids: domain.map_or(&ids, |d| &d.halo().id),
                 comm: domain.map(|d| d.comm()),
             };
             t.apply(&mut self.system, self.dt, &noise);
+            self.system.id = ids;
+        }
+        if let Some(flow) = self
+            .flow
+            .as_mut()
+            .filter(|f| self.system.step.is_multiple_of(f.every))
+        {
+            flow.apply(&mut self.system, &mut self.forces, self.seed);
         }
         self.stepping += since.elapsed();
         Ok(())
@@ -371,16 +403,23 @@ impl mote_run::Propagator for Simulation {
         }
         let sys = &self.system;
         let keys = self.forces.carried_keys();
-        let carried = keys
+        let mut carried: Vec<(String, Vec<f64>)> = keys
             .into_iter()
             .zip(&self.forces.interactions)
             .map(|(key, i)| (key, i.carried_state()))
             .filter(|(_, v)| !v.is_empty())
             .collect();
+        if let Some(flow) = &self.flow {
+            carried.push((FLOW_KEY.to_string(), flow.carried_state(sys)));
+        }
         write_state(sys, carried, cp);
         Ok(())
     }
 }
+
+/// The key under which a checkpoint carries the flow's state
+/// ([`crate::flow::Flow::carried_state`]) beside the interactions'.
+pub const FLOW_KEY: &str = "flow";
 
 /// Puts `sys` and what its interactions carry into `cp`: positions,
 /// velocities, the accelerations leap-frog carries (and the angular ones

@@ -13,6 +13,7 @@ mod dipolar_rows;
 mod domain;
 mod electric_scenes;
 mod ewald;
+mod flow;
 mod from_file;
 mod granular;
 mod kepler;

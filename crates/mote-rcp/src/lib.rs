@@ -27,6 +27,7 @@ mod error;
 mod fit;
 mod packing;
 pub mod resolution;
+mod sizes;
 
 pub mod design;
 pub mod heatmap;
@@ -40,6 +41,7 @@ pub use error::RcpError;
 pub use fit::{lognormal_fit, MONODISPERSE_FIT};
 pub use packing::{pack_rods, Packing, RodPacker, SPHERE_GAP_FRACTION};
 pub use resolution::Checked;
+pub use sizes::SizeSpec;
 
 /// Default number of rods (spherepack1d's default).
 pub const DEFAULT_RODS: usize = 16_000;

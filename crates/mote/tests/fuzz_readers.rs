@@ -116,6 +116,10 @@ fn fuzz_all(count: usize) -> usize {
             "scene rotating-drum",
             include_str!("../../../examples/rotating-drum.toml"),
         ),
+        (
+            "scene chute-flow",
+            include_str!("../../../examples/chute-flow.toml"),
+        ),
     ] {
         tried += fuzz(name, text.as_bytes(), count, |b| {
             let t = lossy(b);

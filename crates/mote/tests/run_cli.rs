@@ -211,6 +211,7 @@ fn examples_are_listed_and_written_and_each_one_runs() {
         "settling",
         "column-collapse",
         "rotating-drum",
+        "chute-flow",
         "plummer",
         "ferrofluid",
         "magnet-in-field",

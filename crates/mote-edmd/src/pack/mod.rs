@@ -32,105 +32,28 @@ use crate::EdmdError;
 
 mod propagator;
 
-/// A size distribution of the packed particles (diameters up to a common
-/// scale).
-#[derive(Debug, Clone, PartialEq)]
-pub enum SizeSpec {
-    /// All diameters equal.
-    Monodisperse,
-    /// Two sizes: diameter ratio large/small ≥ 1 and the number fraction of
-    /// the large ones.
-    Bidisperse { ratio: f64, large_fraction: f64 },
-    /// Lognormal number distribution of log-width σ (003 Eq. 10; the same
-    /// [`mote_rcp::Population::Lognormal`] that `mote rcp` estimates).
-    Lognormal { sigma: f64 },
-    /// Given radii (their number fixes N).
-    Radii(Vec<f64>),
-}
+pub use mote_rcp::SizeSpec;
 
-impl SizeSpec {
-    /// Parses `mono`, `bi:RATIO:FRACTION` (number fraction of the large),
-    /// `lognormal:SIGMA`; radii files are read by the caller.
-    pub fn parse(text: &str) -> Result<Self, String> {
-        let parts: Vec<&str> = text.split(':').collect();
-        let num = |s: &str, what: &str| -> Result<f64, String> {
-            s.trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| format!("{what} `{s}` is not a number"))
-        };
-        match parts.as_slice() {
-            ["mono"] | ["monodisperse"] => Ok(SizeSpec::Monodisperse),
-            ["bi", ratio, frac] | ["bidisperse", ratio, frac] => {
-                let ratio = num(ratio, "diameter ratio")?;
-                let large_fraction = num(frac, "number fraction")?;
-                if ratio < 1.0 {
-                    return Err(format!("diameter ratio {ratio} must be ≥ 1 (large/small)"));
-                }
-                if !(0.0..=1.0).contains(&large_fraction) {
-                    return Err(format!(
-                        "number fraction {large_fraction} of the large particles must lie in [0, 1]"
-                    ));
-                }
-                Ok(SizeSpec::Bidisperse {
-                    ratio,
-                    large_fraction,
-                })
-            }
-            ["lognormal", sigma] | ["logn", sigma] => {
-                let sigma = num(sigma, "lognormal width σ")?;
-                if !(0.0..=2.0).contains(&sigma) {
-                    return Err(format!("lognormal width σ = {sigma} must lie in [0, 2]"));
-                }
-                Ok(SizeSpec::Lognormal { sigma })
-            }
-            _ => Err(format!(
-                "unknown size distribution `{text}`: use mono, bi:RATIO:FRACTION, lognormal:SIGMA or file:PATH"
-            )),
+/// `n` diameters (any common scale) of `sizes`, drawn with `rng` where
+/// random; a bidisperse set has its exact counts, the large first.
+pub fn diameters(sizes: &SizeSpec, n: usize, rng: &mut Xoshiro256PlusPlus) -> Vec<f64> {
+    match sizes {
+        SizeSpec::Monodisperse => vec![1.0; n],
+        SizeSpec::Bidisperse {
+            ratio,
+            large_fraction,
+        } => {
+            let large = (large_fraction * n as f64).round() as usize;
+            (0..n)
+                .map(|i| if i < large { *ratio } else { 1.0 })
+                .collect()
         }
-    }
-
-    /// `n` diameters (any common scale), drawn with `rng` where random.
-    pub fn diameters(&self, n: usize, rng: &mut Xoshiro256PlusPlus) -> Vec<f64> {
-        match self {
-            SizeSpec::Monodisperse => vec![1.0; n],
-            SizeSpec::Bidisperse {
-                ratio,
-                large_fraction,
-            } => {
-                let large = (large_fraction * n as f64).round() as usize;
-                (0..n)
-                    .map(|i| if i < large { *ratio } else { 1.0 })
-                    .collect()
-            }
-            SizeSpec::Lognormal { sigma } => {
-                // number median D0 = d43·e^(−7σ²/2) (003 Eqs. 11–12), d43 = 1
-                let d0 = (-3.5 * sigma * sigma).exp();
-                (0..n).map(|_| d0 * (sigma * normal(rng)).exp()).collect()
-            }
-            SizeSpec::Radii(r) => r.iter().map(|r| 2.0 * r).collect(),
+        SizeSpec::Lognormal { sigma } => {
+            // number median D0 = d43·e^(−7σ²/2) (003 Eqs. 11–12), d43 = 1
+            let d0 = (-3.5 * sigma * sigma).exp();
+            (0..n).map(|_| d0 * (sigma * normal(rng)).exp()).collect()
         }
-    }
-
-    /// The same distribution as `mote rcp` describes it (occluded volumes
-    /// from number fractions, 003 Eqs. 15–16), for its RCP estimate; `None`
-    /// for a file of radii.
-    pub fn rcp_distribution(&self) -> Option<mote_rcp::SizeDistribution> {
-        use mote_rcp::Population;
-        let pops = match self {
-            SizeSpec::Monodisperse => vec![Population::monodisperse(1.0, 1.0)],
-            SizeSpec::Bidisperse {
-                ratio,
-                large_fraction,
-            } => vec![
-                Population::monodisperse(1.0, 1.0 - large_fraction),
-                Population::monodisperse(*ratio, large_fraction * ratio.powi(3)),
-            ],
-            SizeSpec::Lognormal { sigma } => vec![Population::lognormal(1.0, *sigma, 1.0)],
-            SizeSpec::Radii(_) => return None,
-        };
-        mote_rcp::SizeDistribution::new(pops).ok()
+        SizeSpec::Radii(r) => r.iter().map(|r| 2.0 * r).collect(),
     }
 }
 
@@ -697,7 +620,7 @@ impl<const D: usize> Packer<D> {
         let (simbox, pos, radii) = match &settings.start {
             Some(start) => Self::given_start(start, boundary, settings.target_phi)?,
             None => {
-                let d = settings.sizes.diameters(n, &mut rng);
+                let d = diameters(&settings.sizes, n, &mut rng);
                 if let Some(k) = d.iter().position(|x| !(*x > 0.0 && x.is_finite())) {
                     return Err(invalid(format!(
                         "radius {} (particle {k}) must be positive and finite",

@@ -71,7 +71,7 @@ pub(crate) fn settings(
         _ => settings.n,
     };
     Ok(SoftPackSettings {
-        diameters: settings.sizes.diameters(n, &mut rng),
+        diameters: mote_edmd::pack::diameters(&settings.sizes, n, &mut rng),
         phi_start: settings.phi_start,
         pressures: SoftPackSettings::decades(min_pressure.max(LOWEST_HELD)),
         tolerance: 0.02,

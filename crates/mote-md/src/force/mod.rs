@@ -90,6 +90,9 @@ pub struct State<'a> {
     /// `halo`): what an interaction that sums over every particle (a mesh)
     /// gathers through.
     pub comm: Option<&'a dyn Comm>,
+    /// Each particle's id (empty: particle i has id i); ids differ from
+    /// indices where particles come and go ([`crate::flow`]).
+    pub id: &'a [u64],
 }
 
 /// The pairs an interaction lists over a decomposed run's halo: those
@@ -179,6 +182,7 @@ impl<'a> State<'a> {
             neighbours: None,
             halo: None,
             comm: None,
+            id: &[],
         }
     }
 
@@ -205,6 +209,7 @@ impl<'a> State<'a> {
             neighbours: None,
             halo: None,
             comm: None,
+            id: &sys.id,
         }
     }
 
@@ -540,6 +545,23 @@ impl ForceField {
         }
     }
 
+    /// Tells every interaction that particles left and came
+    /// ([`crate::flow`]): those where `keep` is false are gone (`None`:
+    /// none left), then the particles of ids `arrived` were appended in
+    /// that order, carrying nothing. The shared list is made afresh at the
+    /// next evaluation.
+    pub fn particles_changed(&mut self, keep: Option<&[bool]>, arrived: &[u64]) {
+        for interaction in &mut self.interactions {
+            if let Some(keep) = keep {
+                interaction.retain_particles(keep);
+            }
+            for id in arrived {
+                interaction.unpack_particle(*id, &[]);
+            }
+        }
+        self.neighbours = None;
+    }
+
     /// Readies a decomposed run's halo for a force evaluation at the
     /// system's positions (particles migrate at a rebuild, so the system
     /// may change); nothing in one process. Integrators call it before
@@ -596,6 +618,9 @@ impl ForceField {
     /// Accelerations a_i = F_i / m_i, zero along fixed axes (`mobility`).
     pub fn accelerations(&mut self, state: &State, mobility: &[DVec3], acc: &mut [DVec3]) {
         let n = state.position.len();
+        if self.nothing_to_do(n) {
+            return;
+        }
         self.refresh_neighbours(state);
         let state = &sharing(state, &self.neighbours, &self.domain);
         self.force.clear();
@@ -610,6 +635,13 @@ impl ForceField {
             .enumerate()
             .with_min_len(4096)
             .for_each(|(i, a)| *a = force[i] / mass[i] * mobility[i]);
+    }
+
+    /// Whether there are no particles to evaluate (a run whose particles
+    /// are all yet to be inserted, or all gone); a decomposed run's rank
+    /// without particles still takes part in its ranks' exchanges.
+    fn nothing_to_do(&self, n: usize) -> bool {
+        n == 0 && self.domain.is_none()
     }
 
     /// Whether any interaction exerts torques.
@@ -664,6 +696,9 @@ impl ForceField {
         force: &mut [DVec3],
         torque: &mut [DVec3],
     ) {
+        if self.nothing_to_do(state.position.len()) {
+            return;
+        }
         self.refresh_neighbours(state);
         let state = &sharing(state, &self.neighbours, &self.domain);
         for (k, interaction) in self.interactions.iter_mut().enumerate() {
@@ -714,6 +749,10 @@ impl ForceField {
 
     /// Total potential energy, and its parts by interaction name.
     pub fn potential_energy(&mut self, state: &State) -> (f64, Vec<(&'static str, f64)>) {
+        if self.nothing_to_do(state.position.len()) {
+            let parts = self.interactions.iter().map(|i| (i.name(), 0.0)).collect();
+            return (0.0, parts);
+        }
         self.refresh_halo(state);
         self.refresh_neighbours(state);
         let state = &sharing(state, &self.neighbours, &self.domain);

@@ -132,8 +132,10 @@ impl Section for GranularSettings {
         );
         law.rolling_friction = v.rolling_friction;
         law.adhesion = v.adhesion;
-        let d_min = radius.iter().cloned().fold(f64::INFINITY, f64::min) * 2.0;
-        let r_max = radius.iter().cloned().fold(0.0, f64::max);
+        // The spheres `[[insert]]` brings in count among them.
+        let (r_lo, r_hi) = super::flow::radius_range(scene).unwrap_or((f64::INFINITY, 0.0));
+        let d_min = radius.iter().cloned().fold(r_lo, f64::min) * 2.0;
+        let r_max = radius.iter().cloned().fold(r_hi, f64::max);
         let n = radius.len();
         let skin = v.skin.unwrap_or(0.25 * d_min);
         if skin.is_nan() || skin <= 0.0 {

@@ -26,6 +26,7 @@
 pub mod bath;
 pub mod dipolar;
 pub mod electric;
+pub mod flow;
 pub mod granular;
 pub mod gravity;
 pub mod lennard_jones;
@@ -124,6 +125,12 @@ pub struct SceneFile<R> {
     pub from_file: Vec<Spanned<DataSpec>>,
     #[serde(default)]
     pub spring: Vec<Spanned<SpringSpec>>,
+    /// `[[insert]]`: streams of spheres into regions.
+    #[serde(default)]
+    pub insert: Vec<Spanned<flow::InsertSpec>>,
+    /// `[[outlet]]`: where particles leave.
+    #[serde(default)]
+    pub outlet: Vec<Spanned<flow::OutletSpec>>,
     #[serde(default)]
     pub output: OutputTable,
     /// `[rigid]`: the rigid clumps' engine table.
@@ -313,6 +320,7 @@ impl Scene {
             system.to_centre_of_mass_frame();
         }
         let mut forces = b.forces;
+        let flow = flow::flow(self, src, &mut system, &forces)?;
         if let Some(asked) = &self.output.pressure_tensor {
             forces.pressure_tensor = asked.value;
             pressure_tensor_measurable(&system, &mut forces, asked, src)?;
@@ -322,6 +330,7 @@ impl Scene {
                 let mut sim = Simulation::new(system, forces, Stepper::new(integrator), dt, seed);
                 sim.thermostat = thermostat;
                 sim.brownian = brownian;
+                sim.flow = flow;
                 sim
             },
             length,

@@ -1001,8 +1001,8 @@ pub fn make(scene: &Scene, src: Source, rng: &mut Xoshiro256PlusPlus) -> Result<
         }
     }
     let n = inits.len();
-    if n == 0 {
-        return Err(src.whole("the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]], [[fcc]], [[cloud]], [[plummer]]) or [[from_file]]"));
+    if n == 0 && scene.insert.is_empty() {
+        return Err(src.whole("the scene makes no particles: add [[particle]] or a generator ([[lattice]], [[ring]], [[annulus]], [[random_box]], [[fcc]], [[cloud]], [[plummer]]), [[from_file]] or [[insert]]"));
     }
     for spec in &scene.spring {
         let s = spec.get_ref();

@@ -205,11 +205,14 @@ impl GranularContacts {
                 let list = state.neighbours.unwrap_or(&self.list);
                 let from = Listed::List(list.builds, list.neighbors.len());
                 if self.listed_from != Some(from) {
-                    // The rows are the particles.
+                    // The rows are the particles, named by their ids
+                    // (increasing along them).
                     let n = state.position.len();
-                    let rows: Vec<u32> = (0..n as u32).collect();
+                    let particle: Vec<u32> = (0..n as u32).collect();
+                    let ids = (0..n).map(|i| state.id.get(i).map_or(i as u32, |id| *id as u32));
                     let (start, partner) = (list.start.clone(), list.neighbors.clone());
-                    self.pairs.rebuild(rows.clone(), rows, n, start, partner);
+                    self.pairs
+                        .rebuild(ids.collect(), particle, n, start, partner);
                     self.listed_from = Some(from);
                 }
             }
@@ -522,6 +525,14 @@ impl Interaction for GranularContacts {
 
     fn unpack_particle(&mut self, id: u64, data: &[f64]) {
         self.pairs.arrive(id, data);
+        (self.listed_from, self.inbox_for) = (None, None);
+    }
+
+    /// The pairs are listed afresh at the next evaluation (a list of the
+    /// same length is not the same list once particles have gone); their
+    /// histories follow by the particles' ids.
+    fn retain_particles(&mut self, _: &[bool]) {
+        (self.listed_from, self.inbox_for) = (None, None);
     }
 
     /// The elastic energy of the Hertz springs, Σ (8/15) E* √R* δ^{5/2}

@@ -1,0 +1,367 @@
+//! Particles that enter and leave a run: inserters bring spheres into
+//! regions at a number or mass rate ([`insert`]), outlets take out those
+//! that reach a region or cross a face ([`outlet`]), every `every` steps,
+//! after the step's kick (LAMMPS and LIGGGHTS do it between steps too).
+//!
+//! What the run keeps exact:
+//!
+//! - **Mass balance**: every particle has an id; inserted ones take the
+//!   next unused id, so ids increase along the particles and a contact's
+//!   history follows its two ids through a removal. in − out = held, in
+//!   number and in mass, at every event.
+//! - **Rates**: by time t an inserter has made ⌊ṅ (t − t₀)⌋ particles (or
+//!   the fewest whose mass reaches ṁ (t − t₀)); a region too full to take
+//!   them leaves the rest owed to the next event, and the summary says so.
+//! - **Resumes**: an event's random numbers come from a generator seeded
+//!   by the run's seed, the step and the inserter (no state to carry),
+//!   and the checkpoint holds which particles exist, by id, with the
+//!   inserter and size of each inserted one: a resumed run is the
+//!   uninterrupted one bit for bit.
+//!
+//! A new particle is placed clear of every particle and wall, so its
+//! contacts start without history; its first half kick, before any force
+//! has been evaluated for it, uses a zero acceleration (as a LAMMPS
+//! `fix deposit` atom's does).
+
+pub mod insert;
+pub mod outlet;
+
+use glam::DVec3;
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use crate::boundary::Boundary;
+use crate::force::granular::Wall;
+use crate::force::ForceField;
+use crate::particles::System;
+
+pub use insert::{Inserter, Rate};
+pub use outlet::{Departure, Exit, Outlet};
+
+/// An axis-aligned box [lo, hi].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Region {
+    pub lo: DVec3,
+    pub hi: DVec3,
+}
+
+impl Region {
+    /// Whether x lies in the box (lower faces in, upper out).
+    pub fn contains(&self, x: DVec3) -> bool {
+        x.cmpge(self.lo).all() && x.cmplt(self.hi).all()
+    }
+
+    pub fn volume(&self) -> f64 {
+        (self.hi - self.lo).element_product()
+    }
+
+    /// The distance from x to the box (0 inside), through the periodic
+    /// axes' nearest image.
+    pub fn distance(&self, x: DVec3, boundary: &Boundary) -> f64 {
+        let centre = 0.5 * (self.lo + self.hi);
+        let half = 0.5 * (self.hi - self.lo);
+        let d = boundary.minimum_image(x - centre).abs() - half;
+        d.max(DVec3::ZERO).length()
+    }
+}
+
+/// Marks the particles the scene made (not an inserter).
+const SCENE: u32 = u32::MAX;
+
+/// The inserters and outlets of a run.
+#[derive(Debug, Clone)]
+pub struct Flow {
+    pub inserters: Vec<Inserter>,
+    pub outlets: Vec<Outlet>,
+    /// Steps between events (≥ 1).
+    pub every: u64,
+    /// The walls new particles keep clear of.
+    pub walls: Vec<Wall>,
+    /// The next unused id.
+    next_id: u64,
+    /// The inserter that made each particle, or [`SCENE`].
+    made_by: Vec<u32>,
+    /// The particles the scene made (ids 0 up to this).
+    scene: u64,
+    /// The particles that left at the last event.
+    pub departed: Vec<Departure>,
+}
+
+impl Flow {
+    /// The flow of a run whose scene made the particles of `sys`, which
+    /// get their ids 0, 1, … here.
+    pub fn new(
+        sys: &mut System,
+        inserters: Vec<Inserter>,
+        outlets: Vec<Outlet>,
+        every: u64,
+        walls: Vec<Wall>,
+    ) -> Self {
+        let n = sys.particles.len();
+        sys.id = (0..n as u64).collect();
+        Self {
+            inserters,
+            outlets,
+            every: every.max(1),
+            walls,
+            next_id: n as u64,
+            made_by: vec![SCENE; n],
+            scene: n as u64,
+            departed: Vec::new(),
+        }
+    }
+
+    /// The random numbers of inserter `c` at `step`: a generator seeded
+    /// through SplitMix64 from the seed, the step and the inserter.
+    fn stream(seed: u64, step: u64, c: usize) -> Xoshiro256PlusPlus {
+        Xoshiro256PlusPlus::seed_from_u64(
+            seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(17)
+                ^ (c as u64 + 1)
+                    .wrapping_mul(0x94D0_49BB_1331_11EB)
+                    .rotate_left(41),
+        )
+    }
+
+    /// The event at the system's step: the outlets take out what reached
+    /// them (in particle order, each particle through the first outlet
+    /// that takes it), then each inserter in turn brings its stream up to
+    /// the system's time. The interactions hear of both.
+    pub fn apply(&mut self, sys: &mut System, forces: &mut ForceField, seed: u64) {
+        let (step, time) = (sys.step, sys.time);
+        self.departed.clear();
+        let n = sys.particles.len();
+        let mut keep = vec![true; n];
+        for (i, kept) in keep.iter_mut().enumerate() {
+            let p = &sys.particles;
+            let x = sys.boundary.wrap(p.position[i]);
+            let Some(k) = self.outlets.iter().position(|o| o.takes(x)) else {
+                continue;
+            };
+            *kept = false;
+            let outlet = &mut self.outlets[k];
+            outlet.removed += 1;
+            outlet.mass += p.mass[i];
+            outlet.charge += p.charge[i];
+            self.departed.push(Departure {
+                step,
+                time,
+                id: sys.id_of(i),
+                outlet: k,
+                species: sys.species.get(i).cloned().unwrap_or_else(|| "X".into()),
+                mass: p.mass[i],
+                charge: p.charge[i],
+                radius: p.radius[i],
+                position: p.position[i],
+                velocity: p.velocity[i],
+            });
+        }
+        let removed = !self.departed.is_empty();
+        if removed {
+            sys.retain_particles(&keep);
+            crate::domain::retain(&mut self.made_by, &keep);
+        }
+        let mut arrived = Vec::new();
+        let (t, rotating) = (sys.time, forces.exerts_torques());
+        for c in 0..self.inserters.len() {
+            let mut rng = Self::stream(seed, step, c);
+            let made = self.inserters[c].insert(sys, &self.walls, t, &mut rng);
+            for m in made {
+                let id = self.next_id;
+                self.next_id += 1;
+                add(sys, m.init, &m.species, id, rotating);
+                self.made_by.push(c as u32);
+                arrived.push(id);
+            }
+        }
+        if removed || !arrived.is_empty() {
+            forces.particles_changed(removed.then_some(&keep), &arrived);
+        }
+    }
+
+    /// Particles in and out, and their masses, since the run began: for
+    /// each inserter (inserted, mass), for each outlet (removed, mass).
+    pub fn columns(&self) -> Vec<f64> {
+        let ins = self
+            .inserters
+            .iter()
+            .flat_map(|i| [i.inserted as f64, i.mass]);
+        let outs = self.outlets.iter().flat_map(|o| [o.removed as f64, o.mass]);
+        ins.chain(outs).collect()
+    }
+
+    /// The names of [`Flow::columns`]: `in_NAME`, `mass_in_NAME`,
+    /// `out_NAME`, `mass_out_NAME`.
+    pub fn column_names(&self) -> Vec<String> {
+        let ins = self
+            .inserters
+            .iter()
+            .flat_map(|i| [format!("in_{}", i.name), format!("mass_in_{}", i.name)]);
+        let outs = self
+            .outlets
+            .iter()
+            .flat_map(|o| [format!("out_{}", o.name), format!("mass_out_{}", o.name)]);
+        ins.chain(outs).collect()
+    }
+
+    /// What came and went, for the run's summary.
+    pub fn summary(&self, held: usize) -> String {
+        let n_in: u64 = self.inserters.iter().map(|i| i.inserted).sum();
+        let n_out: u64 = self.outlets.iter().map(|o| o.removed).sum();
+        let m_in: f64 = self.inserters.iter().map(|i| i.mass).sum();
+        let m_out: f64 = self.outlets.iter().map(|o| o.mass).sum();
+        let mut text = format!(
+            "Flow: {n_in} particles inserted (mass {m_in:.6e}), {n_out} removed (mass {m_out:.6e}), \
+             {held} held."
+        );
+        for i in self.inserters.iter().filter(|i| i.most_behind > 0) {
+            text.push_str(&format!(
+                " Inserter {} fell behind its rate by up to {} particle{}: its region was too full.",
+                i.name,
+                i.most_behind,
+                if i.most_behind == 1 { "" } else { "s" }
+            ));
+        }
+        text
+    }
+
+    /// What a checkpoint needs: the next id; each inserter's count, mass
+    /// and lag; each outlet's count, mass and charge; then a row per
+    /// particle (id, inserter or −1 for the scene's, radius, mass).
+    pub fn carried_state(&self, sys: &System) -> Vec<f64> {
+        let mut out = vec![self.next_id as f64, self.inserters.len() as f64];
+        for i in &self.inserters {
+            out.extend([i.inserted as f64, i.mass, i.most_behind as f64]);
+        }
+        out.push(self.outlets.len() as f64);
+        for o in &self.outlets {
+            out.extend([o.removed as f64, o.mass, o.charge]);
+        }
+        let p = &sys.particles;
+        for (i, by) in self.made_by.iter().enumerate() {
+            let by = if *by == SCENE { -1.0 } else { *by as f64 };
+            out.extend([sys.id_of(i) as f64, by, p.radius[i], p.mass[i]]);
+        }
+        out
+    }
+
+    /// Makes `sys`, freshly built from the scene, hold the particles of
+    /// [`Flow::carried_state`]: the scene's particles still there, then
+    /// those inserted, each from its inserter with its size (positions and
+    /// velocities are the checkpoint's, put in after).
+    pub fn restore(
+        &mut self,
+        state: &[f64],
+        sys: &mut System,
+        forces: &mut ForceField,
+    ) -> Result<(), String> {
+        let bad = |what: &str| format!("flow: {what}");
+        let whole = |x: f64| x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53);
+        let mut at = 0;
+        let mut take = |k: usize| -> Result<&[f64], String> {
+            let slice = state
+                .get(at..at + k)
+                .ok_or_else(|| bad("the carried state is cut short"))?;
+            at += k;
+            Ok(slice)
+        };
+        let head = take(2)?;
+        let (next_id, inserters) = (head[0], head[1]);
+        if !whole(next_id) || inserters != self.inserters.len() as f64 {
+            return Err(bad("the checkpoint's inserters are not the scene's"));
+        }
+        for i in &mut self.inserters {
+            let r = take(3)?;
+            if !whole(r[0]) || !whole(r[2]) {
+                return Err(bad("an inserter's count is not a whole number"));
+            }
+            (i.inserted, i.mass, i.most_behind) = (r[0] as u64, r[1], r[2] as u64);
+        }
+        if take(1)?[0] != self.outlets.len() as f64 {
+            return Err(bad("the checkpoint's outlets are not the scene's"));
+        }
+        for o in &mut self.outlets {
+            let r = take(3)?;
+            if !whole(r[0]) {
+                return Err(bad("an outlet's count is not a whole number"));
+            }
+            (o.removed, o.mass, o.charge) = (r[0] as u64, r[1], r[2]);
+        }
+        let rows = &state[at..];
+        if !rows.len().is_multiple_of(4) {
+            return Err(bad("particle rows of 4 numbers expected"));
+        }
+        let scene = sys.particles.len();
+        let mut keep = vec![false; scene];
+        let mut last = None;
+        let mut inserted = Vec::new();
+        for r in rows.chunks(4) {
+            let (id, by) = (r[0], r[1]);
+            if !whole(id) || last.is_some_and(|l| id <= l) || id >= next_id {
+                return Err(bad(&format!("particle id {id} out of order")));
+            }
+            last = Some(id);
+            if by == -1.0 {
+                if id >= scene as f64 {
+                    return Err(bad(&format!("particle {id} is not one the scene makes")));
+                }
+                keep[id as usize] = true;
+            } else if whole(by) && (by as usize) < self.inserters.len() {
+                inserted.push((id as u64, by as usize, r[2], r[3]));
+            } else {
+                return Err(bad(&format!("particle {id} names inserter {by}")));
+            }
+        }
+        sys.retain_particles(&keep);
+        sys.id = (0..scene as u64)
+            .zip(&keep)
+            .filter(|k| *k.1)
+            .map(|k| k.0)
+            .collect();
+        self.made_by = vec![SCENE; sys.particles.len()];
+        forces.particles_changed(Some(&keep), &[]);
+        let mut arrived = Vec::new();
+        for (id, by, radius, mass) in inserted {
+            let ins = &self.inserters[by];
+            let mut init = ins.particle(radius);
+            if init.mass != mass {
+                return Err(bad(&format!(
+                    "particle {id}: mass {mass} is not inserter {}'s for radius {radius}",
+                    ins.name
+                )));
+            }
+            init.position = DVec3::ZERO;
+            add(sys, init, &ins.species.clone(), id, forces.exerts_torques());
+            self.made_by.push(by as u32);
+            arrived.push(id);
+        }
+        forces.particles_changed(None, &arrived);
+        self.next_id = next_id as u64;
+        self.scene = scene as u64;
+        Ok(())
+    }
+}
+
+/// Appends a particle of id `id` and species `species` to `sys`, with
+/// zero carried accelerations where the integrator carries them (angular
+/// ones where the forces turn the particles).
+fn add(
+    sys: &mut System,
+    init: crate::particles::ParticleInit,
+    species: &str,
+    id: u64,
+    rotating: bool,
+) {
+    let n = sys.particles.len();
+    if sys.species.len() != n {
+        sys.species = vec!["X".to_string(); n];
+    }
+    if sys.carried_acceleration.len() == n {
+        sys.carried_acceleration.push(DVec3::ZERO);
+    }
+    if rotating && sys.carried_angular_acceleration.len() == n {
+        sys.carried_angular_acceleration.push(DVec3::ZERO);
+    }
+    sys.particles.push(init);
+    sys.species.push(species.to_string());
+    sys.id.push(id);
+}

@@ -1,0 +1,259 @@
+//! Particles coming and going (`[[insert]]`, `[[outlet]]`): rates held,
+//! no overlap at insertion, exact mass balance, contact histories that
+//! follow their particles through a removal, and refusals.
+
+use mote_md::scene::Scene;
+use mote_md::{DVec3, Simulation};
+use mote_run::Propagator;
+
+/// Grains poured into a closed box at 3000 a second (two sizes), taken
+/// out where they reach the left half of the floor; the right half piles
+/// up under the stream.
+const POUR: &str = r#"
+[run]
+integrator = "leapfrog"
+dt = 2e-5
+
+[field]
+g = [0.0, 0.0, -9.81]
+
+[granular]
+young = 5e6
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+
+[[wall]]
+kind = "box"
+name = "bin"
+lo = [0.0, 0.0, 0.0]
+hi = [0.03, 0.03, 0.08]
+
+[[insert]]
+name = "feed"
+lo = [0.001, 0.001, 0.05]
+hi = [0.029, 0.029, 0.075]
+rate = 3000.0
+radius = 0.0008
+sizes = "bi:1.5:0.3"
+density = 2500.0
+velocity = [0.0, 0.0, -0.3]
+velocity_spread = 0.05
+every = 100
+
+[[outlet]]
+name = "drain"
+lo = [-1.0, -1.0, -1.0]
+hi = [0.012, 1.0, 0.004]
+every = 100
+"#;
+
+fn build(text: &str, seed: u64) -> Simulation {
+    Scene::parse(text, "pour.toml")
+        .unwrap()
+        .build(text, "pour.toml", seed)
+        .unwrap()
+        .simulation
+}
+
+/// The pairs (i, j) of `sim`'s particles that overlap, and the particles
+/// that cut into the bin's walls, among those with ids ≥ `from`.
+fn overlaps_of_new(sim: &Simulation, from: u64) -> Vec<(u64, u64)> {
+    let s = &sim.system;
+    let p = &s.particles;
+    let (lo, hi) = (DVec3::ZERO, DVec3::new(0.03, 0.03, 0.08));
+    let mut bad = Vec::new();
+    for i in (0..p.len()).filter(|&i| s.id[i] >= from) {
+        let (x, r) = (p.position[i], p.radius[i]);
+        if (x - r).cmplt(lo).any() || (x + r).cmpgt(hi).any() {
+            bad.push((s.id[i], u64::MAX));
+        }
+        for j in 0..p.len() {
+            let reach = r + p.radius[j];
+            if j != i && p.position[j].distance_squared(x) < reach * reach {
+                bad.push((s.id[i], s.id[j]));
+            }
+        }
+    }
+    bad
+}
+
+#[test]
+fn a_stream_holds_its_rate_lands_clear_and_balances_in_out_and_held() {
+    let mut sim = build(POUR, 7);
+    sim.prime(&mut |_| {}).unwrap();
+    let rate = 3000.0;
+    let mut next_new = 0;
+    let mut events = 0;
+    let mut removed_seen = 0;
+    for _ in 0..20_000 {
+        let before = sim.system.particles.len();
+        sim.advance().unwrap();
+        let step = sim.system.step;
+        if !step.is_multiple_of(100) {
+            assert_eq!(
+                sim.system.particles.len(),
+                before,
+                "no event at step {step}"
+            );
+            continue;
+        }
+        events += 1;
+        // Nothing inserted overlaps a particle or a wall.
+        let bad = overlaps_of_new(&sim, next_new);
+        assert!(bad.is_empty(), "step {step}: overlaps {bad:?}");
+        next_new = sim.system.id.last().map_or(0, |id| id + 1);
+        let flow = sim.flow.as_ref().unwrap();
+        let (feed, drain) = (&flow.inserters[0], &flow.outlets[0]);
+        // The count owed by the time: ⌊ṅ t⌋, exactly.
+        assert_eq!(
+            feed.inserted,
+            (rate * sim.system.time).floor() as u64,
+            "t = {}",
+            sim.system.time
+        );
+        // In − out = held, in number and in mass.
+        let held = sim.system.particles.len() as u64;
+        assert_eq!(feed.inserted - drain.removed, held, "step {step}");
+        let mass: f64 = sim.system.particles.mass.iter().sum();
+        assert!(
+            (feed.mass - drain.mass - mass).abs() <= 1e-12 * feed.mass,
+            "step {step}: {} − {} against {mass}",
+            feed.mass,
+            drain.mass
+        );
+        // Each departure is a particle that was in the drain's region.
+        for d in &flow.departed {
+            assert!(d.position.x < 0.012 && d.position.z < 0.004, "{d:?}");
+        }
+        removed_seen += flow.departed.len() as u64;
+        // Ids increase along the particles.
+        assert!(sim.system.id.windows(2).all(|w| w[0] < w[1]));
+    }
+    let flow = sim.flow.as_ref().unwrap();
+    assert_eq!(events, 200);
+    // The run is long enough to hold the rate to 1 % and to drain.
+    let t = sim.system.time;
+    let held = flow.inserters[0].inserted as f64 / (rate * t);
+    assert!((held - 1.0).abs() < 0.01, "{held}");
+    assert_eq!(flow.inserters[0].most_behind, 0);
+    assert!(removed_seen > 100, "{removed_seen} removed");
+    assert_eq!(removed_seen, flow.outlets[0].removed);
+    // Both sizes came.
+    let large = (sim.system.particles.radius.iter())
+        .filter(|r| **r > 0.001)
+        .count();
+    let n = sim.system.particles.len();
+    assert!(large > n / 10 && large < n / 2, "{large} of {n} large");
+}
+
+/// Two spheres leaning on each other on a floor, and a third far off in
+/// an outlet: taken out at the first event, it leaves the pair's motion,
+/// whose friction carries a shear history, bit for bit as in the scene
+/// without it (the history follows the pair's ids through the removal).
+#[test]
+fn a_removal_leaves_the_other_contacts_and_their_histories_as_they_were() {
+    let pair = r#"
+[run]
+integrator = "leapfrog"
+dt = 1e-5
+
+[field]
+g = [0.0, 0.0, -9.81]
+
+[granular]
+young = 1e6
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+skin = 0.001
+
+[[wall]]
+kind = "plane"
+name = "floor"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+
+[[particle]]
+position = [0.0, 0.0, 0.002]
+radius = 0.002
+density = 2500.0
+
+[[particle]]
+position = [0.0025, 0.0, 0.0051]
+radius = 0.002
+density = 2500.0
+"#;
+    let far = "\n[[particle]]\nposition = [0.5, 0.5, 0.5]\nvelocity = [0.0, 0.0, 9.81e-3]\nradius = 0.002\ndensity = 2500.0\n";
+    let outlet = "\n[[outlet]]\nlo = [0.4, 0.4, 0.4]\nevery = 50\n";
+    // The far sphere first: the pair are particles 1 and 2.
+    let with = format!(
+        "{}{far}{}{outlet}",
+        &pair[..pair.find("[[particle]]").unwrap()],
+        &pair[pair.find("[[particle]]").unwrap()..]
+    );
+    let mut a = build(&with, 3);
+    let mut b = build(pair, 3);
+    assert_eq!(a.system.particles.len(), 3);
+    a.prime(&mut |_| {}).unwrap();
+    b.prime(&mut |_| {}).unwrap();
+    for step in 1..=3000 {
+        a.advance().unwrap();
+        b.advance().unwrap();
+        if step == 50 {
+            // The pair touches as the far one leaves.
+            let p = &b.system.particles;
+            assert!(p.position[0].distance(p.position[1]) < 0.004);
+        }
+        if step >= 50 {
+            assert_eq!(a.system.id, [1, 2]);
+            assert_eq!(
+                a.system.particles.position, b.system.particles.position,
+                "step {step}"
+            );
+            assert_eq!(
+                a.system.particles.angular_velocity,
+                b.system.particles.angular_velocity
+            );
+        }
+    }
+    // The upper sphere slides and rolls off the lower.
+    let p = &b.system.particles;
+    assert!(
+        p.position[1].x - p.position[0].x > 0.0035,
+        "{:?}",
+        p.position
+    );
+}
+
+#[test]
+fn flows_are_refused_where_they_cannot_run() {
+    let base = "[run]\ndt = 1e-4\nintegrator = \"leapfrog\"\n[[particle]]\nposition = [0.0, 0.0, 0.0]\nradius = 0.001\n";
+    let cases = [
+        ("[[insert]]\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, -1.0]\nrate = 1.0\nradius = 0.1\ndensity = 1.0\n", 7, "lo < hi"),
+        ("[[insert]]\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, 1.0]\nrate = 1.0\nmass_rate = 2.0\nradius = 0.1\ndensity = 1.0\n", 7, "not both"),
+        ("[[insert]]\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, 1.0]\nradius = 0.1\ndensity = 1.0\n", 7, "give rate"),
+        ("[[insert]]\nlo = [0.0, 0.0, 0.0]\nhi = [1.0, 1.0, 1.0]\nrate = 1.0\nradius = 0.1\ndensity = 1.0\nsizes = \"tri\"\n", 7, "unknown size distribution"),
+        ("[[outlet]]\npoint = [0.0, 0.0, 0.0]\n", 7, "give a region"),
+        ("[[outlet]]\nhi = [1.0, 1.0, 1.0]\nevery = 10\n[[outlet]]\nlo = [2.0, 2.0, 2.0]\nevery = 20\n", 10, "share one interval"),
+        ("[[outlet]]\nhi = [1.0, 1.0, 1.0]\n[gravity]\nG = 1.0\n", 7, "cannot come and go under gravity"),
+    ];
+    for (extra, line, words) in cases {
+        let text = format!("{base}{extra}");
+        let scene = Scene::parse(&text, "s.toml").unwrap();
+        let e = match scene.build(&text, "s.toml", 1) {
+            Err(e) => e,
+            Ok(_) => panic!("{extra} must be refused"),
+        };
+        assert_eq!(e.line, line, "{e}");
+        assert!(e.message.contains(words), "{e}");
+    }
+    // RK4 cannot carry new particles.
+    let text = "[run]\ndt = 1e-4\nintegrator = \"rk4\"\n[[particle]]\nposition = [0.0, 0.0, 0.0]\nradius = 0.001\n[[outlet]]\nhi = [1.0, 1.0, 1.0]\n";
+    let e = Scene::parse(text, "s.toml")
+        .unwrap()
+        .build(text, "s.toml", 1)
+        .err()
+        .unwrap();
+    assert!(e.message.contains("leapfrog"), "{e}");
+}
