@@ -257,3 +257,83 @@ fn flows_are_refused_where_they_cannot_run() {
         .unwrap();
     assert!(e.message.contains("leapfrog"), "{e}");
 }
+
+/// A lid (a plane wall with `travel`) brings a loose bed of 400 spheres
+/// from a solid fraction of 0.2 to 0.55 (a free volume of 45 %), then
+/// stops: the bed is held below it, its spheres rearranged rather than
+/// crushed, and the lid bears the bed's load.
+#[test]
+fn a_lid_compresses_a_bed_to_a_set_free_volume_and_stays() {
+    let scene = r#"
+[run]
+integrator = "leapfrog"
+dt = 4e-6
+
+[field]
+g = [0.0, 0.0, -9.81]
+
+[granular]
+young = 5e6
+poisson = 0.3
+restitution = 0.3
+friction = 0.1
+
+[[wall]]
+kind = "box"
+name = "bin"
+lo = [0.0, 0.0, 0.0]
+hi = [0.01, 0.01, 0.0105]
+
+[[wall]]
+kind = "plane"
+name = "lid"
+point = [0.0, 0.0, 0.0105]
+normal = [0.0, 0.0, -1.0]
+velocity = [0.0, 0.0, -0.05]
+travel = 0.0066920
+
+[[cloud]]
+n = 400
+min = [0.0, 0.0, 0.0]
+max = [0.01, 0.01, 0.0104]
+radius = 0.0005
+density = 2500.0
+"#;
+    let mut sim = build(scene, 2);
+    sim.prime(&mut |_| {}).unwrap();
+    let v = 4.0 / 3.0 * std::f64::consts::PI * 0.0005f64.powi(3);
+    let h = 0.0105 - 0.0066920;
+    let solid = 400.0 * v / (1e-4 * h);
+    assert!((solid - 0.55).abs() < 1e-4, "{solid}");
+    // 0.134 s of travel, then 0.03 s at rest.
+    for _ in 0..41_000 {
+        sim.advance().unwrap();
+    }
+    let p = &sim.system.particles;
+    let top = (0..p.len())
+        .map(|i| p.position[i].z + p.radius[i])
+        .fold(0.0, f64::max);
+    let deepest = |i: usize| -> f64 {
+        let mut d: f64 = 0.0;
+        for j in 0..p.len() {
+            if j != i {
+                d = d.max(p.radius[i] + p.radius[j] - p.position[i].distance(p.position[j]));
+            }
+        }
+        d
+    };
+    let overlap = (0..p.len()).map(deepest).fold(0.0, f64::max);
+    assert!(
+        top < h + 0.1 * 0.0005,
+        "a sphere above the lid: {top} against {h}"
+    );
+    assert!(overlap < 0.1 * 0.0005, "overlap {overlap}");
+    let obs = mote_md::Observables::measure(&sim.system, &mut sim.forces);
+    let lid = obs.wall_forces.iter().find(|w| w.0 == "lid").unwrap().1;
+    let weight = 400.0 * 2500.0 * v * 9.81;
+    assert!(
+        lid.z > 0.1 * weight,
+        "the lid bears {} of the weight {weight}",
+        lid.z
+    );
+}

@@ -35,7 +35,7 @@ use super::interaction::{BodyInteraction, BodyView};
 use crate::boundary::Boundary;
 use crate::boundary::MinimumImage;
 use crate::force::granular::history::{block_firsts, history_of, split_blocks, PAIR_ROW};
-use crate::force::granular::{ContactForce, ContactLaw, History, PairHistories, Wall, WallShape};
+use crate::force::granular::{ContactForce, ContactLaw, History, PairHistories, Wall};
 use crate::neighbor::VerletList;
 
 /// Contact parameters shared by all sphere pairs and walls. Stiffness comes
@@ -438,16 +438,7 @@ impl BodyInteraction for RigidContacts {
             view,
             law: &self.wall_law,
             walls: &self.walls,
-            planes: self
-                .walls
-                .iter()
-                .map(|w| match w.shape {
-                    WallShape::Plane { point, normal } => {
-                        Some((normal, (point + w.velocity * t).dot(normal)))
-                    }
-                    WallShape::Cylinder { .. } => None,
-                })
-                .collect(),
+            planes: self.walls.iter().map(|w| w.plane_at(t)).collect(),
         };
         let n_walls = self.walls.len();
         if st.wall_history.len() != n * n_walls {

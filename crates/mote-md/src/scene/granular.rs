@@ -75,6 +75,9 @@ pub struct WallSpec {
     /// Angular speed about the cylinder's axis or the plane's normal (rad/s).
     #[serde(default)]
     pub angular_speed: f64,
+    /// The distance the wall translates before it stops (default: it
+    /// never stops).
+    pub travel: Option<f64>,
 }
 
 impl Section for GranularSettings {
@@ -218,8 +221,15 @@ impl WallSpec {
                 ))
             }
         };
+        let velocity = DVec3::from(w.velocity);
+        let stop = match w.travel {
+            None => f64::INFINITY,
+            Some(d) if d > 0.0 && velocity != DVec3::ZERO => d / velocity.length(),
+            Some(_) => return Err("travel: a positive distance, for a wall with a velocity".into()),
+        };
         for wall in &mut walls {
-            wall.velocity = DVec3::from(w.velocity);
+            wall.velocity = velocity;
+            wall.stop = stop;
             wall.angular_speed = w.angular_speed;
         }
         Ok(walls)

@@ -31,9 +31,11 @@ pub enum WallShape {
 pub struct Wall {
     pub name: String,
     pub shape: WallShape,
-    /// The wall moves rigidly with this velocity: its position at time t is
-    /// the t = 0 position plus velocity · t.
+    /// The wall moves rigidly with this velocity until time `stop`: its
+    /// position at time t is the t = 0 position plus velocity · min(t,
+    /// stop) (a lid that compresses to a set height, then stays).
     pub velocity: DVec3,
+    pub stop: f64,
     /// Angular speed Ω about the axis (cylinder) or the normal through
     /// `point` (plane); the wall's surface moves at Ω × (x − point).
     pub angular_speed: f64,
@@ -49,6 +51,7 @@ impl Wall {
                 normal: normal.normalize(),
             },
             velocity: DVec3::ZERO,
+            stop: f64::INFINITY,
             angular_speed: 0.0,
         }
     }
@@ -74,13 +77,41 @@ impl Wall {
                 radius,
             },
             velocity: DVec3::ZERO,
+            stop: f64::INFINITY,
             angular_speed: 0.0,
+        }
+    }
+
+    /// How far the wall has moved by time t.
+    #[inline(always)]
+    pub fn shift(&self, t: f64) -> DVec3 {
+        self.velocity * t.min(self.stop)
+    }
+
+    /// The wall's translation velocity at time t (zero once stopped).
+    #[inline(always)]
+    pub fn translation(&self, t: f64) -> DVec3 {
+        if t < self.stop {
+            self.velocity
+        } else {
+            DVec3::ZERO
+        }
+    }
+
+    /// A plane as (n, c), its gap x·n − c at time t; `None` for a
+    /// cylinder.
+    pub fn plane_at(&self, t: f64) -> Option<(DVec3, f64)> {
+        match self.shape {
+            WallShape::Plane { point, normal } => {
+                Some((normal, (point + self.shift(t)).dot(normal)))
+            }
+            WallShape::Cylinder { .. } => None,
         }
     }
 
     /// Where the wall is at time t, for the live viewer.
     pub fn geometry(&self, t: f64) -> mote_run::WallGeometry {
-        let shift = self.velocity * t;
+        let shift = self.shift(t);
         match self.shape {
             WallShape::Plane { point, normal } => mote_run::WallGeometry::Plane {
                 point: (point + shift).to_array(),
@@ -104,15 +135,13 @@ impl Wall {
     #[inline(always)]
     pub fn gap(&self, x: DVec3, t: f64) -> (f64, DVec3) {
         match self.shape {
-            WallShape::Plane { point, normal } => {
-                ((x - point - self.velocity * t).dot(normal), normal)
-            }
+            WallShape::Plane { point, normal } => ((x - point - self.shift(t)).dot(normal), normal),
             WallShape::Cylinder {
                 point,
                 axis,
                 radius,
             } => {
-                let rel = x - point - self.velocity * t;
+                let rel = x - point - self.shift(t);
                 let radial = rel - axis * rel.dot(axis);
                 let rho = radial.length();
                 let outward = if rho > 0.0 { radial / rho } else { DVec3::X };
@@ -126,14 +155,14 @@ impl Wall {
     #[inline]
     pub fn surface_velocity(&self, x: DVec3, gap: f64, n: DVec3, t: f64) -> DVec3 {
         if self.angular_speed == 0.0 {
-            return self.velocity;
+            return self.translation(t);
         }
         let (point, axis) = match self.shape {
             WallShape::Plane { point, normal } => (point, normal),
             WallShape::Cylinder { point, axis, .. } => (point, axis),
         };
         let contact = x - n * gap;
-        self.velocity + (axis * self.angular_speed).cross(contact - point - self.velocity * t)
+        self.translation(t) + (axis * self.angular_speed).cross(contact - point - self.shift(t))
     }
 }
 
@@ -186,15 +215,7 @@ impl GranularWalls {
         }
         let radius = state.radius;
         // Planes as (n, c) with gap = x·n − c at this time.
-        let planes: Vec<Option<(DVec3, f64)>> = walls
-            .iter()
-            .map(|w| match w.shape {
-                WallShape::Plane { point, normal } => {
-                    Some((normal, (point + w.velocity * t).dot(normal)))
-                }
-                WallShape::Cylinder { .. } => None,
-            })
-            .collect();
+        let planes: Vec<Option<(DVec3, f64)>> = walls.iter().map(|w| w.plane_at(t)).collect();
         let planes = &planes;
         self.found
             .resize_with(force.len().div_ceil(CHUNK), Default::default);
