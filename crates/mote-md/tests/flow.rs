@@ -337,3 +337,77 @@ density = 2500.0
         lid.z
     );
 }
+
+/// A mass rate: by each event the stream has made the fewest spheres
+/// whose mass reaches ṁ t (lognormal sizes, so one sphere's mass at most
+/// over); a volume fraction alone fills its region to just under it at
+/// every event, and no further while nothing leaves.
+#[test]
+fn a_mass_rate_and_a_fill_to_a_volume_fraction_are_met() {
+    let scene = r#"
+[run]
+integrator = "leapfrog"
+dt = 1e-5
+
+[granular]
+young = 5e6
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [0.02, 0.02, 0.02]
+periodic = [true, true, true]
+
+[[insert]]
+name = "stream"
+lo = [0.0, 0.0, 0.0]
+hi = [0.02, 0.02, 0.01]
+mass_rate = 0.002
+radius = 0.0005
+sizes = "lognormal:0.2"
+density = 2500.0
+every = 20
+
+[[insert]]
+name = "fill"
+lo = [0.0, 0.0, 0.012]
+hi = [0.02, 0.02, 0.02]
+volume_fraction = 0.3
+radius = 0.0004
+density = 1000.0
+attempts = 5000
+"#;
+    let mut sim = build(scene, 4);
+    sim.prime(&mut |_| {}).unwrap();
+    let largest = 2500.0 * 4.0 / 3.0
+        * std::f64::consts::PI
+        * (0.0005f64 * (-3.5f64 * 0.04 + 0.8).exp()).powi(3);
+    let fill_volume = 0.02 * 0.02 * 0.008;
+    let one = 4.0 / 3.0 * std::f64::consts::PI * 0.0004f64.powi(3);
+    let mut filled_count = 0;
+    for _ in 0..2000 {
+        sim.advance().unwrap();
+        if !sim.system.step.is_multiple_of(20) {
+            continue;
+        }
+        let flow = sim.flow.as_ref().unwrap();
+        let (stream, fill) = (&flow.inserters[0], &flow.inserters[1]);
+        let owed = 0.002 * sim.system.time;
+        assert!(
+            stream.mass >= owed && stream.mass < owed + largest,
+            "{} against {owed}",
+            stream.mass
+        );
+        let solid = fill.inserted as f64 * one / fill_volume;
+        assert!(solid <= 0.3 && solid > 0.3 - one / fill_volume, "{solid}");
+        if filled_count == 0 {
+            filled_count = fill.inserted;
+        }
+        assert_eq!(fill.inserted, filled_count, "the filled region took more");
+    }
+    let sizes = &sim.system.particles.radius;
+    let spread = sizes.iter().filter(|r| **r > 0.00045).count();
+    assert!(spread > 10, "lognormal sizes: {spread}");
+}
