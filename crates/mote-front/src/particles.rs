@@ -431,6 +431,14 @@ fn summary(report: &RunReport, sim: &Simulation, scene: &Scene, dir: &Path) -> S
             "Overdamped dynamics conserve no energy: potential energy went from {:.9e} to {:.9e} {}.",
             report.initial.potential, report.last.potential, e_unit
         )
+    } else if sim.flow.is_some() {
+        // Particles carry energy in and out: no drift to report.
+        format!(
+            "Particles come and go, carrying energy in and out (no drift to report): total energy went from {:.9e} to {:.9e} {}.",
+            report.initial.total_energy(),
+            report.last.total_energy(),
+            e_unit,
+        )
     } else if sim.thermostat.is_some() {
         // A bath exchanges energy with the system: a "drift" would mean
         // nothing; the temperature is what the thermostat holds.

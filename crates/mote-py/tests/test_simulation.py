@@ -258,6 +258,9 @@ def test_bad_input_raises_with_the_line():
         mote.Simulation.from_toml(LJ).run(steps=1, until=1.0)
     with pytest.raises(OSError, match="no/such/scene.toml"):
         mote.Simulation.from_file("no/such/scene.toml")
+    # Particles that come and go would move the arrays under the views.
+    with pytest.raises(ValueError, match="come and go.*mote.run"):
+        mote.Simulation.from_file("example:chute-flow")
 
 
 def test_an_unstable_run_raises_naming_step_and_particle_and_keeps_the_state():
@@ -293,6 +296,7 @@ def test_every_engine_runs_whole(tmp_path):
     for scene, kw in [
         ("example:cube", {"until": 0.5}),
         ("example:magnet-in-field", {"steps": 20}),
+        ("example:chute-flow", {"steps": 600}),
         ("[packing]\nn = 100\nmax_pressure = 1e5\n", {}),
         (LJ, {"steps": 10}),
     ]:

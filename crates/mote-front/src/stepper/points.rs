@@ -99,6 +99,13 @@ impl Points {
         let scene = Scene::parse(text, label)?;
         let (seed, _) = crate::seed::resolve(seed, scene.seed);
         let built = scene.build(text, label, seed)?;
+        if built.simulation.flow.is_some() {
+            // The views are mote's arrays, which insertion reallocates.
+            return Err(FrontError::request(format!(
+                "{label}: particles that come and go ([[insert]], [[outlet]]) change the arrays \
+                 mote.Simulation shows as views; run this scene with mote.run()"
+            )));
+        }
         if built.simulation.dt <= 0.0 {
             return Err(FrontError::request(format!(
                 "{label}: no time step ([run] dt)"
