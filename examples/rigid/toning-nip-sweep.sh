@@ -6,7 +6,8 @@
 # Loadings above 160 beads cannot be placed at random: the developer is
 # first compressed into the gap (example:toning-nip-compress with N beads
 # and 4 N toner, a lid travelling down to the shell), and the nip starts
-# from its last frame (`[[from_file]]`).
+# from its last frame (`[[from_file]]`); COMPRESS_ABOVE=0 prepares every
+# loading so (the control of docs/toning-nip.md).
 #
 #   examples/rigid/toning-nip-sweep.sh [OUT] [N ...]
 #   MOTE=target/release/mote SEED=12 examples/rigid/toning-nip-sweep.sh out/sweep 40 80 120 160
@@ -32,7 +33,7 @@ for n in $LOADS; do
   loaded() {
     awk -v n="$n" -v t="$t" '/^n = / { k++; if (k == 1) $0 = "n = " n; else if (k == 2) $0 = "n = " t } { print }' "$1"
   }
-  if [ "$n" -gt 160 ]; then
+  if [ "$n" -gt "${COMPRESS_ABOVE:-160}" ]; then
     loaded "$COMPRESS" > "$OUT/compress-$n.toml"
     "$MOTE" -q --seed "$SEED" run "$OUT/compress-$n.toml" -o "$OUT/compress-$n"
     # The nip's developer from the compressed frame.

@@ -106,7 +106,12 @@ impl ObservablesCsv {
             columns.push("N".into());
             unit_row.push("1".into());
             for name in flow.column_names() {
-                unit_row.push(if name.starts_with("mass") { m } else { "1" }.into());
+                let unit = match name.split('_').next() {
+                    Some("mass") => m,
+                    Some("charge") => "charge",
+                    _ => "1",
+                };
+                unit_row.push(unit.into());
                 columns.push(name);
             }
         }

@@ -39,6 +39,7 @@ sizes = "bi:1.5:0.3"
 density = 2500.0
 velocity = [0.0, 0.0, -0.3]
 velocity_spread = 0.05
+charge = 1e-12
 every = 100
 
 [[outlet]]
@@ -122,6 +123,9 @@ fn a_stream_holds_its_rate_lands_clear_and_balances_in_out_and_held() {
             feed.mass,
             drain.mass
         );
+        // The charge out is the removed particles'.
+        let q = drain.removed as f64 * 1e-12;
+        assert!((drain.charge - q).abs() <= 1e-12 * q, "{} against {q}", drain.charge);
         // Each departure is a particle that was in the drain's region.
         for d in &flow.departed {
             assert!(d.position.x < 0.012 && d.position.z < 0.004, "{d:?}");

@@ -179,27 +179,31 @@ impl Flow {
     }
 
     /// Particles in and out, and their masses, since the run began: for
-    /// each inserter (inserted, mass), for each outlet (removed, mass).
+    /// each inserter (inserted, mass), for each outlet (removed, mass,
+    /// charge).
     pub fn columns(&self) -> Vec<f64> {
         let ins = self
             .inserters
             .iter()
             .flat_map(|i| [i.inserted as f64, i.mass]);
-        let outs = self.outlets.iter().flat_map(|o| [o.removed as f64, o.mass]);
+        let outs = (self.outlets.iter()).flat_map(|o| [o.removed as f64, o.mass, o.charge]);
         ins.chain(outs).collect()
     }
 
     /// The names of [`Flow::columns`]: `in_NAME`, `mass_in_NAME`,
-    /// `out_NAME`, `mass_out_NAME`.
+    /// `out_NAME`, `mass_out_NAME`, `charge_out_NAME`.
     pub fn column_names(&self) -> Vec<String> {
         let ins = self
             .inserters
             .iter()
             .flat_map(|i| [format!("in_{}", i.name), format!("mass_in_{}", i.name)]);
-        let outs = self
-            .outlets
-            .iter()
-            .flat_map(|o| [format!("out_{}", o.name), format!("mass_out_{}", o.name)]);
+        let outs = self.outlets.iter().flat_map(|o| {
+            [
+                format!("out_{}", o.name),
+                format!("mass_out_{}", o.name),
+                format!("charge_out_{}", o.name),
+            ]
+        });
         ins.chain(outs).collect()
     }
 
