@@ -125,7 +125,11 @@ fn a_stream_holds_its_rate_lands_clear_and_balances_in_out_and_held() {
         );
         // The charge out is the removed particles'.
         let q = drain.removed as f64 * 1e-12;
-        assert!((drain.charge - q).abs() <= 1e-12 * q, "{} against {q}", drain.charge);
+        assert!(
+            (drain.charge - q).abs() <= 1e-12 * q,
+            "{} against {q}",
+            drain.charge
+        );
         // Each departure is a particle that was in the drain's region.
         for d in &flow.departed {
             assert!(d.position.x < 0.012 && d.position.z < 0.004, "{d:?}");
@@ -414,4 +418,77 @@ attempts = 5000
     let sizes = &sim.system.particles.radius;
     let spread = sizes.iter().filter(|r| **r > 0.00045).count();
     assert!(spread > 10, "lognormal sizes: {spread}");
+}
+
+/// Through a face (lo = hi on one axis): every new sphere is centred on
+/// it, clear of the others, at the rate; a face has no volume to fill.
+#[test]
+fn a_stream_through_a_face_lands_on_it() {
+    let scene = r#"
+[run]
+integrator = "leapfrog"
+dt = 1e-5
+
+[granular]
+young = 5e6
+poisson = 0.3
+restitution = 0.5
+friction = 0.5
+
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [0.02, 0.02, 0.02]
+periodic = [true, true, true]
+
+[[insert]]
+lo = [0.0, 0.0, 0.015]
+hi = [0.02, 0.02, 0.015]
+rate = 20000.0
+radius = 0.0005
+density = 2500.0
+velocity = [0.0, 0.0, -2.0]
+every = 50
+"#;
+    let mut sim = build(scene, 9);
+    sim.prime(&mut |_| {}).unwrap();
+    let mut next_new = 0;
+    for _ in 0..1000 {
+        sim.advance().unwrap();
+        if !sim.system.step.is_multiple_of(50) {
+            continue;
+        }
+        let s = &sim.system;
+        let new: Vec<usize> = (0..s.id.len()).filter(|&i| s.id[i] >= next_new).collect();
+        // ⌊ṅ t⌋ by the (summed, so rounded) time: ten an event, give or
+        // take the one a rounding moves.
+        let inserted = sim.flow.as_ref().unwrap().inserters[0].inserted;
+        assert_eq!(inserted, (20000.0 * s.time).floor() as u64);
+        assert!(
+            (9..=11).contains(&new.len()),
+            "step {}: {}",
+            s.step,
+            new.len()
+        );
+        for &i in &new {
+            assert_eq!(s.particles.position[i].z, 0.015);
+        }
+        next_new = s.id.last().map_or(0, |id| id + 1);
+        let p = &s.particles;
+        for &i in &new {
+            for j in 0..p.len() {
+                let d = s
+                    .boundary
+                    .minimum_image(p.position[i] - p.position[j])
+                    .length();
+                assert!(j == i || d >= 0.001, "{i} and {j} at {d}");
+            }
+        }
+    }
+    let text = scene.replace("every = 50\n", "every = 50\nvolume_fraction = 0.2\n");
+    let e = Scene::parse(&text, "s.toml")
+        .unwrap()
+        .build(&text, "s.toml", 1)
+        .err()
+        .unwrap();
+    assert!(e.message.contains("no volume to fill"), "{e}");
 }

@@ -38,7 +38,7 @@ use crate::particles::System;
 pub use insert::{Inserter, Rate};
 pub use outlet::{Departure, Exit, Outlet};
 
-/// An axis-aligned box [lo, hi].
+/// An axis-aligned box [lo, hi]; flat on one axis, a face.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Region {
     pub lo: DVec3,

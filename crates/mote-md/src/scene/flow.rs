@@ -13,7 +13,8 @@ use crate::flow::{Exit, Flow, Inserter, Outlet, Rate, Region};
 use crate::force::ForceField;
 use crate::particles::{ParticleInit, System};
 
-/// `[[insert]]`: a stream of spheres into the box [lo, hi].
+/// `[[insert]]`: a stream of spheres into the box [lo, hi], or through a
+/// face (lo = hi on one axis: LIGGGHTS `insert/stream`).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InsertSpec {
@@ -215,8 +216,16 @@ fn inserter(
     let name = s.name.clone().unwrap_or_else(|| format!("insert{k}"));
     let bad = |why: String| Err(src.error(span.clone(), format!("[[insert]] {name}: {why}")));
     let (lo, hi) = (DVec3::from(s.lo), DVec3::from(s.hi));
-    if (0..3).any(|a| hi[a] <= lo[a]) {
-        return bad("the region needs lo < hi on every axis".into());
+    let flat = (0..3).filter(|&a| hi[a] == lo[a]).count();
+    if (0..3).any(|a| hi[a] < lo[a]) || flat > 1 {
+        return bad(
+            "the region needs lo < hi on every axis, or on all but one for a face \
+             (lo = hi on that axis)"
+                .into(),
+        );
+    }
+    if flat == 1 && s.volume_fraction.is_some() {
+        return bad("a face (lo = hi on one axis) has no volume to fill".into());
     }
     if s.radius <= 0.0 || s.density <= 0.0 {
         return bad("radius and density must be positive".into());
