@@ -233,8 +233,9 @@ impl mote_run::Propagator for Simulation {
         Ok(())
     }
 
-    /// In a decomposed run, the particle of least id among those found on
-    /// every rank (its id: its index in the undivided system).
+    /// The particle with a non-finite position or velocity, by its id; in a
+    /// decomposed run, the one of least id among those found on every rank
+    /// (its id: its index in the undivided system).
     fn unstable(&self) -> Option<(usize, String)> {
         let p = &self.system.particles;
         let found = first_non_finite(&[&p.position, &p.velocity]).map(|(column, i)| {
@@ -242,7 +243,8 @@ impl mote_run::Propagator for Simulation {
             (i, format!("{what} ({} / {})", p.position[i], p.velocity[i]))
         });
         let Some(domain) = &self.forces.domain else {
-            return found;
+            // Named by its id (its index unless particles came and went).
+            return found.map(|(i, what)| (self.system.id_of(i) as usize, what));
         };
         let found = found.map(|(i, what)| (domain.halo().id[i] as usize, what));
         let least = -domain
