@@ -166,6 +166,13 @@ pub fn flow(
                 .into(),
         );
     }
+    if !scene.insert.is_empty() && sys.particles.radius.iter().any(|r| *r <= 0.0) {
+        return refuse(
+            "new spheres are kept clear of the others by their radii, and the scene's \
+             particles have none: give them a radius (σ/2 for Lennard-Jones)"
+                .into(),
+        );
+    }
     let mut every: Option<(u64, Range<usize>)> = None;
     let givens = (scene.insert.iter().map(|s| (s.get_ref().every, s.span())))
         .chain(scene.outlet.iter().map(|s| (s.get_ref().every, s.span())));
