@@ -79,7 +79,7 @@ impl Inserter {
     /// The particle of radius r this inserter makes (mass from its
     /// density), at rest at the origin.
     pub fn particle(&self, radius: f64) -> ParticleInit {
-        let mass = self.density * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+        let mass = self.density * ball(radius);
         ParticleInit {
             radius,
             mass,
@@ -121,7 +121,7 @@ impl Inserter {
         let p = &sys.particles;
         let solid: f64 = (0..p.len())
             .filter(|&i| self.region.contains(sys.boundary.wrap(p.position[i])))
-            .map(|i| 4.0 / 3.0 * std::f64::consts::PI * p.radius[i].powi(3))
+            .map(|i| ball(p.radius[i]))
             .sum();
         solid / self.region.volume()
     }
@@ -165,7 +165,7 @@ impl Inserter {
                 }
             };
             let radius = self.radius * self.sizes.draw(rng.gen(), z);
-            let volume = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+            let volume = ball(radius);
             if fill_volume.is_some_and(|room| added_volume + volume > room) {
                 break;
             }
@@ -249,4 +249,9 @@ impl Inserter {
         }
         None
     }
+}
+
+/// The volume (4/3)π r³ of a sphere of radius r.
+fn ball(r: f64) -> f64 {
+    4.0 / 3.0 * std::f64::consts::PI * r.powi(3)
 }
