@@ -409,7 +409,8 @@ pub(crate) fn table_observers(
             &dir.join("outflow.csv"),
             provenance,
             scene.units,
-            flow,
+            &flow.outlets,
+            flow.every,
             append,
         )?));
     }

@@ -138,7 +138,7 @@ impl EngineRun for RigidRun {
 
     fn observers(
         &self,
-        _: &RigidDynamics,
+        d: &RigidDynamics,
         files: &RunFiles,
     ) -> Result<Vec<Box<dyn Observer<RigidDynamics>>>, FrontError> {
         let mut observers: Vec<Box<dyn Observer<RigidDynamics>>> =
@@ -148,8 +148,19 @@ impl EngineRun for RigidRun {
                 &self.walls,
                 self.scene.output.observables_every().max(1),
                 self.pressure,
+                d.flow.as_ref(),
                 files.append,
             )?)];
+        if let Some(flow) = d.flow.as_ref().filter(|f| !f.outlets.is_empty()) {
+            observers.push(Box::new(mote_md::output::OutflowCsv::create(
+                &files.dir.join("outflow.csv"),
+                &files.provenance,
+                mote_md::UnitSystem::Si,
+                &flow.outlets,
+                flow.every,
+                files.append,
+            )?));
+        }
         if let Some((probe, every)) = &self.nip {
             observers.push(Box::new(mote_nip::NipCsv::create(
                 &files.dir.join("nip.csv"),
@@ -218,6 +229,9 @@ impl EngineRun for RigidRun {
             summary.push(format!("  force on wall {name}: {f}"));
         }
         summary.extend(d.frbi.descriptions());
+        if let Some(flow) = &d.flow {
+            summary.push(flow.summary(b.len()));
+        }
         if self.pressure {
             summary.push(format!(
                 "Pressure {:.6e} at the end (molecular virial: the bodies' centres, as LAMMPS's fix rigid).",

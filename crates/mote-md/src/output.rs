@@ -198,7 +198,8 @@ impl OutflowCsv {
         path: &Path,
         provenance: &Provenance,
         units: UnitSystem,
-        flow: &crate::flow::Flow,
+        outlets: &[crate::flow::Outlet],
+        every: u64,
         append: bool,
     ) -> Result<Self, MdError> {
         let [l, t, m, _] = units.labels();
@@ -214,28 +215,55 @@ impl OutflowCsv {
             let columns: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
             let units: Vec<String> = units.iter().map(|c| c.to_string()).collect();
             let mut w = CsvWriter::create(path, provenance, &columns, &units)?;
-            let names: Vec<String> = (flow.outlets.iter().enumerate())
+            let names: Vec<String> = (outlets.iter().enumerate())
                 .map(|(k, o)| format!("{k} = {}", o.name))
                 .collect();
             w.comment(&format!("outlets: {}", names.join(", ")))?;
             w
         };
-        Ok(Self {
-            writer,
-            every: flow.every,
-        })
+        Ok(Self { writer, every })
     }
 }
 
-impl Observer<Simulation> for OutflowCsv {
+/// A run whose particles or bodies leave at outlets: those that left at
+/// its last flow event.
+pub trait Departures {
+    /// The step the run stands at.
+    fn at_step(&self) -> u64;
+    /// What left at the last event (empty without outlets).
+    fn departed(&self) -> &[crate::flow::Departure];
+}
+
+impl Departures for Simulation {
+    fn at_step(&self) -> u64 {
+        self.system.step
+    }
+    fn departed(&self) -> &[crate::flow::Departure] {
+        self.flow.as_ref().map_or(&[], |f| &f.departed)
+    }
+}
+
+impl Departures for crate::rigid::run::RigidDynamics {
+    fn at_step(&self) -> u64 {
+        self.step
+    }
+    fn departed(&self) -> &[crate::flow::Departure] {
+        self.flow.as_ref().map_or(&[], |f| &f.departed)
+    }
+}
+
+impl<P> Observer<P> for OutflowCsv
+where
+    P: mote_run::Propagator<Error = MdError> + Departures,
+{
     /// Every flow event: the departures of each are there until the next.
     fn every(&self) -> u64 {
         self.every
     }
 
-    fn observe(&mut self, sim: &Simulation, _: &Observables) -> Result<(), MdError> {
-        let Some(flow) = &sim.flow else { return Ok(()) };
-        for d in flow.departed.iter().filter(|d| d.step == sim.system.step) {
+    fn observe(&mut self, run: &P, _: &P::Sample) -> Result<(), MdError> {
+        let step = run.at_step();
+        for d in run.departed().iter().filter(|d| d.step == step) {
             let row = [
                 d.step as f64,
                 d.time,

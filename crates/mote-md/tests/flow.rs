@@ -105,7 +105,7 @@ fn a_stream_holds_its_rate_lands_clear_and_balances_in_out_and_held() {
         assert!(bad.is_empty(), "step {step}: overlaps {bad:?}");
         next_new = sim.system.id.last().map_or(0, |id| id + 1);
         let flow = sim.flow.as_ref().unwrap();
-        let (feed, drain) = (&flow.inserters[0], &flow.outlets[0]);
+        let (feed, drain) = (&flow.inserters[0].stream, &flow.outlets[0]);
         // The count owed by the time: ⌊ṅ t⌋, exactly.
         assert_eq!(
             feed.inserted,
@@ -142,9 +142,9 @@ fn a_stream_holds_its_rate_lands_clear_and_balances_in_out_and_held() {
     assert_eq!(events, 200);
     // The run is long enough to hold the rate to 1 % and to drain.
     let t = sim.system.time;
-    let held = flow.inserters[0].inserted as f64 / (rate * t);
+    let held = flow.inserters[0].stream.inserted as f64 / (rate * t);
     assert!((held - 1.0).abs() < 0.01, "{held}");
-    assert_eq!(flow.inserters[0].most_behind, 0);
+    assert_eq!(flow.inserters[0].stream.most_behind, 0);
     assert!(removed_seen > 100, "{removed_seen} removed");
     assert_eq!(removed_seen, flow.outlets[0].removed);
     // Both sizes came.
@@ -410,7 +410,7 @@ attempts = 5000
             continue;
         }
         let flow = sim.flow.as_ref().unwrap();
-        let (stream, fill) = (&flow.inserters[0], &flow.inserters[1]);
+        let (stream, fill) = (&flow.inserters[0].stream, &flow.inserters[1].stream);
         let owed = 0.002 * sim.system.time;
         assert!(
             stream.mass >= owed && stream.mass < owed + largest,
@@ -470,7 +470,7 @@ every = 50
         let new: Vec<usize> = (0..s.id.len()).filter(|&i| s.id[i] >= next_new).collect();
         // ⌊ṅ t⌋ by the (summed, so rounded) time: ten an event, give or
         // take the one a rounding moves.
-        let inserted = sim.flow.as_ref().unwrap().inserters[0].inserted;
+        let inserted = sim.flow.as_ref().unwrap().inserters[0].stream.inserted;
         assert_eq!(inserted, (20000.0 * s.time).floor() as u64);
         assert!(
             (9..=11).contains(&new.len()),
@@ -556,7 +556,7 @@ every = 25
         sim.advance().unwrap();
     }
     let flow = sim.flow.as_ref().unwrap();
-    let (came, went) = (flow.inserters[0].inserted, flow.outlets[0].removed);
+    let (came, went) = (flow.inserters[0].stream.inserted, flow.outlets[0].removed);
     assert!(came > 20 && went > 20, "{came} came, {went} went");
     assert!(s_finite(&sim));
     let mut fresh = build(scene, 5).forces;

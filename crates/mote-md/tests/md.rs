@@ -28,6 +28,7 @@ mod plist_twin;
 mod pressure;
 mod rigid_contacts;
 mod rigid_field;
+mod rigid_flow;
 mod rigid_free_flight;
 mod rigid_mass;
 mod rigid_pair;

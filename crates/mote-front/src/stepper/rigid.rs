@@ -62,6 +62,13 @@ impl Rigid {
         }
         let scene = RigidScene::parse(text, label)?;
         let built = scene.build(text, label, seed)?;
+        if built.flow.is_some() {
+            // The views are mote's arrays, which insertion reallocates.
+            return Err(FrontError::request(format!(
+                "{label}: bodies that come and go ([[insert]], [[outlet]]) change the arrays \
+                 mote.RigidSimulation shows as views; run this scene with mote.run()"
+            )));
+        }
         let every = scene.output.observables_every().max(1);
         let seed = built.seed;
         let mut dynamics = RigidDynamics::new(built);

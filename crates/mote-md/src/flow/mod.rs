@@ -35,7 +35,7 @@ use crate::force::granular::Wall;
 use crate::force::ForceField;
 use crate::particles::System;
 
-pub use insert::{Inserter, Rate};
+pub use insert::{clear_of, Inserter, Rate, Stream};
 pub use outlet::{Departure, Exit, Outlet};
 
 /// An axis-aligned box [lo, hi]; flat on one axis, a face.
@@ -77,14 +77,245 @@ pub struct Flow {
     pub every: u64,
     /// The walls new particles keep clear of.
     pub walls: Vec<Wall>,
+    ledger: Ledger,
+    /// The particles that left at the last event.
+    pub departed: Vec<Departure>,
+}
+
+/// Who made each particle, and the next id: what a flow's checkpoint
+/// rows say of the particles (shared by spheres and rigid clumps).
+#[derive(Debug, Clone)]
+pub struct Ledger {
     /// The next unused id.
     next_id: u64,
     /// The inserter that made each particle, or [`SCENE`].
     made_by: Vec<u32>,
-    /// The particles the scene made (ids 0 up to this).
-    scene: u64,
-    /// The particles that left at the last event.
-    pub departed: Vec<Departure>,
+}
+
+/// What a checkpoint's particle rows say: which of the scene's particles
+/// are still there, and each inserted one as (id, inserter, two numbers
+/// its inserter wrote: a sphere's radius and mass, a clump's template
+/// and mass).
+pub struct Restored {
+    pub next_id: u64,
+    pub keep: Vec<bool>,
+    pub inserted: Vec<(u64, usize, f64, f64)>,
+}
+
+impl Ledger {
+    /// The scene's `n` particles, ids 0 … n − 1.
+    pub fn new(n: usize) -> Self {
+        Self {
+            next_id: n as u64,
+            made_by: vec![SCENE; n],
+        }
+    }
+
+    /// Drops the rows of the particles not kept.
+    pub fn retain(&mut self, keep: &[bool]) {
+        crate::domain::retain(&mut self.made_by, keep);
+    }
+
+    /// A particle inserter `by` made: its id.
+    pub fn arrive(&mut self, by: usize) -> u64 {
+        let id = self.next_id;
+        self.next_id += 1;
+        self.made_by.push(by as u32);
+        id
+    }
+
+    /// The next unused id.
+    pub fn next_id(&self) -> u64 {
+        self.next_id
+    }
+
+    /// Appends a row (id, inserter or −1 for the scene's, a, b) per
+    /// particle, `row(i)` giving its id, a and b.
+    pub fn write(&self, out: &mut Vec<f64>, row: impl Fn(usize) -> [f64; 3]) {
+        for (i, by) in self.made_by.iter().enumerate() {
+            let by = if *by == SCENE { -1.0 } else { *by as f64 };
+            let [id, a, b] = row(i);
+            out.extend([id, by, a, b]);
+        }
+    }
+
+    /// Reads [`Ledger::write`]'s rows, with the next id, for a scene that
+    /// makes `scene` particles and has `inserters` inserters; the ledger
+    /// then holds the particles the rows name, the scene's first, then the
+    /// inserted ones in order (the caller adds those).
+    pub fn read(
+        &mut self,
+        next_id: f64,
+        rows: &[f64],
+        scene: usize,
+        inserters: usize,
+    ) -> Result<Restored, String> {
+        let bad = |what: &str| format!("flow: {what}");
+        if !whole(next_id) {
+            return Err(bad("the next id is not a whole number"));
+        }
+        if !rows.len().is_multiple_of(4) {
+            return Err(bad("particle rows of 4 numbers expected"));
+        }
+        let mut keep = vec![false; scene];
+        let mut last = None;
+        let mut inserted = Vec::new();
+        for r in rows.chunks(4) {
+            let (id, by) = (r[0], r[1]);
+            if !whole(id) || last.is_some_and(|l| id <= l) || id >= next_id {
+                return Err(bad(&format!("particle id {id} out of order")));
+            }
+            last = Some(id);
+            if by == -1.0 {
+                if id >= scene as f64 {
+                    return Err(bad(&format!("particle {id} is not one the scene makes")));
+                }
+                keep[id as usize] = true;
+            } else if whole(by) && (by as usize) < inserters {
+                inserted.push((id as u64, by as usize, r[2], r[3]));
+            } else {
+                return Err(bad(&format!("particle {id} names inserter {by}")));
+            }
+        }
+        self.made_by = vec![SCENE; keep.iter().filter(|k| **k).count()];
+        self.made_by.extend(inserted.iter().map(|r| r.1 as u32));
+        self.next_id = next_id as u64;
+        Ok(Restored {
+            next_id: next_id as u64,
+            keep,
+            inserted,
+        })
+    }
+}
+
+/// Whether x is a whole number a checkpoint can count with.
+fn whole(x: f64) -> bool {
+    x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53)
+}
+
+/// The streams' and outlets' counts as observables columns: for each
+/// stream (inserted, mass), for each outlet (removed, mass, charge).
+pub fn tally_columns<'a>(
+    streams: impl Iterator<Item = &'a Stream>,
+    outlets: &[Outlet],
+) -> Vec<f64> {
+    let ins = streams.flat_map(|i| [i.inserted as f64, i.mass]);
+    let outs = outlets
+        .iter()
+        .flat_map(|o| [o.removed as f64, o.mass, o.charge]);
+    ins.chain(outs).collect()
+}
+
+/// The names of [`tally_columns`]: `in_NAME`, `mass_in_NAME`,
+/// `out_NAME`, `mass_out_NAME`, `charge_out_NAME`.
+pub fn tally_names<'a>(
+    streams: impl Iterator<Item = &'a Stream>,
+    outlets: &[Outlet],
+) -> Vec<String> {
+    let ins = streams.flat_map(|i| [format!("in_{}", i.name), format!("mass_in_{}", i.name)]);
+    let outs = outlets.iter().flat_map(|o| {
+        [
+            format!("out_{}", o.name),
+            format!("mass_out_{}", o.name),
+            format!("charge_out_{}", o.name),
+        ]
+    });
+    ins.chain(outs).collect()
+}
+
+/// What came and went, for a run's summary; `things` names what flows
+/// ("particles", "bodies").
+pub fn tally_summary<'a>(
+    streams: impl Iterator<Item = &'a Stream> + Clone,
+    outlets: &[Outlet],
+    held: usize,
+    things: &str,
+) -> String {
+    let n_in: u64 = streams.clone().map(|i| i.inserted).sum();
+    let n_out: u64 = outlets.iter().map(|o| o.removed).sum();
+    let m_in: f64 = streams.clone().map(|i| i.mass).sum();
+    let m_out: f64 = outlets.iter().map(|o| o.mass).sum();
+    let mut text = format!(
+        "Flow: {n_in} {things} inserted (mass {m_in:.6e}), {n_out} removed (mass {m_out:.6e}), \
+         {held} held."
+    );
+    let one = things.strip_suffix('s').unwrap_or(things);
+    for i in streams.filter(|i| i.most_behind > 0) {
+        text.push_str(&format!(
+            " Inserter {} fell behind its rate by up to {} {}: its region was too full.",
+            i.name,
+            i.most_behind,
+            if i.most_behind == 1 { one } else { things }
+        ));
+    }
+    text
+}
+
+/// Appends each stream's count, mass and lag, then each outlet's count,
+/// mass and charge (with the numbers of each).
+pub fn write_tally<'a>(
+    out: &mut Vec<f64>,
+    streams: impl ExactSizeIterator<Item = &'a Stream>,
+    outlets: &[Outlet],
+) {
+    out.push(streams.len() as f64);
+    for i in streams {
+        out.extend([i.inserted as f64, i.mass, i.most_behind as f64]);
+    }
+    out.push(outlets.len() as f64);
+    for o in outlets {
+        out.extend([o.removed as f64, o.mass, o.charge]);
+    }
+}
+
+/// Reads [`write_tally`]'s numbers into the scene's streams and outlets;
+/// returns how many numbers it read.
+pub fn read_tally<'a>(
+    state: &[f64],
+    streams: impl ExactSizeIterator<Item = &'a mut Stream>,
+    outlets: &mut [Outlet],
+) -> Result<usize, String> {
+    let bad = |what: &str| format!("flow: {what}");
+    let mut at = 0;
+    let mut take = |k: usize| -> Result<&[f64], String> {
+        let slice = state
+            .get(at..at + k)
+            .ok_or_else(|| bad("the carried state is cut short"))?;
+        at += k;
+        Ok(slice)
+    };
+    if take(1)?[0] != streams.len() as f64 {
+        return Err(bad("the checkpoint's inserters are not the scene's"));
+    }
+    for i in streams {
+        let r = take(3)?;
+        if !whole(r[0]) || !whole(r[2]) {
+            return Err(bad("an inserter's count is not a whole number"));
+        }
+        (i.inserted, i.mass, i.most_behind) = (r[0] as u64, r[1], r[2] as u64);
+    }
+    if take(1)?[0] != outlets.len() as f64 {
+        return Err(bad("the checkpoint's outlets are not the scene's"));
+    }
+    for o in outlets {
+        let r = take(3)?;
+        if !whole(r[0]) {
+            return Err(bad("an outlet's count is not a whole number"));
+        }
+        (o.removed, o.mass, o.charge) = (r[0] as u64, r[1], r[2]);
+    }
+    Ok(at)
+}
+
+/// The random numbers of inserter `c` at `step`: a generator seeded
+/// through SplitMix64 from the seed, the step and the inserter.
+pub fn stream_rng(seed: u64, step: u64, c: usize) -> Xoshiro256PlusPlus {
+    Xoshiro256PlusPlus::seed_from_u64(
+        seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(17)
+            ^ (c as u64 + 1)
+                .wrapping_mul(0x94D0_49BB_1331_11EB)
+                .rotate_left(41),
+    )
 }
 
 impl Flow {
@@ -104,22 +335,9 @@ impl Flow {
             outlets,
             every: every.max(1),
             walls,
-            next_id: n as u64,
-            made_by: vec![SCENE; n],
-            scene: n as u64,
+            ledger: Ledger::new(n),
             departed: Vec::new(),
         }
-    }
-
-    /// The random numbers of inserter `c` at `step`: a generator seeded
-    /// through SplitMix64 from the seed, the step and the inserter.
-    fn stream(seed: u64, step: u64, c: usize) -> Xoshiro256PlusPlus {
-        Xoshiro256PlusPlus::seed_from_u64(
-            seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15).rotate_left(17)
-                ^ (c as u64 + 1)
-                    .wrapping_mul(0x94D0_49BB_1331_11EB)
-                    .rotate_left(41),
-        )
     }
 
     /// The event at the system's step: the outlets take out what reached
@@ -134,14 +352,10 @@ impl Flow {
         for (i, kept) in keep.iter_mut().enumerate() {
             let p = &sys.particles;
             let x = sys.boundary.wrap(p.position[i]);
-            let Some(k) = self.outlets.iter().position(|o| o.takes(x)) else {
+            let Some(k) = outlet::take(&mut self.outlets, x, p.mass[i], p.charge[i]) else {
                 continue;
             };
             *kept = false;
-            let outlet = &mut self.outlets[k];
-            outlet.removed += 1;
-            outlet.mass += p.mass[i];
-            outlet.charge += p.charge[i];
             self.departed.push(Departure {
                 step,
                 time,
@@ -158,18 +372,16 @@ impl Flow {
         let removed = !self.departed.is_empty();
         if removed {
             sys.retain_particles(&keep);
-            crate::domain::retain(&mut self.made_by, &keep);
+            self.ledger.retain(&keep);
         }
         let mut arrived = Vec::new();
         let (t, rotating) = (sys.time, forces.exerts_torques());
         for c in 0..self.inserters.len() {
-            let mut rng = Self::stream(seed, step, c);
+            let mut rng = stream_rng(seed, step, c);
             let made = self.inserters[c].insert(sys, &self.walls, t, &mut rng);
             for m in made {
-                let id = self.next_id;
-                self.next_id += 1;
+                let id = self.ledger.arrive(c);
                 add(sys, m.init, &m.species, id, rotating);
-                self.made_by.push(c as u32);
                 arrived.push(id);
             }
         }
@@ -178,73 +390,34 @@ impl Flow {
         }
     }
 
-    /// Particles in and out, and their masses, since the run began: for
-    /// each inserter (inserted, mass), for each outlet (removed, mass,
-    /// charge).
-    pub fn columns(&self) -> Vec<f64> {
-        let ins = self
-            .inserters
-            .iter()
-            .flat_map(|i| [i.inserted as f64, i.mass]);
-        let outs = (self.outlets.iter()).flat_map(|o| [o.removed as f64, o.mass, o.charge]);
-        ins.chain(outs).collect()
+    fn streams(&self) -> impl ExactSizeIterator<Item = &Stream> + Clone {
+        self.inserters.iter().map(|i| &i.stream)
     }
 
-    /// The names of [`Flow::columns`]: `in_NAME`, `mass_in_NAME`,
-    /// `out_NAME`, `mass_out_NAME`, `charge_out_NAME`.
+    /// Particles in and out, and their masses, since the run began
+    /// ([`tally_columns`]).
+    pub fn columns(&self) -> Vec<f64> {
+        tally_columns(self.streams(), &self.outlets)
+    }
+
+    /// The names of [`Flow::columns`].
     pub fn column_names(&self) -> Vec<String> {
-        let ins = self
-            .inserters
-            .iter()
-            .flat_map(|i| [format!("in_{}", i.name), format!("mass_in_{}", i.name)]);
-        let outs = self.outlets.iter().flat_map(|o| {
-            [
-                format!("out_{}", o.name),
-                format!("mass_out_{}", o.name),
-                format!("charge_out_{}", o.name),
-            ]
-        });
-        ins.chain(outs).collect()
+        tally_names(self.streams(), &self.outlets)
     }
 
     /// What came and went, for the run's summary.
     pub fn summary(&self, held: usize) -> String {
-        let n_in: u64 = self.inserters.iter().map(|i| i.inserted).sum();
-        let n_out: u64 = self.outlets.iter().map(|o| o.removed).sum();
-        let m_in: f64 = self.inserters.iter().map(|i| i.mass).sum();
-        let m_out: f64 = self.outlets.iter().map(|o| o.mass).sum();
-        let mut text = format!(
-            "Flow: {n_in} particles inserted (mass {m_in:.6e}), {n_out} removed (mass {m_out:.6e}), \
-             {held} held."
-        );
-        for i in self.inserters.iter().filter(|i| i.most_behind > 0) {
-            text.push_str(&format!(
-                " Inserter {} fell behind its rate by up to {} particle{}: its region was too full.",
-                i.name,
-                i.most_behind,
-                if i.most_behind == 1 { "" } else { "s" }
-            ));
-        }
-        text
+        tally_summary(self.streams(), &self.outlets, held, "particles")
     }
 
-    /// What a checkpoint needs: the next id; each inserter's count, mass
-    /// and lag; each outlet's count, mass and charge; then a row per
-    /// particle (id, inserter or −1 for the scene's, radius, mass).
+    /// What a checkpoint needs: the next id, the streams' and outlets'
+    /// counts ([`write_tally`]), then a row per particle (id, inserter or
+    /// −1 for the scene's, radius, mass).
     pub fn carried_state(&self, sys: &System) -> Vec<f64> {
-        let mut out = vec![self.next_id as f64, self.inserters.len() as f64];
-        for i in &self.inserters {
-            out.extend([i.inserted as f64, i.mass, i.most_behind as f64]);
-        }
-        out.push(self.outlets.len() as f64);
-        for o in &self.outlets {
-            out.extend([o.removed as f64, o.mass, o.charge]);
-        }
+        let mut out = vec![self.ledger.next_id() as f64];
+        write_tally(&mut out, self.streams(), &self.outlets);
         let p = &sys.particles;
-        for (i, by) in self.made_by.iter().enumerate() {
-            let by = if *by == SCENE { -1.0 } else { *by as f64 };
-            out.extend([sys.id_of(i) as f64, by, p.radius[i], p.mass[i]]);
-        }
+        (self.ledger).write(&mut out, |i| [sys.id_of(i) as f64, p.radius[i], p.mass[i]]);
         out
     }
 
@@ -259,88 +432,39 @@ impl Flow {
         forces: &mut ForceField,
     ) -> Result<(), String> {
         let bad = |what: &str| format!("flow: {what}");
-        let whole = |x: f64| x >= 0.0 && x.fract() == 0.0 && x < 2f64.powi(53);
-        let mut at = 0;
-        let mut take = |k: usize| -> Result<&[f64], String> {
-            let slice = state
-                .get(at..at + k)
-                .ok_or_else(|| bad("the carried state is cut short"))?;
-            at += k;
-            Ok(slice)
+        let Some((&next_id, state)) = state.split_first() else {
+            return Err(bad("the carried state is empty"));
         };
-        let head = take(2)?;
-        let (next_id, inserters) = (head[0], head[1]);
-        if !whole(next_id) || inserters != self.inserters.len() as f64 {
-            return Err(bad("the checkpoint's inserters are not the scene's"));
-        }
-        for i in &mut self.inserters {
-            let r = take(3)?;
-            if !whole(r[0]) || !whole(r[2]) {
-                return Err(bad("an inserter's count is not a whole number"));
-            }
-            (i.inserted, i.mass, i.most_behind) = (r[0] as u64, r[1], r[2] as u64);
-        }
-        if take(1)?[0] != self.outlets.len() as f64 {
-            return Err(bad("the checkpoint's outlets are not the scene's"));
-        }
-        for o in &mut self.outlets {
-            let r = take(3)?;
-            if !whole(r[0]) {
-                return Err(bad("an outlet's count is not a whole number"));
-            }
-            (o.removed, o.mass, o.charge) = (r[0] as u64, r[1], r[2]);
-        }
-        let rows = &state[at..];
-        if !rows.len().is_multiple_of(4) {
-            return Err(bad("particle rows of 4 numbers expected"));
-        }
+        let at = read_tally(
+            state,
+            self.inserters.iter_mut().map(|i| &mut i.stream),
+            &mut self.outlets,
+        )?;
         let scene = sys.particles.len();
-        let mut keep = vec![false; scene];
-        let mut last = None;
-        let mut inserted = Vec::new();
-        for r in rows.chunks(4) {
-            let (id, by) = (r[0], r[1]);
-            if !whole(id) || last.is_some_and(|l| id <= l) || id >= next_id {
-                return Err(bad(&format!("particle id {id} out of order")));
-            }
-            last = Some(id);
-            if by == -1.0 {
-                if id >= scene as f64 {
-                    return Err(bad(&format!("particle {id} is not one the scene makes")));
-                }
-                keep[id as usize] = true;
-            } else if whole(by) && (by as usize) < self.inserters.len() {
-                inserted.push((id as u64, by as usize, r[2], r[3]));
-            } else {
-                return Err(bad(&format!("particle {id} names inserter {by}")));
-            }
-        }
-        sys.retain_particles(&keep);
+        let restored = (self.ledger).read(next_id, &state[at..], scene, self.inserters.len())?;
+        let keep = &restored.keep;
+        sys.retain_particles(keep);
         sys.id = (0..scene as u64)
-            .zip(&keep)
+            .zip(keep)
             .filter(|k| *k.1)
             .map(|k| k.0)
             .collect();
-        self.made_by = vec![SCENE; sys.particles.len()];
-        forces.particles_changed(Some(&keep), &[]);
+        forces.particles_changed(Some(keep), &[]);
         let mut arrived = Vec::new();
-        for (id, by, radius, mass) in inserted {
+        for &(id, by, radius, mass) in &restored.inserted {
             let ins = &self.inserters[by];
             let mut init = ins.particle(radius);
             if init.mass != mass {
                 return Err(bad(&format!(
                     "particle {id}: mass {mass} is not inserter {}'s for radius {radius}",
-                    ins.name
+                    ins.stream.name
                 )));
             }
             init.position = DVec3::ZERO;
             add(sys, init, &ins.species.clone(), id, forces.exerts_torques());
-            self.made_by.push(by as u32);
             arrived.push(id);
         }
         forces.particles_changed(None, &arrived);
-        self.next_id = next_id as u64;
-        self.scene = scene as u64;
         Ok(())
     }
 }

@@ -47,6 +47,17 @@ impl Outlet {
     }
 }
 
+/// The first outlet that takes a particle at `x` (wrapped into the box),
+/// which counts it with its mass and charge.
+pub fn take(outlets: &mut [Outlet], x: DVec3, mass: f64, charge: f64) -> Option<usize> {
+    let k = outlets.iter().position(|o| o.takes(x))?;
+    let o = &mut outlets[k];
+    o.removed += 1;
+    o.mass += mass;
+    o.charge += charge;
+    Some(k)
+}
+
 /// A particle that left: what the outflow table writes of it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Departure {

@@ -181,6 +181,13 @@ impl ConductingPlanes {
         }
     }
 
+    /// Forgets the P3M list's build (the charges changed).
+    pub fn forget_list(&mut self) {
+        if let DoubledCell::P3m { solver, .. } = &mut self.sum {
+            solver.forget_list();
+        }
+    }
+
     /// Restores [`ConductingPlanes::carried_state`].
     pub fn restore_carried_state(&mut self, state: &[f64]) -> Result<(), String> {
         match &mut self.sum {

@@ -250,6 +250,13 @@ impl GhostList {
         out
     }
 
+    /// Forgets the build (the particles changed): the next update builds
+    /// afresh, and a checkpoint until then carries no list.
+    pub fn invalidate(&mut self) {
+        self.reference.clear();
+        self.pending = None;
+    }
+
     /// Takes the list [`GhostList::carried_state`] describes; it is built
     /// at the next update or refresh, in the box given there. Wrapping is
     /// idempotent, so the build at the stored positions is the one the

@@ -76,6 +76,11 @@ impl VerletList {
         }
     }
 
+    /// Makes the next update rebuild (the particles changed).
+    pub fn invalidate(&mut self) {
+        self.reference.clear();
+    }
+
     /// Rebuilds the list if needed; returns whether it did.
     pub fn update(&mut self, pos: &[DVec3], boundary: &Boundary) -> bool {
         self.since_build += 1;

@@ -27,6 +27,9 @@ pub struct RigidBodies {
     /// Velocity v of the centre of mass.
     pub velocity: Vec<DVec3>,
     pub time: f64,
+    /// Each body's id where bodies come and go (`rigid::flow`): increasing
+    /// along the bodies, a removed body's never reused. Empty: the index.
+    pub id: Vec<u64>,
 }
 
 /// Observables of a set of bodies (momenta about the master frame's origin).
@@ -72,6 +75,24 @@ impl RigidBodies {
         self.omega.push(h.omega);
         self.velocity.push(h.v);
         self.kind.len() - 1
+    }
+
+    /// The id of body i ([`RigidBodies::id`]).
+    pub fn id_of(&self, i: usize) -> u64 {
+        self.id.get(i).copied().unwrap_or(i as u64)
+    }
+
+    /// Keeps the bodies with `keep[i]`, in order.
+    pub fn retain(&mut self, keep: &[bool]) {
+        use crate::domain::retain;
+        retain(&mut self.kind, keep);
+        retain(&mut self.rotation, keep);
+        retain(&mut self.position, keep);
+        retain(&mut self.omega, keep);
+        retain(&mut self.velocity, keep);
+        if !self.id.is_empty() {
+            retain(&mut self.id, keep);
+        }
     }
 
     pub fn len(&self) -> usize {

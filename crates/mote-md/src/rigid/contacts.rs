@@ -127,6 +127,17 @@ impl Totals<'_> {
 /// Spheres per block of the parallel wall loop.
 const WALL_BLOCK: usize = 1024;
 
+/// Keeps the rows of `width` entries (one per wall) of the spheres with
+/// `keep[s]`.
+fn retain_rows<T>(v: &mut Vec<T>, keep: &[bool], width: usize) {
+    let mut slot = 0;
+    v.retain(|_| {
+        let k = keep.get(slot / width).copied().unwrap_or(false);
+        slot += 1;
+        k
+    });
+}
+
 /// Numbers per carried sphere–wall row: slot, ξ (3), ψ (3).
 const WALL_ROW: usize = 7;
 
@@ -441,10 +452,10 @@ impl BodyInteraction for RigidContacts {
             planes: self.walls.iter().map(|w| w.plane_at(t)).collect(),
         };
         let n_walls = self.walls.len();
-        if st.wall_history.len() != n * n_walls {
-            st.wall_history = vec![History::default(); n * n_walls];
-            st.wall_touching = vec![false; n * n_walls];
-        }
+        // New spheres (the first evaluation's, bodies inserted) start
+        // without history against the walls.
+        st.wall_history.resize(n * n_walls, History::default());
+        st.wall_touching.resize(n * n_walls, false);
         for (slot, h) in st.pending_walls.drain(..) {
             if slot < st.wall_history.len() {
                 st.wall_history[slot] = h;
@@ -552,6 +563,33 @@ impl BodyInteraction for RigidContacts {
         (st.contacts, st.wall_contacts) = (totals.contacts, totals.wall_contacts);
         st.pairs.history = history;
         st.pairs.touching = touching;
+    }
+
+    /// The histories of the spheres that stay, renumbered; the list is
+    /// rebuilt at the next evaluation and carries them.
+    fn bodies_changed(&mut self, kept: Option<&[bool]>) {
+        let st = &mut self.state;
+        st.list.invalidate();
+        let Some(keep) = kept else { return };
+        st.pairs.retain(keep);
+        let n_walls = self.walls.len();
+        if n_walls == 0 {
+            return;
+        }
+        retain_rows(&mut st.wall_history, keep, n_walls);
+        retain_rows(&mut st.wall_touching, keep, n_walls);
+        let mut new_index = Vec::with_capacity(keep.len());
+        let mut kept = 0;
+        for &k in keep {
+            new_index.push(k.then_some(kept));
+            kept += usize::from(k);
+        }
+        st.pending_walls.retain_mut(|(slot, _)| {
+            let sphere = new_index.get(*slot / n_walls).copied().flatten();
+            sphere
+                .inspect(|s| *slot = s * n_walls + *slot % n_walls)
+                .is_some()
+        });
     }
 
     /// [NaN (the time of the last evaluation before dt came with the view;

@@ -398,6 +398,16 @@ impl Frbi {
         b.time += dt;
     }
 
+    /// Bodies came or went ([`BodyInteraction::bodies_changed`], `kept`
+    /// per sphere of the bodies before): every interaction hears of it,
+    /// and the world frame is laid out afresh.
+    pub fn bodies_changed(&mut self, kept: Option<&[bool]>) {
+        self.world = WorldFrame::default();
+        for it in &mut self.interactions {
+            it.bodies_changed(kept);
+        }
+    }
+
     /// The keys of the interactions' carried state in checkpoints: their
     /// names, a repeated one numbered (`mote_io::checkpoint::carried_keys`).
     fn carried_keys(&self) -> Vec<String> {

@@ -57,6 +57,13 @@ pub trait BodyInteraction: AsAny + Send + Sync {
         None
     }
 
+    /// Bodies came or went (`rigid::flow`): `kept` says, per sphere of
+    /// the bodies before (body by body, in order), which stayed (`None`:
+    /// all did); new bodies' spheres follow the kept ones. An interaction
+    /// that carries state per sphere or body keeps that of those that
+    /// stayed, renumbered; the others carry nothing and need not hear of it.
+    fn bodies_changed(&mut self, _kept: Option<&[bool]>) {}
+
     /// What this interaction carries from one evaluation to the next
     /// (contact histories), as plain numbers for checkpoints; empty if nothing.
     fn carried_state(&self) -> Vec<f64> {

@@ -18,6 +18,7 @@
 //! - [`contacts`]: Hertz–Mindlin contacts between spheres of different
 //!   bodies and with walls;
 //! - [`scene`]: the `[rigid]` scene format;
+//! - [`flow`]: clumps inserted into regions and taken out at outlets;
 //! - [`run`]: the FRBI as a propagator of the one loop, its observers and checkpoints;
 //! - [`frbi`]: `freeStep`, `react` and the many-body step.
 //!
@@ -26,6 +27,7 @@
 pub mod bodies;
 pub mod centres;
 pub mod contacts;
+pub mod flow;
 pub mod frbi;
 mod free8;
 pub mod from_file;

@@ -14,8 +14,10 @@ use mote_run::{Observer, Propagator};
 
 use super::bodies::RigidBodies;
 use super::contacts::RigidContacts;
+use super::flow::BodyFlow;
 use super::frbi::Frbi;
 use crate::error::MdError;
+use crate::simulation::FLOW_KEY;
 
 /// Rigid bodies moved by the FRBI with a fixed step.
 pub struct RigidDynamics {
@@ -29,6 +31,11 @@ pub struct RigidDynamics {
     /// Wall time spent stepping (the FRBI's timing says how much of it
     /// went to each interaction).
     pub stepping: std::time::Duration,
+    /// Bodies inserted and taken out every `flow.every` steps, after the
+    /// step ([`crate::rigid::flow`]).
+    pub flow: Option<BodyFlow>,
+    /// The run's seed (the flow's random numbers).
+    pub seed: u64,
 }
 
 impl RigidDynamics {
@@ -73,6 +80,8 @@ impl RigidDynamics {
             step: 0,
             last_step: built.steps,
             stepping: std::time::Duration::ZERO,
+            flow: built.flow,
+            seed: built.seed,
         }
     }
 }
@@ -91,6 +100,10 @@ pub struct RigidSample {
     /// The pressure in a periodic box ([`RigidDynamics::pressure_volume`]);
     /// NaN where it is not measured.
     pub pressure: f64,
+    /// The bodies held, and where bodies come and go, what came and went
+    /// ([`BodyFlow::columns`]).
+    pub held: usize,
+    pub flow: Vec<f64>,
 }
 
 impl RigidSample {
@@ -115,6 +128,13 @@ impl Propagator for RigidDynamics {
         let since = std::time::Instant::now();
         self.frbi.step(&mut self.bodies, self.dt);
         self.step += 1;
+        if let Some(flow) = self
+            .flow
+            .as_mut()
+            .filter(|f| self.step.is_multiple_of(f.every))
+        {
+            flow.apply(&mut self.bodies, &mut self.frbi, self.seed, self.step);
+        }
         self.stepping += since.elapsed();
         Ok(())
     }
@@ -150,6 +170,8 @@ impl Propagator for RigidDynamics {
             linear_momentum: o.linear_momentum,
             angular_momentum: o.angular_momentum,
             wall_forces: self.contacts().map(|c| c.wall_forces()).unwrap_or_default(),
+            held: self.bodies.len(),
+            flow: self.flow.as_ref().map(|f| f.columns()).unwrap_or_default(),
         }
     }
 
@@ -216,6 +238,10 @@ impl Propagator for RigidDynamics {
             .map(|(r, w)| [r.x, r.y, r.z, w.x, w.y, w.z])
             .collect();
         cp.carried = self.frbi.carried_state();
+        if let Some(flow) = &self.flow {
+            cp.carried
+                .push((FLOW_KEY.to_string(), flow.carried_state(&self.bodies)));
+        }
         Ok(())
     }
 }
@@ -223,6 +249,26 @@ impl Propagator for RigidDynamics {
 impl RigidDynamics {
     /// Puts a checkpoint's state into freshly built bodies and integrator.
     pub fn resume(&mut self, cp: &Checkpoint, label: &str) -> Result<(), MdError> {
+        let malformed = |m: String| ParseError::new(label, 0, format!("checkpoint: {m}"));
+        let carried = cp.carried.iter().find(|(k, _)| k == FLOW_KEY);
+        match (&mut self.flow, carried) {
+            (Some(flow), Some((_, state))) => flow
+                .restore(state, &mut self.bodies, &mut self.frbi)
+                .map_err(malformed)?,
+            (None, None) => {}
+            (Some(_), None) => {
+                return Err(malformed(
+                    "the checkpoint has no flow state, and the scene inserts or removes bodies"
+                        .into(),
+                )
+                .into())
+            }
+            (None, Some(_)) => return Err(malformed(
+                "the checkpoint has a flow state, and the scene neither inserts nor removes bodies"
+                    .into(),
+            )
+            .into()),
+        }
         let b = &mut self.bodies;
         let n = b.len();
         if cp.positions.len() != n || cp.velocities.len() != n || cp.angular.len() != n {
@@ -245,9 +291,16 @@ impl RigidDynamics {
         }
         b.time = cp.time;
         self.step = cp.step;
+        let interactions = Checkpoint {
+            carried: (cp.carried.iter())
+                .filter(|(k, _)| k != FLOW_KEY)
+                .cloned()
+                .collect(),
+            ..Checkpoint::default()
+        };
         self.frbi
-            .restore_carried_state(cp)
-            .map_err(|m| ParseError::new(label, 0, format!("checkpoint: {m}")))?;
+            .restore_carried_state(&interactions)
+            .map_err(malformed)?;
         Ok(())
     }
 }
@@ -256,11 +309,14 @@ impl RigidDynamics {
 /// rotational), translational, rotational, potential and total energy,
 /// momentum, angular momentum (the first twelve of the point-particle
 /// engine's columns, by the same names), the pressure where it is measured
-/// (a periodic box), the force on each wall.
+/// (a periodic box), the force on each wall; where bodies come and go,
+/// the bodies held (N) and what came and went ([`BodyFlow::columns`]).
 pub struct RigidCsv {
     writer: CsvWriter,
     every: u64,
     pressure: bool,
+    /// Whether bodies come and go (the N and flow columns).
+    flow: bool,
 }
 
 impl RigidCsv {
@@ -270,6 +326,7 @@ impl RigidCsv {
         walls: &[String],
         every: u64,
         pressure: bool,
+        flow: Option<&BodyFlow>,
         append: bool,
     ) -> Result<Self, MdError> {
         // The point-particle engine's words for the same quantities.
@@ -285,6 +342,10 @@ impl RigidCsv {
                 columns.push(format!("{w}.f{a}"));
             }
         }
+        if let Some(f) = flow {
+            columns.push("N".into());
+            columns.extend(f.column_names());
+        }
         let writer = if append {
             CsvWriter::append(path, columns.len())?
         } else {
@@ -294,6 +355,7 @@ impl RigidCsv {
             writer,
             every,
             pressure,
+            flow: flow.is_some(),
         })
     }
 }
@@ -319,6 +381,10 @@ impl Observer<RigidDynamics> for RigidCsv {
         }
         for (_, f) in &s.wall_forces {
             row.extend(f.to_array());
+        }
+        if self.flow {
+            row.push(s.held as f64);
+            row.extend(&s.flow);
         }
         Ok(self.writer.row(&row)?)
     }
@@ -412,7 +478,11 @@ pub fn sphere_frame(b: &RigidBodies) -> Frame {
         // "X" is ASE's dummy element; the body column says which clump.
         species: vec!["X".to_string(); positions.len()],
         masses: sphere_masses(b, &world),
-        bodies: world.sphere_body.iter().map(|&k| u64::from(k)).collect(),
+        bodies: world
+            .sphere_body
+            .iter()
+            .map(|&k| b.id_of(k as usize))
+            .collect(),
         angular_velocities: world
             .sphere_body
             .iter()

@@ -372,6 +372,13 @@ impl BodyInteraction for PlaneCoulomb {
         Some(self.planes.describe())
     }
 
+    /// The held forces belong to the bodies that were there: the next
+    /// evaluation sums afresh, on a list built afresh.
+    fn bodies_changed(&mut self, _kept: Option<&[bool]>) {
+        self.held.force.clear();
+        self.planes.forget_list();
+    }
+
     /// The held forces and the evaluation count (so that a resumed run
     /// refreshes them at the same steps): [calls, (body, fx, fy, fz)…];
     /// with P3M, [the length of that, that, the P3M list's build].

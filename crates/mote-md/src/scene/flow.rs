@@ -8,8 +8,8 @@ use mote_io::{ParseError, Source};
 use mote_rcp::SizeSpec;
 use serde::Deserialize;
 
-use super::Scene;
-use crate::flow::{Exit, Flow, Inserter, Outlet, Rate, Region};
+use super::{Scene, SceneFile};
+use crate::flow::{Exit, Flow, Inserter, Outlet, Rate, Region, Stream};
 use crate::force::ForceField;
 use crate::particles::{ParticleInit, System};
 
@@ -37,17 +37,17 @@ pub struct InsertSpec {
     pub start: f64,
     /// The radius (the scale of `sizes`: the small ones' of `bi`, the
     /// number median's of `lognormal`).
-    pub radius: f64,
+    pub radius: Option<f64>,
     /// `mono`, `bi:RATIO:FRACTION` or `lognormal:SIGMA`, as `mote pack`
-    /// takes them.
-    #[serde(default = "mono")]
-    pub sizes: String,
-    pub density: f64,
-    #[serde(default)]
-    pub charge: f64,
-    #[serde(default = "super::white")]
-    pub color: [f64; 3],
+    /// takes them (default `mono`).
+    pub sizes: Option<String>,
+    pub density: Option<f64>,
+    pub charge: Option<f64>,
+    pub color: Option<[f64; 3]>,
     pub species: Option<String>,
+    /// The rigid template the stream makes (rigid scenes; the template
+    /// gives size, mass and charge).
+    pub clump: Option<String>,
     #[serde(default)]
     pub velocity: [f64; 3],
     /// Standard deviation of each velocity component about `velocity`.
@@ -78,10 +78,6 @@ pub struct OutletSpec {
     pub every: Option<u64>,
 }
 
-fn mono() -> String {
-    "mono".into()
-}
-
 fn hundred() -> u32 {
     100
 }
@@ -106,13 +102,14 @@ pub fn radius_range(scene: &Scene) -> Option<(f64, f64)> {
     let mut range: Option<(f64, f64)> = None;
     for spec in &scene.insert {
         let s = spec.get_ref();
-        let (lo, hi) = match SizeSpec::parse(&s.sizes) {
-            Ok(SizeSpec::Bidisperse { ratio, .. }) => (s.radius, s.radius * ratio),
+        let Some(radius) = s.radius else { continue };
+        let (lo, hi) = match SizeSpec::parse(s.sizes.as_deref().unwrap_or("mono")) {
+            Ok(SizeSpec::Bidisperse { ratio, .. }) => (radius, radius * ratio),
             Ok(SizeSpec::Lognormal { sigma }) => {
-                let median = s.radius * (-3.5 * sigma * sigma).exp();
+                let median = radius * (-3.5 * sigma * sigma).exp();
                 (median * (-4.0 * sigma).exp(), median * (4.0 * sigma).exp())
             }
-            _ => (s.radius, s.radius),
+            _ => (radius, radius),
         };
         range = Some(range.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
     }
@@ -173,6 +170,24 @@ pub fn flow(
                 .into(),
         );
     }
+    let every = interval(scene, src)?;
+    let inserters = scene
+        .insert
+        .iter()
+        .enumerate()
+        .map(|(k, s)| inserter(s.get_ref(), k, s.span(), src))
+        .collect::<Result<Vec<_>, _>>()?;
+    let outlets = outlets(scene, src)?;
+    let mut walls = Vec::new();
+    for (k, w) in scene.wall.iter().enumerate() {
+        walls.extend(w.get_ref().walls(k).map_err(|m| src.error(w.span(), m))?);
+    }
+    Ok(Some(Flow::new(sys, inserters, outlets, every, walls)))
+}
+
+/// The steps between flow events: the one `every` the `[[insert]]` and
+/// `[[outlet]]` tables give (100 where none does).
+pub fn interval<T>(scene: &SceneFile<T>, src: Source) -> Result<u64, ParseError> {
     let mut every: Option<(u64, Range<usize>)> = None;
     let givens = (scene.insert.iter().map(|s| (s.get_ref().every, s.span())))
         .chain(scene.outlet.iter().map(|s| (s.get_ref().every, s.span())));
@@ -194,32 +209,61 @@ pub fn flow(
             _ => every = Some((e, span)),
         }
     }
-    let inserters = scene
-        .insert
-        .iter()
-        .enumerate()
-        .map(|(k, s)| inserter(s.get_ref(), k, s.span(), src))
-        .collect::<Result<Vec<_>, _>>()?;
-    let outlets = scene
-        .outlet
-        .iter()
-        .enumerate()
-        .map(|(k, s)| outlet(s.get_ref(), k, s.span(), src))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut walls = Vec::new();
-    for (k, w) in scene.wall.iter().enumerate() {
-        walls.extend(w.get_ref().walls(k).map_err(|m| src.error(w.span(), m))?);
-    }
-    let every = every.map_or(EVERY, |e| e.0);
-    Ok(Some(Flow::new(sys, inserters, outlets, every, walls)))
+    Ok(every.map_or(EVERY, |e| e.0))
 }
 
+/// The scene's `[[outlet]]` tables.
+pub fn outlets<T>(scene: &SceneFile<T>, src: Source) -> Result<Vec<Outlet>, ParseError> {
+    (scene.outlet.iter().enumerate())
+        .map(|(k, s)| outlet(s.get_ref(), k, s.span(), src))
+        .collect()
+}
+
+/// The sphere stream of an `[[insert]]` table of a point-particle scene.
 fn inserter(
     s: &InsertSpec,
     k: usize,
     span: Range<usize>,
     src: Source,
 ) -> Result<Inserter, ParseError> {
+    let stream = stream(s, k, span.clone(), src)?;
+    let bad =
+        |why: String| Err(src.error(span.clone(), format!("[[insert]] {}: {why}", stream.name)));
+    if s.clump.is_some() {
+        return bad("clump names a rigid template, and this scene has no [rigid] table".into());
+    }
+    let (Some(radius), Some(density)) = (s.radius, s.density) else {
+        return bad("give the spheres' radius and density".into());
+    };
+    if radius <= 0.0 || density <= 0.0 {
+        return bad("radius and density must be positive".into());
+    }
+    let sizes = match SizeSpec::parse(s.sizes.as_deref().unwrap_or("mono")) {
+        Ok(sizes) => sizes,
+        Err(m) => return bad(format!("sizes: {m}")),
+    };
+    Ok(Inserter {
+        radius,
+        sizes,
+        density,
+        template: ParticleInit {
+            charge: s.charge.unwrap_or(0.0),
+            color: s.color.unwrap_or_else(super::white),
+            ..ParticleInit::default()
+        },
+        species: s.species.clone().unwrap_or_else(|| "X".into()),
+        stream,
+    })
+}
+
+/// What an `[[insert]]` table says of its stream, whatever it makes:
+/// name, region, rate, count, start, velocity, attempts.
+pub fn stream(
+    s: &InsertSpec,
+    k: usize,
+    span: Range<usize>,
+    src: Source,
+) -> Result<Stream, ParseError> {
     let name = s.name.clone().unwrap_or_else(|| format!("insert{k}"));
     let bad = |why: String| Err(src.error(span.clone(), format!("[[insert]] {name}: {why}")));
     let (lo, hi) = (DVec3::from(s.lo), DVec3::from(s.hi));
@@ -234,13 +278,6 @@ fn inserter(
     if flat == 1 && s.volume_fraction.is_some() {
         return bad("a face (lo = hi on one axis) has no volume to fill".into());
     }
-    if s.radius <= 0.0 || s.density <= 0.0 {
-        return bad("radius and density must be positive".into());
-    }
-    let sizes = match SizeSpec::parse(&s.sizes) {
-        Ok(sizes) => sizes,
-        Err(m) => return bad(format!("sizes: {m}")),
-    };
     if !name
         .chars()
         .all(|c| c.is_alphanumeric() || c == '_' || c == '-')
@@ -270,22 +307,13 @@ fn inserter(
     if s.start < 0.0 || s.velocity_spread < 0.0 {
         return bad("start and velocity_spread must not be negative".into());
     }
-    Ok(Inserter {
+    Ok(Stream {
         name,
         region: Region { lo, hi },
         rate,
         start: s.start,
         count: s.count,
         fill: s.volume_fraction,
-        radius: s.radius,
-        sizes,
-        density: s.density,
-        template: ParticleInit {
-            charge: s.charge,
-            color: s.color,
-            ..ParticleInit::default()
-        },
-        species: s.species.clone().unwrap_or_else(|| "X".into()),
         velocity: DVec3::from(s.velocity),
         velocity_spread: s.velocity_spread,
         attempts: s.attempts,

@@ -121,6 +121,44 @@ impl PairHistories {
         self.place_pending();
     }
 
+    /// Keeps the rows of the particles with `keep[i]`, renumbered in
+    /// order (particle i becomes the number of kept ones before it), and
+    /// the pairs of two kept particles with their histories: the list as
+    /// it stands after particles were taken out, until the next build
+    /// (which merges with it as with any list). Restored rows not yet
+    /// placed are renumbered too.
+    pub fn retain(&mut self, keep: &[bool]) {
+        let mut new_index = Vec::with_capacity(keep.len());
+        let mut kept = 0u32;
+        for &k in keep {
+            new_index.push(if k { kept } else { u32::MAX });
+            kept += u32::from(k);
+        }
+        let renumber = |i: u32| new_index.get(i as usize).copied().unwrap_or(u32::MAX);
+        let (mut start, mut partner) = (vec![0u32], Vec::new());
+        let (mut history, mut touching) = (Vec::new(), Vec::new());
+        for i in 0..self.rows().min(keep.len()) {
+            if !keep[i] {
+                continue;
+            }
+            for k in self.range(i) {
+                let j = renumber(self.partner[k]);
+                if j != u32::MAX {
+                    partner.push(j);
+                    history.push(self.history[k]);
+                    touching.push(self.touching[k]);
+                }
+            }
+            start.push(partner.len() as u32);
+        }
+        (self.start, self.partner) = (start, partner);
+        (self.history, self.touching) = (history, touching);
+        self.pending.retain_mut(|(i, j, _)| {
+            (*i, *j) = (renumber(*i), renumber(*j));
+            *i != u32::MAX && *j != u32::MAX
+        });
+    }
+
     /// The entry of pair (i, j), if listed.
     pub fn find(&self, i: usize, j: usize) -> Option<usize> {
         let (i, j) = if i < j { (i, j) } else { (j, i) };
@@ -279,6 +317,30 @@ mod tests {
         assert!(q.touching[0]);
         assert!(q.restore_rows(&rows[..5], 4).is_err());
         assert!(q.restore_rows(&rows, 2).is_err());
+    }
+
+    /// Taking particles out keeps the pairs of those that stay, with their
+    /// histories, under the kept particles' new numbers.
+    #[test]
+    fn histories_follow_their_pairs_when_particles_are_taken_out() {
+        let mut p = PairHistories::default();
+        // Pairs (0, 1), (0, 3), (1, 2), (2, 3).
+        p.carry_to(&[0, 2, 3, 4, 4], &[1, 3, 2, 3]);
+        for (k, x) in [1.0, 3.0, 2.0, 5.0].into_iter().enumerate() {
+            p.history[k] = h(x);
+            p.touching[k] = true;
+        }
+        p.retain(&[true, false, true, true]);
+        // 0 → 0, 2 → 1, 3 → 2: (0, 3) is (0, 2), (2, 3) is (1, 2).
+        assert_eq!((p.rows(), p.len()), (3, 2));
+        assert_eq!(p.get(0, 2), Some(h(3.0)));
+        assert_eq!(p.get(1, 2), Some(h(5.0)));
+        assert_eq!(p.get(0, 1), None);
+        // A list built after, with a new particle 3 beside 2, carries them.
+        p.carry_to(&[0, 1, 2, 3, 3], &[2, 2, 3]);
+        assert_eq!(p.get(0, 2), Some(h(3.0)));
+        assert_eq!(p.get(1, 2), Some(h(5.0)));
+        assert_eq!(p.get(2, 3), Some(History::default()));
     }
 
     /// Blocks of a half list's rows split its pairs evenly, not its

@@ -80,6 +80,11 @@ struct RowSum {
 }
 
 impl P3mCoulomb {
+    /// Forgets the real-space list's build (the particles changed).
+    pub fn forget_list(&mut self) {
+        self.list.invalidate();
+    }
+
     /// P3M with `parameters` in `boundary` (periodic on every axis), its
     /// real-space list with `skin`.
     pub fn new(k: f64, parameters: Parameters, skin: f64, boundary: &Boundary) -> Self {

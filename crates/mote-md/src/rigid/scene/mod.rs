@@ -132,6 +132,7 @@ use toml::Spanned;
 
 use super::bodies::RigidBodies;
 use super::contacts::RigidContacts;
+use super::flow::BodyFlow;
 use super::frbi::{Frbi, FreeFlight, SpinUpdate};
 use crate::boundary::Boundary;
 use crate::force::granular::Material;
@@ -141,6 +142,7 @@ use crate::scene::{add, Kind, SceneFile, Section};
 mod centres;
 mod contacts;
 mod fields;
+mod flow;
 mod placement;
 mod planes;
 mod point_tables;
@@ -205,6 +207,9 @@ pub struct RigidSettings {
 pub struct BuiltRigid {
     pub bodies: RigidBodies,
     pub frbi: Frbi,
+    /// Bodies inserted and taken out, where the scene has `[[insert]]`
+    /// or `[[outlet]]`.
+    pub flow: Option<BodyFlow>,
     pub dt: f64,
     pub steps: u64,
     pub seed: u64,
@@ -385,10 +390,10 @@ impl RigidScene {
         add_each(&self.from_file, self, &mut b)?;
         add_each(&rigid.lattice, self, &mut b)?;
         add_each(&rigid.random, self, &mut b)?;
-        if b.bodies.is_empty() {
+        if b.bodies.is_empty() && self.insert.is_empty() {
             return Err(src.error(
                 rigid_table.span(),
-                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]] or [[from_file]]",
+                "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]], [[from_file]] or [[insert]]",
             ));
         }
         add(&rigid.fields, self, &mut b)?;
@@ -413,6 +418,7 @@ impl RigidScene {
         add(&rigid.planes, self, &mut b)?;
         add(&rigid.latent_image, self, &mut b)?;
         add(&rigid.roller, self, &mut b)?;
+        let flow = flow::body_flow(self, &mut b)?;
 
         // Run length.
         let run = &self.run;
@@ -444,6 +450,7 @@ impl RigidScene {
         Ok(BuiltRigid {
             bodies: b.bodies,
             frbi: b.frbi,
+            flow,
             dt,
             steps,
             seed,

@@ -91,16 +91,6 @@ pub(super) fn refuse(scene: &RigidScene, src: Source) -> Result<(), ParseError> 
             "[[spring]]",
             "springs join point particles",
         ),
-        (
-            first(&scene.insert),
-            "[[insert]]",
-            "rigid bodies are not inserted yet",
-        ),
-        (
-            first(&scene.outlet),
-            "[[outlet]]",
-            "rigid bodies are not removed yet",
-        ),
         (first(&scene.particle), "[[particle]]", PLACED),
         (first(&scene.lattice), "[[lattice]]", PLACED),
         (first(&scene.ring), "[[ring]]", PLACED),
