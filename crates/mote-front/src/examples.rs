@@ -39,6 +39,7 @@ const RIGID: &[(&str, &str)] = &[
     scene!("clumps-settling", "rigid/clumps-settling.toml"),
     scene!("chains-rotating-field", "rigid/chains-rotating-field.toml"),
     scene!("toning-nip", "rigid/toning-nip.toml"),
+    scene!("toning-nip-flow", "rigid/toning-nip-flow.toml"),
     scene!("toning-nip-compress", "rigid/toning-nip-compress.toml"),
 ];
 

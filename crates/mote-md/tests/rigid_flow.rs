@@ -317,3 +317,61 @@ fn streams_of_clumps_are_refused_at_their_line_when_misspelled() {
         "{e}"
     );
 }
+
+/// In a periodic box, after the first body left, a frame names each
+/// sphere's body by its id and moves every body whole into the box.
+#[test]
+fn frames_of_a_periodic_run_name_the_bodies_by_id() {
+    let text = r#"
+[rigid]
+
+[[rigid.template]]
+name = "trimer"
+generator = "trimer"
+distance = 1.2e-3
+radius = 1.0e-3
+density = 2500.0
+
+[rigid.contacts]
+young = 1.0e7
+poisson = 0.3
+restitution = 0.3
+friction = 0.5
+
+[box]
+lo = [0.0, 0.0, 0.0]
+hi = [0.02, 0.02, 0.02]
+periodic = [true, true, true]
+
+[[rigid.body]]
+template = "trimer"
+position = [0.001, 0.01, 0.01]
+
+[[rigid.body]]
+template = "trimer"
+position = [0.019, 0.01, 0.005]
+velocity = [10.0, 0.0, 0.0]
+
+[[outlet]]
+lo = [-1.0, -1.0, 0.008]
+hi = [0.002, 1.0, 1.0]
+every = 10
+
+[run]
+dt = 1.0e-5
+steps = 20
+"#;
+    let mut d = build(text);
+    for _ in 0..20 {
+        d.advance().unwrap();
+    }
+    assert_eq!(d.bodies.id, vec![1], "the first left, the second stayed");
+    assert!(
+        d.bodies.position[0].x > 0.02,
+        "it crossed the periodic face"
+    );
+    let frame = d.sphere_frame();
+    assert_eq!(frame.bodies, vec![1, 1, 1]);
+    let centre = frame.positions.iter().map(|p| p[0]).sum::<f64>() / 3.0;
+    assert!((0.0..0.02).contains(&centre), "{centre}");
+}

@@ -12,6 +12,7 @@
 //! toner = "toner"        # the templates that are toner and carrier
 //! carrier = "carrier"
 //! every = 50             # steps between rows of nip.csv (default: [output] observables_every)
+//! window = [5e-4, 6e-4]  # measure toner and free volume only there (default: the whole box)
 //! ```
 //!
 //! The front (`mote run`) asks [`probe`] for the probe of a rigid scene and
@@ -39,6 +40,10 @@ pub struct NipSettings {
     /// Steps between rows of nip.csv (default: `[output] observables_every`).
     #[serde(default)]
     pub every: Option<u64>,
+    /// Measure the developed toner and the free volume only where
+    /// x₀ ≤ x < x₁ (a flowing nip's exit); default the whole box.
+    #[serde(default)]
+    pub window: Option<[f64; 2]>,
 }
 
 /// The one table of a scene this crate reads; every other key is the
@@ -98,7 +103,16 @@ pub fn probe(
             .unwrap_or_default(),
         speed: latent.map_or(0.0, |l| l.speed),
         contrast,
+        window: nip.window,
     };
+    if let Some([x0, x1]) = nip.window {
+        if !(lo.x <= x0 && x0 < x1 && x1 <= hi.x) {
+            return Err(src.error(
+                span,
+                format!("[rigid.nip] window = [{x0}, {x1}]: give lo.x ≤ x₀ < x₁ ≤ hi.x of the box"),
+            ));
+        }
+    }
     let every = match nip.every {
         Some(0) => {
             return Err(src.error(

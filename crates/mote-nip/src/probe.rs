@@ -44,6 +44,10 @@ pub struct NipProbe {
     pub speed: f64,
     /// The latent image's contrast σ_patch − σ_background (0: none).
     pub contrast: f64,
+    /// Where along x the developed toner and the free volume are
+    /// measured, [x₀, x₁) (`None`: the whole box): a flowing nip's exit,
+    /// where the developer has passed the whole development zone.
+    pub window: Option<[f64; 2]>,
 }
 
 /// One measurement.
@@ -96,15 +100,43 @@ impl NipProbe {
         })
     }
 
+    /// The length of the image within the window [x₀, x₁) at time t,
+    /// each patch's copies one period either side counted.
+    fn image_in(&self, [x0, x1]: [f64; 2], t: f64) -> f64 {
+        let l = self.period()[0];
+        let mut inside = 0.0;
+        for p in &self.patches {
+            let start = self.lo.x + (p[0] + self.speed * t - self.lo.x).rem_euclid(l);
+            for k in -1..=1 {
+                let a = start + k as f64 * l;
+                let b = a + (p[1] - p[0]);
+                inside += (b.min(x1) - a.max(x0)).max(0.0);
+            }
+        }
+        inside
+    }
+
+    /// Whether x (wrapped into the box) lies in the measuring window.
+    fn in_window(&self, x: f64) -> bool {
+        let l = self.period()[0];
+        let x = self.lo.x + (x - self.lo.x).rem_euclid(l);
+        self.window.is_none_or(|[x0, x1]| x >= x0 && x < x1)
+    }
+
     pub fn measure(&self, b: &RigidBodies) -> NipSample {
         let mut s = NipSample::default();
         let [lx, ly] = self.period();
-        let area = lx * ly;
-        let f_image = self.image_fraction();
-        let (a_image, a_background) = (area * f_image, area * (1.0 - f_image));
+        let (area, a_image) = match self.window {
+            Some(w) => ((w[1] - w[0]) * ly, self.image_in(w, b.time) * ly),
+            None => (lx * ly, lx * ly * self.image_fraction()),
+        };
+        let a_background = area - a_image;
         let mut solids = 0.0;
         for i in 0..b.len() {
             let t = b.template(i);
+            if !self.in_window(b.position[i].x) {
+                continue;
+            }
             solids += t.props.volume;
             if b.kind[i] != self.toner {
                 continue;
@@ -312,6 +344,7 @@ mod tests {
             patches: vec![[2.0, 8.0]],
             speed: 1.0,
             contrast: 0.02,
+            window: None,
         };
         let s = probe.measure(&b);
         assert_eq!(s.developed, 3);
@@ -335,5 +368,26 @@ mod tests {
             "{} against {free}",
             s.free_volume
         );
+
+        // A window over x in [0, 10): the image there is [2.5, 8.5) at
+        // t = 0.5; the two toner on it are inside, the background one not;
+        // three toner and three carriers are centred in it.
+        let window = NipProbe {
+            window: Some([0.0, 10.0]),
+            ..probe.clone()
+        };
+        let w = window.measure(&b);
+        assert_eq!(w.developed, 2);
+        assert!((w.mass_image - 2.0 * m / 60.0).abs() < 1e-3 * w.mass_image);
+        assert_eq!(w.mass_background, 0.0);
+        let solids = 3.0 * 4.0 / 3.0 * PI * 0.125 + 3.0 * 4.0 / 3.0 * PI * 8.0;
+        assert!(
+            (w.free_volume - (1.0 - solids / 1400.0)).abs() < 1e-3,
+            "{w:?}"
+        );
+        // The image's length in a window, across the period's end too.
+        assert!((window.image_in([0.0, 10.0], 0.5) - 6.0).abs() < 1e-12);
+        assert!((window.image_in([15.0, 20.0], 17.0) - 1.0).abs() < 1e-12);
+        assert!((window.image_in([0.0, 10.0], 17.0) - 5.0).abs() < 1e-12);
     }
 }

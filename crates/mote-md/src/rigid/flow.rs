@@ -50,11 +50,14 @@ impl ClumpInserter {
             .fold(0.0, f64::max)
     }
 
-    /// The solid fraction of the region: the volume of the bodies whose
-    /// centres lie in it over its volume.
+    /// The solid fraction of the region this stream keeps: the volume of
+    /// the bodies of its template whose centres lie in it over its volume
+    /// (so that streams of carriers and of toner into one region keep a
+    /// developer's mixture, each to its own fraction).
     fn filled(&self, bodies: &RigidBodies, boundary: &Boundary) -> f64 {
         let region = &self.stream.region;
         let solid: f64 = (0..bodies.len())
+            .filter(|&i| bodies.kind[i] == self.kind)
             .filter(|&i| region.contains(boundary.wrap(bodies.position[i])))
             .map(|i| bodies.template(i).props.volume)
             .sum();
@@ -173,6 +176,8 @@ pub struct BodyFlow {
     ledger: Ledger,
     /// The bodies that left at the last event.
     pub departed: Vec<Departure>,
+    /// Mass in and out at each event.
+    pub balance: flow::Balance,
 }
 
 impl BodyFlow {
@@ -199,6 +204,7 @@ impl BodyFlow {
             boundary,
             ledger: Ledger::new(n),
             departed: Vec::new(),
+            balance: flow::Balance::default(),
         }
     }
 
@@ -273,6 +279,9 @@ impl BodyFlow {
         if removed || arrived {
             frbi.bodies_changed(removed.then_some(&kept_spheres));
         }
+        let m_in = self.streams().map(|i| i.mass).sum();
+        let m_out = self.outlets.iter().map(|o| o.mass).sum();
+        self.balance.record(time, m_in, m_out);
     }
 
     /// The name of template `kind`: the inserter's that makes it, else
@@ -294,7 +303,8 @@ impl BodyFlow {
 
     /// What came and went, for the run's summary.
     pub fn summary(&self, held: usize) -> String {
-        flow::tally_summary(self.streams(), &self.outlets, held, "bodies")
+        let text = flow::tally_summary(self.streams(), &self.outlets, held, "bodies");
+        flow::join(text, self.balance.sentence())
     }
 
     /// What a checkpoint needs: the next id, the counts, then a row per

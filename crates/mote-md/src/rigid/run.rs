@@ -434,9 +434,13 @@ impl RigidDynamics {
 /// stick out), and the frame's cell and `pbc` are the box's.
 pub fn sphere_frame_in(b: &RigidBodies, boundary: &crate::boundary::Boundary) -> Frame {
     let mut frame = sphere_frame(b);
-    let shift: Vec<DVec3> = b.position.iter().map(|x| boundary.wrap(*x) - *x).collect();
-    for (p, &k) in frame.positions.iter_mut().zip(&frame.bodies) {
-        let s = shift[k as usize];
+    // Each body's shift for each of its spheres (the frame's `bodies`
+    // column holds the bodies' ids).
+    let shift = (0..b.len()).flat_map(|i| {
+        let s = boundary.wrap(b.position[i]) - b.position[i];
+        std::iter::repeat_n(s, b.template(i).sphere_count())
+    });
+    for (p, s) in frame.positions.iter_mut().zip(shift) {
         for d in 0..3 {
             p[d] += s[d];
         }

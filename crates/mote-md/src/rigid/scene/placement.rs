@@ -13,6 +13,7 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use serde::Deserialize;
 
 use super::{positive, Clumps, RigidBuild, RigidScene};
+use crate::boundary::Boundary;
 use crate::rigid::bodies::RigidBodies;
 use crate::scene::{DataSpec, Section};
 
@@ -238,7 +239,9 @@ impl PlacementSpec {
             ));
         }
         let sites = if random {
-            random_sites(ps.n, lo, hi, bound, &b.bodies, &mut b.rng)
+            let boundary = b.scene_box.as_ref().map(|(bx, _)| *bx);
+            let boundary = boundary.unwrap_or_else(Boundary::open);
+            random_sites(ps.n, lo, hi, bound, &b.bodies, &boundary, &mut b.rng)
         } else {
             let spacing = ps.spacing.unwrap_or(2.0 * bound);
             match ps.arrangement.as_deref() {
@@ -353,15 +356,19 @@ fn fcc_sites(n: usize, lo: DVec3, hi: DVec3, spacing: f64) -> Result<Vec<DVec3>,
 }
 
 /// Random sequential addition of bounding spheres (radius `bound`) with
-/// centres in [lo, hi], not overlapping each other or bodies already placed.
+/// centres in [lo, hi], not overlapping each other or bodies already
+/// placed — through the nearest image along the box's periodic axes (a
+/// region spanning a periodic axis meets itself at the box's faces).
 fn random_sites(
     n: usize,
     lo: DVec3,
     hi: DVec3,
     bound: f64,
     placed: &RigidBodies,
+    boundary: &Boundary,
     rng: &mut Xoshiro256PlusPlus,
 ) -> Result<Vec<DVec3>, String> {
+    let image = boundary.image();
     let mut taken: Vec<(DVec3, f64)> = (0..placed.len())
         .map(|i| (placed.position[i], placed.template(i).props.bounding_radius))
         .collect();
@@ -382,7 +389,7 @@ fn random_sites(
         );
         if taken
             .iter()
-            .all(|(y, r)| (x - *y).length_squared() >= (r + bound) * (r + bound))
+            .all(|(y, r)| image.apply(x - *y).length_squared() >= (r + bound) * (r + bound))
         {
             taken.push((x, bound));
         }
