@@ -195,8 +195,9 @@ impl Ledger {
 /// whether the flow was steady.
 #[derive(Debug, Clone, Default)]
 pub struct Balance {
-    /// (t, mass in, mass out) since the run began, at each event.
-    samples: Vec<[f64; 3]>,
+    /// (t, mass in, mass out, number in, number out) since the run
+    /// began, at each event.
+    samples: Vec<[f64; 5]>,
 }
 
 /// In and out within this fraction of each other: a steady flow (the
@@ -204,27 +205,36 @@ pub struct Balance {
 pub const STEADY: f64 = 0.02;
 
 impl Balance {
-    /// Records the running totals at time t.
-    pub fn record(&mut self, t: f64, mass_in: f64, mass_out: f64) {
-        self.samples.push([t, mass_in, mass_out]);
+    /// Records the running totals of the streams and outlets at time t.
+    pub fn record<'a>(
+        &mut self,
+        t: f64,
+        streams: impl Iterator<Item = &'a Stream> + Clone,
+        outlets: &[Outlet],
+    ) {
+        let mass_in = streams.clone().map(|i| i.mass).sum();
+        let mass_out = outlets.iter().map(|o| o.mass).sum();
+        let n_in = streams.map(|i| i.inserted as f64).sum();
+        let n_out = outlets.iter().map(|o| o.removed as f64).sum();
+        self.samples.push([t, mass_in, mass_out, n_in, n_out]);
     }
 
     /// The mean rates in and out over the later half of the events seen
-    /// (t₀, t₁, ṁ_in, ṁ_out), `None` before two events.
-    pub fn later_half(&self) -> Option<(f64, f64, f64, f64)> {
+    /// (t₀, t₁, ṁ_in, ṁ_out, ṅ_in, ṅ_out), `None` before two events.
+    pub fn later_half(&self) -> Option<(f64, f64, f64, f64, f64, f64)> {
         let last = *self.samples.last()?;
         let first = self.samples[self.samples.len() / 2];
         let span = last[0] - first[0];
         (span > 0.0).then(|| {
             let rate = |k: usize| (last[k] - first[k]) / span;
-            (first[0], last[0], rate(1), rate(2))
+            (first[0], last[0], rate(1), rate(2), rate(3), rate(4))
         })
     }
 
     /// The summary's sentence: the rates over the later half of the run
     /// and whether they agree within [`STEADY`].
     pub fn sentence(&self) -> Option<String> {
-        let (t0, t1, m_in, m_out) = self.later_half()?;
+        let (t0, t1, m_in, m_out, n_in, n_out) = self.later_half()?;
         if m_in == 0.0 && m_out == 0.0 {
             return None;
         }
@@ -238,8 +248,11 @@ impl Balance {
         };
         Some(format!(
             "Over t = {t0:.6e} … {t1:.6e} (the later half of this run's events): mass in \
-             {m_in:.6e} per unit time, out {m_out:.6e}, {:.1} % apart: {verdict}.",
-            100.0 * apart
+             {m_in:.6e} per unit time, out {m_out:.6e}, {:.1} % apart (in number {:.6e} in, \
+             {:.6e} out): {verdict}.",
+            100.0 * apart,
+            n_in,
+            n_out
         ))
     }
 }
@@ -405,14 +418,6 @@ impl Flow {
         }
     }
 
-    /// The running totals of mass in and out.
-    fn masses(&self) -> (f64, f64) {
-        (
-            self.streams().map(|i| i.mass).sum(),
-            self.outlets.iter().map(|o| o.mass).sum(),
-        )
-    }
-
     /// The event at the system's step: the outlets take out what reached
     /// them (in particle order, each particle through the first outlet
     /// that takes it), then each inserter in turn brings its stream up to
@@ -461,8 +466,8 @@ impl Flow {
         if removed || !arrived.is_empty() {
             forces.particles_changed(removed.then_some(&keep), &arrived);
         }
-        let (m_in, m_out) = self.masses();
-        self.balance.record(time, m_in, m_out);
+        let streams = self.inserters.iter().map(|i| &i.stream);
+        self.balance.record(time, streams, &self.outlets);
     }
 
     fn streams(&self) -> impl ExactSizeIterator<Item = &Stream> + Clone {
@@ -574,31 +579,62 @@ fn add(
 mod tests {
     use super::*;
 
+    fn stream() -> Stream {
+        Stream {
+            name: "s".into(),
+            region: Region {
+                lo: DVec3::ZERO,
+                hi: DVec3::ONE,
+            },
+            rate: Rate::Number(1.0),
+            start: 0.0,
+            count: None,
+            fill: None,
+            velocity: DVec3::ZERO,
+            velocity_spread: 0.0,
+            attempts: 1,
+            inserted: 0,
+            mass: 0.0,
+            most_behind: 0,
+        }
+    }
+
     /// Equal rates over the later half are steady, whatever came before;
     /// a rate 5 % short is not.
     #[test]
     fn a_flow_is_steady_when_in_and_out_agree_over_the_later_half() {
+        // One particle of mass 3 in per unit time; from t = 50 one out.
+        let record = |b: &mut Balance, t: f64, n_in: u64, n_out: u64, m_out: f64| {
+            let mut s = stream();
+            (s.inserted, s.mass) = (n_in, 3.0 * n_in as f64);
+            let mut o = Outlet::new("o", Exit::Region(s.region));
+            (o.removed, o.mass) = (n_out, m_out);
+            b.record(t, [s].iter(), &[o]);
+        };
         let mut b = Balance::default();
         assert_eq!(b.sentence(), None);
-        for k in 0..=100 {
-            let t = k as f64;
-            // Filling at first (nothing out), then 3 in and 3 out per unit time.
-            let out = if k < 50 { 0.0 } else { 3.0 * (t - 50.0) };
-            b.record(t, 3.0 * t, out);
+        for k in 0..=100u64 {
+            let out = k.saturating_sub(50);
+            record(&mut b, k as f64, k, out, 3.0 * out as f64);
         }
-        let (t0, t1, m_in, m_out) = b.later_half().unwrap();
-        assert_eq!((t0, t1, m_in, m_out), (50.0, 100.0, 3.0, 3.0));
-        assert!(b
-            .sentence()
-            .unwrap()
-            .ends_with("0.0 % apart: steady (in and out within 2 %)."));
+        assert_eq!(b.later_half().unwrap(), (50.0, 100.0, 3.0, 3.0, 1.0, 1.0));
+        let steady = b.sentence().unwrap();
+        assert!(
+            steady.ends_with(
+                "0.0 % apart (in number 1.000000e0 in, 1.000000e0 out): steady (in and out within 2 %)."
+            ),
+            "{steady}"
+        );
+        // The same count out, each 5 % lighter.
         let mut short = Balance::default();
-        for k in 0..=100 {
-            short.record(k as f64, 3.0 * k as f64, 2.85 * k as f64);
+        for k in 0..=100u64 {
+            record(&mut short, k as f64, k, k, 2.85 * k as f64);
         }
-        assert!(short
-            .sentence()
-            .unwrap()
-            .ends_with("5.0 % apart: not steady: the held mass grows."));
+        let growing = short.sentence().unwrap();
+        assert!(growing.contains("5.0 % apart"), "{growing}");
+        assert!(
+            growing.ends_with("not steady: the held mass grows."),
+            "{growing}"
+        );
     }
 }

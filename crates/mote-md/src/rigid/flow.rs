@@ -279,9 +279,8 @@ impl BodyFlow {
         if removed || arrived {
             frbi.bodies_changed(removed.then_some(&kept_spheres));
         }
-        let m_in = self.streams().map(|i| i.mass).sum();
-        let m_out = self.outlets.iter().map(|o| o.mass).sum();
-        self.balance.record(time, m_in, m_out);
+        let streams = self.inserters.iter().map(|i| &i.stream);
+        self.balance.record(time, streams, &self.outlets);
     }
 
     /// The name of template `kind`: the inserter's that makes it, else
