@@ -217,6 +217,16 @@ impl Balance {
         let n_in = streams.map(|i| i.inserted as f64).sum();
         let n_out = outlets.iter().map(|o| o.removed as f64).sum();
         self.samples.push([t, mass_in, mass_out, n_in, n_out]);
+        // A long run keeps every other sample once it holds 2¹⁴ (the
+        // samples stay evenly spread in time, the memory bounded).
+        let n = self.samples.len();
+        if n >= 1 << 14 {
+            let mut k = 0;
+            self.samples.retain(|_| {
+                k += 1;
+                (n - k).is_multiple_of(2)
+            });
+        }
     }
 
     /// The mean rates in and out over the later half of the events seen
@@ -625,6 +635,13 @@ mod tests {
             ),
             "{steady}"
         );
+        // Thinned when long, the last sample kept.
+        let mut long = Balance::default();
+        for k in 0..=(1u64 << 15) {
+            record(&mut long, k as f64, k, k, 3.0 * k as f64);
+        }
+        assert!(long.samples.len() < 1 << 14);
+        assert_eq!(long.samples.last().unwrap()[0], (1u64 << 15) as f64);
         // The same count out, each 5 % lighter.
         let mut short = Balance::default();
         for k in 0..=100u64 {
