@@ -139,6 +139,8 @@ impl Propagator for RigidDynamics {
         Ok(())
     }
 
+    /// The first body with a non-finite placement, velocity or spin, by
+    /// its id (its index unless bodies came and went).
     fn unstable(&self) -> Option<(usize, String)> {
         let b = &self.bodies;
         let (column, i) =
@@ -149,7 +151,7 @@ impl Propagator for RigidDynamics {
             "a non-finite spin",
         ][column];
         Some((
-            i,
+            b.id_of(i) as usize,
             format!(
                 "{what} (x {}, v {}, ω {})",
                 b.position[i], b.velocity[i], b.omega[i]
