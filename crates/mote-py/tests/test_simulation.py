@@ -261,6 +261,8 @@ def test_bad_input_raises_with_the_line():
     # Particles that come and go would move the arrays under the views.
     with pytest.raises(ValueError, match="come and go.*mote.run"):
         mote.Simulation.from_file("example:chute-flow")
+    with pytest.raises(ValueError, match="come and go.*mote.run"):
+        mote.RigidSimulation.from_file("example:toning-nip-flow")
 
 
 def test_an_unstable_run_raises_naming_step_and_particle_and_keeps_the_state():

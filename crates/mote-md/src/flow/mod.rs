@@ -99,7 +99,6 @@ pub struct Ledger {
 /// its inserter wrote: a sphere's radius and mass, a clump's template
 /// and mass).
 pub struct Restored {
-    pub next_id: u64,
     pub keep: Vec<bool>,
     pub inserted: Vec<(u64, usize, f64, f64)>,
 }
@@ -182,11 +181,7 @@ impl Ledger {
         self.made_by = vec![SCENE; keep.iter().filter(|k| **k).count()];
         self.made_by.extend(inserted.iter().map(|r| r.1 as u32));
         self.next_id = next_id as u64;
-        Ok(Restored {
-            next_id: next_id as u64,
-            keep,
-            inserted,
-        })
+        Ok(Restored { keep, inserted })
     }
 }
 
@@ -302,13 +297,13 @@ pub fn tally_names<'a>(
     ins.chain(outs).collect()
 }
 
-/// What came and went, for a run's summary; `things` names what flows
-/// ("particles", "bodies").
+/// What came and went, for a run's summary; `[one, things]` names what
+/// flows (`["particle", "particles"]`, `["body", "bodies"]`).
 pub fn tally_summary<'a>(
     streams: impl Iterator<Item = &'a Stream> + Clone,
     outlets: &[Outlet],
     held: usize,
-    things: &str,
+    [one, things]: [&str; 2],
 ) -> String {
     let n_in: u64 = streams.clone().map(|i| i.inserted).sum();
     let n_out: u64 = outlets.iter().map(|o| o.removed).sum();
@@ -318,7 +313,6 @@ pub fn tally_summary<'a>(
         "Flow: {n_in} {things} inserted (mass {m_in:.6e}), {n_out} removed (mass {m_out:.6e}), \
          {held} held."
     );
-    let one = things.strip_suffix('s').unwrap_or(things);
     for i in streams.filter(|i| i.most_behind > 0) {
         text.push_str(&format!(
             " Inserter {} fell behind its rate by up to {} {}: its region was too full.",
@@ -497,7 +491,12 @@ impl Flow {
 
     /// What came and went, for the run's summary.
     pub fn summary(&self, held: usize) -> String {
-        let text = tally_summary(self.streams(), &self.outlets, held, "particles");
+        let text = tally_summary(
+            self.streams(),
+            &self.outlets,
+            held,
+            ["particle", "particles"],
+        );
         join(text, self.balance.sentence())
     }
 
@@ -611,6 +610,26 @@ mod tests {
 
     /// Equal rates over the later half are steady, whatever came before;
     /// a rate 5 % short is not.
+    #[test]
+    fn the_summary_says_how_far_a_stream_fell_behind_in_its_own_words() {
+        let mut s = stream();
+        (s.inserted, s.mass, s.most_behind) = (5, 15.0, 1);
+        let one = tally_summary([s.clone()].iter(), &[], 5, ["body", "bodies"]);
+        assert!(
+            one.starts_with("Flow: 5 bodies inserted (mass 1.500000e1), 0 removed")
+                && one.ends_with(
+                    "Inserter s fell behind its rate by up to 1 body: its region was too full."
+                ),
+            "{one}"
+        );
+        s.most_behind = 3;
+        let three = tally_summary([s].iter(), &[], 5, ["particle", "particles"]);
+        assert!(
+            three.ends_with("by up to 3 particles: its region was too full."),
+            "{three}"
+        );
+    }
+
     #[test]
     fn a_flow_is_steady_when_in_and_out_agree_over_the_later_half() {
         // One particle of mass 3 in per unit time; from t = 50 one out.

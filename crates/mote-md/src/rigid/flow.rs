@@ -302,7 +302,7 @@ impl BodyFlow {
 
     /// What came and went, for the run's summary.
     pub fn summary(&self, held: usize) -> String {
-        let text = flow::tally_summary(self.streams(), &self.outlets, held, "bodies");
+        let text = flow::tally_summary(self.streams(), &self.outlets, held, ["body", "bodies"]);
         flow::join(text, self.balance.sentence())
     }
 
