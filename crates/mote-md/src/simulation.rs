@@ -110,9 +110,9 @@ impl Simulation {
             Ok(reach) => reach,
             Err(names) => {
                 return not_yet(&format!(
-                    "{} (Lennard-Jones/WCA, cut-off dipoles, Coulomb and dipoles by Ewald or \
-                     P3M, springs, granular contacts and walls, applied, uniform and electric fields \
-                     and damping do)",
+                    "{} (Lennard-Jones/WCA, cut-off dipoles, direct gravity, Coulomb direct, \
+                     Coulomb and dipoles by Ewald or P3M, springs, granular contacts and walls, \
+                     applied, uniform and electric fields and damping do)",
                     names.join(", ")
                 ))
             }

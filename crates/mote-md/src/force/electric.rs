@@ -17,6 +17,7 @@
 
 use glam::DVec3;
 
+use super::whole::Whole;
 use super::{DirectGravity, Interaction, State, ViewerHooks, Virial};
 
 /// Coulomb's law between all pairs of charges, in open space.
@@ -53,18 +54,43 @@ impl Interaction for DirectCoulomb {
         let charge = state.charges();
         self.field.clear();
         self.field.resize(state.position.len(), DVec3::ZERO);
-        self.kernel
-            .inverse_square_field(state.position, charge, &mut self.field);
+        match Whole::charges(state) {
+            Whole {
+                position,
+                value,
+                rows: Some((rows, _)),
+            } => self
+                .kernel
+                .inverse_square_rows(&position, &value, &rows, &mut self.field),
+            _ => self
+                .kernel
+                .inverse_square_field(state.position, charge, &mut self.field),
+        }
         for ((f, e), q) in force.iter_mut().zip(&self.field).zip(charge) {
             *f -= *e * (self.k * q);
         }
     }
 
+    /// U = (k/2) Σ_i q_i Σ_{j≠i} q_j / r_ij (on ranks, each rank's share:
+    /// the sum over its own charges).
     fn potential_energy(&mut self, state: &State) -> f64 {
-        0.5 * self.k
-            * self
+        let sum = match Whole::charges(state) {
+            Whole {
+                position,
+                value,
+                rows: Some((rows, _)),
+            } => self.kernel.pair_potential_rows(&position, &value, &rows),
+            _ => self
                 .kernel
-                .pair_potential_sum(state.position, state.charges())
+                .pair_potential_sum(state.position, state.charges()),
+        };
+        0.5 * self.k * sum
+    }
+
+    /// Decomposed as [`DirectGravity`]: all charges gathered in id order,
+    /// each rank's rows against all.
+    fn halo_reach(&self) -> Option<super::HaloReach> {
+        Some(super::HaloReach::NONE)
     }
 }
 

@@ -41,6 +41,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::whole::Whole;
 use super::{HaloReach, Interaction, Spin, State, Virial};
 
 /// erfc of musl/fdlibm (relative error below 1e-15 on the whole line), the
@@ -824,48 +825,8 @@ impl EwaldCoulomb {
     }
 }
 
-/// Every particle's position and one property in id order, as an Ewald sum
-/// reads them: the state's in one process, gathered to every rank
-/// ([`crate::domain::gathered`]) in a decomposed run, with the rows of
-/// this rank's particles.
-struct Whole<T> {
-    position: Vec<DVec3>,
-    value: Vec<T>,
-    rows: Option<(Vec<usize>, bool)>,
-}
-
+/// How an Ewald sum reads the whole: its share of it.
 impl<T: Copy> Whole<T> {
-    fn of<const K: usize>(
-        state: &State,
-        own: &[T],
-        pack: impl Fn(DVec3, T) -> [f64; K],
-        unpack: impl Fn(&[f64; K]) -> T,
-    ) -> Self {
-        match (state.halo, state.comm) {
-            (Some(halo), Some(comm)) => {
-                let all = crate::domain::gathered(
-                    state.position.iter().zip(own).map(|(r, v)| pack(*r, *v)),
-                    halo,
-                    comm,
-                    halo.total,
-                );
-                Whole {
-                    position: all.iter().map(|a| DVec3::new(a[0], a[1], a[2])).collect(),
-                    value: all.iter().map(unpack).collect(),
-                    rows: Some((
-                        halo.id.iter().map(|&id| id as usize).collect(),
-                        comm.rank() == 0,
-                    )),
-                }
-            }
-            _ => Whole {
-                position: state.position.to_vec(),
-                value: own.to_vec(),
-                rows: None,
-            },
-        }
-    }
-
     fn share(&self) -> Share<'_> {
         match &self.rows {
             None => Share::Whole,
@@ -878,23 +839,6 @@ impl<T: Copy> Whole<T> {
 
     fn counts_the_whole(&self) -> bool {
         self.share().counts_the_whole()
-    }
-}
-
-impl Whole<f64> {
-    fn charges(state: &State) -> Self {
-        Self::of(state, state.charges(), |r, q| [r.x, r.y, r.z, q], |a| a[3])
-    }
-}
-
-impl Whole<DVec3> {
-    fn dipoles(state: &State) -> Self {
-        Self::of(
-            state,
-            state.dipole,
-            |r, m| [r.x, r.y, r.z, m.x, m.y, m.z],
-            |a| DVec3::new(a[3], a[4], a[5]),
-        )
     }
 }
 

@@ -17,6 +17,7 @@ mod springs;
 pub mod timing;
 mod uniform;
 mod virial;
+mod whole;
 
 pub use damping::GlobalDamping;
 pub use electric::{DirectCoulomb, ElectricField};

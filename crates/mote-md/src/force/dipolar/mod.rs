@@ -67,6 +67,7 @@ mod listed;
 mod portable;
 mod tiled;
 
+use super::whole::Whole;
 use super::{HaloReach, Interaction, Spin, State, ViewerHooks, Virial};
 use crate::boundary::Boundary;
 use crate::domain::Halo;
@@ -504,20 +505,7 @@ impl DipoleDipole {
         tiled: bool,
     ) -> f64 {
         let n = pos.len();
-        let npad = n.div_ceil(LANES) * LANES;
-        let s = &mut self.soa;
-        for (v, c) in [
-            (&mut s.x, 0),
-            (&mut s.y, 1),
-            (&mut s.z, 2),
-            (&mut s.mx, 3),
-            (&mut s.my, 4),
-            (&mut s.mz, 5),
-        ] {
-            v.clear();
-            v.extend((0..n).map(|i| if c < 3 { pos[i][c] } else { dipoles[i][c - 3] }));
-            v.resize(npad, 0.0);
-        }
+        self.load(pos, dipoles);
         if tiled && n <= tiled::TILED_MAX {
             return self.tiled_forces(n, force, torque, isa);
         }
@@ -541,6 +529,97 @@ impl DipoleDipole {
             })
             .collect();
         0.5 * virials.iter().sum::<f64>()
+    }
+}
+
+impl DipoleDipole {
+    /// Copies positions and moments into the structure-of-arrays scratch,
+    /// padded to a multiple of the lanes with zero moments.
+    fn load(&mut self, pos: &[DVec3], dipoles: &[DVec3]) {
+        let n = pos.len();
+        let npad = n.div_ceil(LANES) * LANES;
+        let s = &mut self.soa;
+        for (v, c) in [
+            (&mut s.x, 0),
+            (&mut s.y, 1),
+            (&mut s.z, 2),
+            (&mut s.mx, 3),
+            (&mut s.my, 4),
+            (&mut s.mz, 5),
+        ] {
+            v.clear();
+            v.extend((0..n).map(|i| if c < 3 { pos[i][c] } else { dipoles[i][c - 3] }));
+            v.resize(npad, 0.0);
+        }
+    }
+
+    /// All pairs on ranks: the forces and torques on `rows` of the whole
+    /// (`pos`, `dipoles`: every particle in id order), each row over every
+    /// partner in id order — the row kernel one process uses beyond the
+    /// tiles' reach — so a row's bits do not depend on the rank count.
+    fn all_pairs_rows(
+        &mut self,
+        pos: &[DVec3],
+        dipoles: &[DVec3],
+        rows: &[usize],
+        force: &mut [DVec3],
+        torque: &mut [DVec3],
+    ) {
+        let n = pos.len();
+        self.load(pos, dipoles);
+        let (kern, soa, isa) = (self.kernel(), &self.soa, self.isa);
+        let virials: Vec<f64> = force
+            .par_iter_mut()
+            .zip(torque.par_iter_mut())
+            .zip(rows)
+            .with_min_len(16)
+            .map(|((f, t), &i)| {
+                let (fi, ti, w) = match isa {
+                    // SAFETY: the CPU supports AVX-512F (`isa`); the arrays have length ≥ n.
+                    #[cfg(target_arch = "x86_64")]
+                    Isa::Avx512 => unsafe { avx512::all_pairs_row(&kern, soa, i, n) },
+                    Isa::Portable => all_pairs_row(&kern, soa, i, n),
+                };
+                *f += fi;
+                *t += ti;
+                w
+            })
+            .collect();
+        // This rank's share of the virial, as its rows give it.
+        self.virial = 0.5 * virials.iter().sum::<f64>();
+    }
+
+    /// ½ Σ_{i ∈ rows} Σ_{j≠i} U_ij over the whole: a rank's share of the
+    /// all-pairs energy.
+    fn all_pairs_energy_rows(&self, pos: &[DVec3], dipoles: &[DVec3], rows: &[usize]) -> f64 {
+        let kern = self.kernel();
+        let per_i: Vec<f64> = rows
+            .par_iter()
+            .with_min_len(16)
+            .map(|&i| {
+                let mut u = 0.0;
+                for j in (0..pos.len()).filter(|&j| j != i) {
+                    let d = pos[i] - pos[j];
+                    let r2 = d.length_squared();
+                    if r2 > 0.0 {
+                        u += kern.pair(d, r2, dipoles[i], dipoles[j]).0;
+                    }
+                }
+                0.5 * u
+            })
+            .collect();
+        per_i.iter().sum()
+    }
+
+    /// The whole system where this is a decomposed run of all pairs: the
+    /// rank's share is then evaluated row by row ([`Whole`]).
+    fn whole_on_ranks(&self, state: &State) -> Option<(Whole<DVec3>, Vec<usize>)> {
+        if self.cutoff.is_finite() || state.halo.is_none() || state.comm.is_none() {
+            return None;
+        }
+        let mut whole = Whole::dipoles(state);
+        let (rows, _) = whole.rows.take()?;
+        Some((whole, rows))
     }
 }
 
@@ -661,6 +740,10 @@ impl Interaction for DipoleDipole {
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
         if state.dipole.len() == state.position.len() {
             let mut torque = vec![DVec3::ZERO; force.len()];
+            if let Some((whole, rows)) = self.whole_on_ranks(state) {
+                self.all_pairs_rows(&whole.position, &whole.value, &rows, force, &mut torque);
+                return;
+            }
             self.forces_in(
                 state.position,
                 state.dipole,
@@ -677,15 +760,19 @@ impl Interaction for DipoleDipole {
     }
 
     /// With a cut-off: its ghost list over the halo, the moments
-    /// forwarded. All pairs (open space) does not decompose (a ring of
-    /// the particle blocks would).
+    /// forwarded. All pairs (open space): every rank gathers every
+    /// particle's position and moment in id order ([`Whole`]) and sums its
+    /// own particles' rows over all of them; no ghosts.
     fn halo_reach(&self) -> Option<HaloReach> {
-        self.cutoff.is_finite().then_some(HaloReach {
-            cutoff: self.list.cutoff,
-            skin: self.list.skin,
-            every: self.list.every,
-            moments: true,
-            motion: false,
+        Some(match self.cutoff.is_finite() {
+            true => HaloReach {
+                cutoff: self.list.cutoff,
+                skin: self.list.skin,
+                every: self.list.every,
+                moments: true,
+                motion: false,
+            },
+            false => HaloReach::NONE,
         })
     }
 
@@ -701,6 +788,10 @@ impl Interaction for DipoleDipole {
         torque: &mut [DVec3],
     ) {
         if state.dipole.len() == state.position.len() {
+            if let Some((whole, rows)) = self.whole_on_ranks(state) {
+                self.all_pairs_rows(&whole.position, &whole.value, &rows, force, torque);
+                return;
+            }
             self.forces_in(
                 state.position,
                 state.dipole,
@@ -712,9 +803,13 @@ impl Interaction for DipoleDipole {
         }
     }
 
-    /// Σ_{i<j} U_ij (0 for a state without dipoles).
+    /// Σ_{i<j} U_ij (0 for a state without dipoles; on ranks of all
+    /// pairs, this rank's share ½ Σ_{i own} Σ_{j≠i} U_ij).
     fn potential_energy(&mut self, state: &State) -> f64 {
         if state.dipole.len() == state.position.len() {
+            if let Some((whole, rows)) = self.whole_on_ranks(state) {
+                return self.all_pairs_energy_rows(&whole.position, &whole.value, &rows);
+            }
             self.energy_in(state.position, state.dipole, state.boundary, state.halo)
         } else {
             0.0

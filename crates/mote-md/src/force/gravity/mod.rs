@@ -25,7 +25,8 @@ use glam::DVec3;
 use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
-use super::{Interaction, State};
+use super::whole::Whole;
+use super::{HaloReach, Interaction, State};
 
 /// Lanes of the inner loop: one AVX-512 register of f64.
 const LANES: usize = 8;
@@ -264,24 +265,109 @@ impl DirectGravity {
     }
 }
 
+impl DirectGravity {
+    /// The field of [`DirectGravity::inverse_square_field`] at `rows` of
+    /// the sources only, into `out` (one per row): each row summed over
+    /// every source, in the sources' order ([`portable::field_at`] or its
+    /// AVX-512 twin), so a row's bits do not depend on which rows are asked
+    /// for. A decomposed run's share: the rows of its rank's particles.
+    pub(crate) fn inverse_square_rows(
+        &mut self,
+        position: &[DVec3],
+        strength: &[f64],
+        rows: &[usize],
+        out: &mut [DVec3],
+    ) {
+        self.load_strengths(position, strength);
+        let eps2 = self.softening * self.softening;
+        let (soa, isa) = (self.soa(), isa());
+        out.par_iter_mut()
+            .zip(rows)
+            .with_min_len(16)
+            .for_each(|(a, &i)| {
+                *a = match isa {
+                    // SAFETY: the CPU supports AVX-512F (`isa`); slices are padded to 8.
+                    #[cfg(target_arch = "x86_64")]
+                    Isa::Avx512 => unsafe { avx512::field_at(i, soa, eps2) },
+                    Isa::Portable => portable::field_at(i, soa, eps2),
+                }
+            });
+    }
+
+    /// Σ_{i ∈ rows} s_i Σ_{j≠i} s_j / (|r_j − r_i|² + ε²)^{1/2}, the rows
+    /// in their order: [`DirectGravity::pair_potential_sum`]'s share of
+    /// `rows`.
+    pub(crate) fn pair_potential_rows(
+        &mut self,
+        position: &[DVec3],
+        strength: &[f64],
+        rows: &[usize],
+    ) -> f64 {
+        self.load_strengths(position, strength);
+        let eps2 = self.softening * self.softening;
+        let (soa, isa) = (self.soa(), isa());
+        let per_i: Vec<f64> = rows
+            .par_iter()
+            .with_min_len(16)
+            .map(|&i| {
+                soa.m[i]
+                    * match isa {
+                        // SAFETY: as in `inverse_square_rows`.
+                        #[cfg(target_arch = "x86_64")]
+                        Isa::Avx512 => unsafe { avx512::potential_at(i, soa, eps2) },
+                        Isa::Portable => portable::potential_at(i, soa, eps2),
+                    }
+            })
+            .collect();
+        per_i.iter().sum()
+    }
+}
+
 impl Interaction for DirectGravity {
     fn name(&self) -> &'static str {
         "gravity"
     }
 
     fn add_forces(&mut self, state: &State, force: &mut [DVec3]) {
-        self.load(state);
         let mut field = vec![DVec3::ZERO; state.position.len()];
-        self.field(&mut field);
+        match Whole::masses(state) {
+            Whole {
+                position,
+                value,
+                rows: Some((rows, _)),
+            } => self.inverse_square_rows(&position, &value, &rows, &mut field),
+            _ => {
+                self.load(state);
+                self.field(&mut field);
+            }
+        }
         for ((f, a), m) in force.iter_mut().zip(&field).zip(state.mass) {
             *f += *a * (self.g * m);
         }
     }
 
-    /// U = −(G/2) Σ_i m_i Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2}, summed in a fixed order.
+    /// U = −(G/2) Σ_i m_i Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2}, summed in a fixed order
+    /// (on ranks, each rank's share: the sum over its own particles).
     fn potential_energy(&mut self, state: &State) -> f64 {
-        self.load(state);
-        -0.5 * self.g * self.potential_sum(state.position.len())
+        let sum = match Whole::masses(state) {
+            Whole {
+                position,
+                value,
+                rows: Some((rows, _)),
+            } => self.pair_potential_rows(&position, &value, &rows),
+            _ => {
+                self.load(state);
+                self.potential_sum(state.position.len())
+            }
+        };
+        -0.5 * self.g * sum
+    }
+
+    /// Decomposed over ranks: every rank gathers every particle's position
+    /// and mass in id order ([`Whole`]) and sums the pull of all of them
+    /// on each of its own particles, row by row; no ghosts.
+    fn halo_reach(&self) -> Option<HaloReach> {
+        Some(HaloReach::NONE)
     }
 }
 
