@@ -20,16 +20,67 @@ unsafe fn separations(
     eps2: __m512d,
 ) -> ([__m512d; 3], __m512d, __m512d) {
     // SAFETY: the caller guarantees j + 8 ≤ the slices' length.
-    let dx = _mm512_sub_pd(_mm512_loadu_pd(p.x.as_ptr().add(j)), ri[0]);
-    let dy = _mm512_sub_pd(_mm512_loadu_pd(p.y.as_ptr().add(j)), ri[1]);
-    let dz = _mm512_sub_pd(_mm512_loadu_pd(p.z.as_ptr().add(j)), ri[2]);
-    let m = _mm512_loadu_pd(p.m.as_ptr().add(j));
+    let (rj, m) = unsafe { load(p, j) };
+    let (d, r2) = separated(rj, ri, eps2);
+    (d, m, r2)
+}
+
+/// The 8 particles from j: positions and masses.
+///
+/// # Safety
+/// j + 8 ≤ the slices' length.
+#[inline]
+#[target_feature(enable = "avx512f")]
+unsafe fn load(p: Soa, j: usize) -> ([__m512d; 3], __m512d) {
+    // SAFETY: the caller guarantees j + 8 ≤ the slices' length.
+    unsafe {
+        (
+            [
+                _mm512_loadu_pd(p.x.as_ptr().add(j)),
+                _mm512_loadu_pd(p.y.as_ptr().add(j)),
+                _mm512_loadu_pd(p.z.as_ptr().add(j)),
+            ],
+            _mm512_loadu_pd(p.m.as_ptr().add(j)),
+        )
+    }
+}
+
+/// d = r_j − r_i and r² = |d|² + ε².
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn separated(rj: [__m512d; 3], ri: [__m512d; 3], eps2: __m512d) -> ([__m512d; 3], __m512d) {
+    let dx = _mm512_sub_pd(rj[0], ri[0]);
+    let dy = _mm512_sub_pd(rj[1], ri[1]);
+    let dz = _mm512_sub_pd(rj[2], ri[2]);
     let r2 = _mm512_fmadd_pd(
         dx,
         dx,
         _mm512_fmadd_pd(dy, dy, _mm512_fmadd_pd(dz, dz, eps2)),
     );
-    ([dx, dy, dz], m, r2)
+    ([dx, dy, dz], r2)
+}
+
+/// The pull m_j d/r³ of 8 partners added to `a` (lanes at no distance add nothing).
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn pull(a: &mut [__m512d; 3], d: [__m512d; 3], m: __m512d, r2: __m512d) {
+    let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, _mm512_setzero_pd());
+    let y = rsqrt(r2);
+    let s = _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_mul_pd(y, y), y), m);
+    for (a, d) in a.iter_mut().zip(d) {
+        *a = _mm512_fmadd_pd(s, d, *a);
+    }
+}
+
+/// The lanes of a row's sums added up.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn reduced(a: [__m512d; 3]) -> DVec3 {
+    DVec3::new(
+        _mm512_reduce_add_pd(a[0]),
+        _mm512_reduce_add_pd(a[1]),
+        _mm512_reduce_add_pd(a[2]),
+    )
 }
 
 /// r_i broadcast to all lanes.
@@ -183,23 +234,36 @@ pub(super) unsafe fn pairs2(
 pub(super) unsafe fn field_at(i: usize, p: Soa, eps2: f64) -> DVec3 {
     let ri = broadcast(p, i);
     let veps2 = _mm512_set1_pd(eps2);
-    let zero = _mm512_setzero_pd();
-    let (mut ax, mut ay, mut az) = (zero, zero, zero);
+    let mut a = [_mm512_setzero_pd(); 3];
     for j in (0..p.x.len()).step_by(8) {
         // SAFETY: j + 8 ≤ len.
-        let ([dx, dy, dz], m, r2) = separations(p, j, ri, veps2);
-        let live = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r2, zero);
-        let y = rsqrt(r2);
-        let s = _mm512_maskz_mul_pd(live, _mm512_mul_pd(_mm512_mul_pd(y, y), y), m);
-        ax = _mm512_fmadd_pd(s, dx, ax);
-        ay = _mm512_fmadd_pd(s, dy, ay);
-        az = _mm512_fmadd_pd(s, dz, az);
+        let (rj, m) = unsafe { load(p, j) };
+        let (d, r2) = separated(rj, ri, veps2);
+        pull(&mut a, d, m, r2);
     }
-    DVec3::new(
-        _mm512_reduce_add_pd(ax),
-        _mm512_reduce_add_pd(ay),
-        _mm512_reduce_add_pd(az),
-    )
+    reduced(a)
+}
+
+/// [`field_at`] of rows i0 and i1 through each block of partners together:
+/// one load of the block for both, two independent 1/√r² chains; each row
+/// the bits of [`field_at`].
+///
+/// # Safety
+/// As for [`field_at`]; i0, i1 < the slices' length.
+#[target_feature(enable = "avx512f")]
+pub(super) unsafe fn field_at2(i0: usize, i1: usize, p: Soa, eps2: f64) -> (DVec3, DVec3) {
+    let (r0, r1) = (broadcast(p, i0), broadcast(p, i1));
+    let veps2 = _mm512_set1_pd(eps2);
+    let (mut a0, mut a1) = ([_mm512_setzero_pd(); 3], [_mm512_setzero_pd(); 3]);
+    for j in (0..p.x.len()).step_by(8) {
+        // SAFETY: j + 8 ≤ len.
+        let (rj, m) = unsafe { load(p, j) };
+        let (d0, r2_0) = separated(rj, r0, veps2);
+        let (d1, r2_1) = separated(rj, r1, veps2);
+        pull(&mut a0, d0, m, r2_0);
+        pull(&mut a1, d1, m, r2_1);
+    }
+    (reduced(a0), reduced(a1))
 }
 
 /// See [`super::portable::potential_at`].

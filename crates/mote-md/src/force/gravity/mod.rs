@@ -172,18 +172,8 @@ impl DirectGravity {
         let npad = self.x.len();
         let n = out.len();
         if npad > SYMMETRIC_MAX {
-            let soa = self.soa();
-            out.par_iter_mut()
-                .enumerate()
-                .with_min_len(64)
-                .for_each(|(i, a)| {
-                    *a = match isa {
-                        // SAFETY: the CPU supports AVX-512F (`isa`); slices are padded to 8.
-                        #[cfg(target_arch = "x86_64")]
-                        Isa::Avx512 => unsafe { avx512::field_at(i, soa, eps2) },
-                        Isa::Portable => portable::field_at(i, soa, eps2),
-                    }
-                });
+            let rows: Vec<usize> = (0..n).collect();
+            field_rows(self.soa(), eps2, &rows, out, isa);
             return;
         }
         let tile = Self::tile(npad);
@@ -280,18 +270,7 @@ impl DirectGravity {
     ) {
         self.load_strengths(position, strength);
         let eps2 = self.softening * self.softening;
-        let (soa, isa) = (self.soa(), isa());
-        out.par_iter_mut()
-            .zip(rows)
-            .with_min_len(16)
-            .for_each(|(a, &i)| {
-                *a = match isa {
-                    // SAFETY: the CPU supports AVX-512F (`isa`); slices are padded to 8.
-                    #[cfg(target_arch = "x86_64")]
-                    Isa::Avx512 => unsafe { avx512::field_at(i, soa, eps2) },
-                    Isa::Portable => portable::field_at(i, soa, eps2),
-                }
-            });
+        field_rows(self.soa(), eps2, rows, out, isa());
     }
 
     /// Σ_{i ∈ rows} s_i Σ_{j≠i} s_j / (|r_j − r_i|² + ε²)^{1/2}, the rows
@@ -321,6 +300,27 @@ impl DirectGravity {
             .collect();
         per_i.iter().sum()
     }
+}
+
+/// The field at each of `rows` into `out`, each row over every particle of
+/// `soa` in its order, two rows through each block of partners together
+/// (each row the bits of the one-row kernel, whatever its neighbour: so a
+/// row's bits do not depend on which rows are asked for).
+fn field_rows(soa: Soa, eps2: f64, rows: &[usize], out: &mut [DVec3], isa: Isa) {
+    out.par_chunks_mut(2)
+        .zip(rows.par_chunks(2))
+        .with_min_len(8)
+        .for_each(|(a, i)| match (i, isa) {
+            // SAFETY: the CPU supports AVX-512F (`isa`); slices are padded to 8.
+            #[cfg(target_arch = "x86_64")]
+            (&[i0, i1], Isa::Avx512) => {
+                (a[0], a[1]) = unsafe { avx512::field_at2(i0, i1, soa, eps2) }
+            }
+            #[cfg(target_arch = "x86_64")]
+            (&[i0], Isa::Avx512) => a[0] = unsafe { avx512::field_at(i0, soa, eps2) },
+            (&[i0, i1], _) => (a[0], a[1]) = portable::field_at2(i0, i1, soa, eps2),
+            (i, _) => a[0] = portable::field_at(i[0], soa, eps2),
+        });
 }
 
 impl Interaction for DirectGravity {
@@ -449,6 +449,56 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// Two rows through each block of partners give each row the bits of
+    /// the one-row kernel, at every level (so a rank's rows do not depend
+    /// on which rows it holds).
+    #[test]
+    fn paired_rows_have_the_bits_of_single_rows() {
+        let (pos, vel, mass) = cloud(203);
+        let state = State::new(&pos, &vel, &mass, 0.0);
+        let mut g = DirectGravity::new(1.0, 1e-3);
+        g.load(&state);
+        let eps2 = 1e-6;
+        let mut isas = vec![Isa::Portable];
+        if isa() != Isa::Portable {
+            isas.push(isa());
+        }
+        for which in isas {
+            for (i0, i1) in [(0, 1), (5, 150), (202, 7)] {
+                let single = |i| match which {
+                    #[cfg(target_arch = "x86_64")]
+                    Isa::Avx512 => unsafe { avx512::field_at(i, g.soa(), eps2) },
+                    Isa::Portable => portable::field_at(i, g.soa(), eps2),
+                };
+                let paired = match which {
+                    #[cfg(target_arch = "x86_64")]
+                    Isa::Avx512 => unsafe { avx512::field_at2(i0, i1, g.soa(), eps2) },
+                    Isa::Portable => portable::field_at2(i0, i1, g.soa(), eps2),
+                };
+                assert_eq!(
+                    paired,
+                    (single(i0), single(i1)),
+                    "{which:?} rows {i0}, {i1}"
+                );
+            }
+            // Asked for in any order and number, a row is the same.
+            let mut all = vec![DVec3::ZERO; 203];
+            field_rows(
+                g.soa(),
+                eps2,
+                &(0..203).collect::<Vec<_>>(),
+                &mut all,
+                which,
+            );
+            let some = [150, 3, 77];
+            let mut three = vec![DVec3::ZERO; 3];
+            field_rows(g.soa(), eps2, &some, &mut three, which);
+            for (k, &i) in some.iter().enumerate() {
+                assert_eq!(three[k], all[i], "{which:?} row {i}");
             }
         }
     }

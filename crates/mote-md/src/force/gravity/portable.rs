@@ -100,19 +100,54 @@ pub(super) fn pairs2(
     (sum(a0), sum(a1))
 }
 
-/// Σ_{j≠i} m_j d_j / (|d_j|² + ε²)^{3/2}, d_j = r_j − r_i (every j).
+/// Σ_{j≠i} m_j d_j / (|d_j|² + ε²)^{3/2}, d_j = r_j − r_i (every j), eight
+/// partners at a time on [`Lanes`], 1/√r² by [`Lane::rsqrt`].
 pub(super) fn field_at(i: usize, p: Soa, eps2: f64) -> DVec3 {
-    let (xi, yi, zi) = (p.x[i], p.y[i], p.z[i]);
-    let mut a = DVec3::ZERO;
-    for j in 0..p.x.len() {
-        let (dx, dy, dz) = (p.x[j] - xi, p.y[j] - yi, p.z[j] - zi);
-        let r2 = dx * dx + dy * dy + dz * dz + eps2;
-        if r2 > 0.0 {
-            let s = p.m[j] / (r2 * r2.sqrt());
-            a += DVec3::new(s * dx, s * dy, s * dz);
-        }
+    let ri = [p.x[i], p.y[i], p.z[i]].map(Lanes::splat);
+    let mut a = [Lanes::splat(0.0); 3];
+    for j in (0..p.x.len()).step_by(LANES) {
+        let (rj, mj) = partners(p, j);
+        pull(&mut a, rj, mj, ri, eps2);
     }
-    a
+    a.map(Lanes::sum).into()
+}
+
+/// [`field_at`] of rows i0 and i1 through each block of partners together
+/// (shared loads, two independent 1/√r² chains); each row the bits of
+/// [`field_at`].
+pub(super) fn field_at2(i0: usize, i1: usize, p: Soa, eps2: f64) -> (DVec3, DVec3) {
+    let row = |i: usize| [p.x[i], p.y[i], p.z[i]].map(Lanes::splat);
+    let (r0, r1) = (row(i0), row(i1));
+    let (mut a0, mut a1) = ([Lanes::splat(0.0); 3], [Lanes::splat(0.0); 3]);
+    for j in (0..p.x.len()).step_by(LANES) {
+        let (rj, mj) = partners(p, j);
+        pull(&mut a0, rj, mj, r0, eps2);
+        pull(&mut a1, rj, mj, r1, eps2);
+    }
+    (a0.map(Lanes::sum).into(), a1.map(Lanes::sum).into())
+}
+
+/// Positions and masses of the eight partners from j (the slices are
+/// padded to a multiple of [`LANES`]).
+#[inline(always)]
+fn partners(p: Soa, j: usize) -> ([Lanes; 3], Lanes) {
+    (
+        [p.x, p.y, p.z].map(|v| Lanes::load(v, j, LANES)),
+        Lanes::load(p.m, j, LANES),
+    )
+}
+
+/// a += m_j d/(|d|² + ε²)^{3/2}, d = r_j − r_i, lane by lane (a lane at no
+/// distance adds nothing).
+#[inline(always)]
+fn pull(a: &mut [Lanes; 3], rj: [Lanes; 3], mj: Lanes, ri: [Lanes; 3], eps2: f64) {
+    let d: [Lanes; 3] = std::array::from_fn(|c| rj[c] - ri[c]);
+    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2;
+    let y = r2.rsqrt();
+    let s = (y * y * y).where_positive(r2) * mj;
+    for (a, d) in a.iter_mut().zip(d) {
+        *a = *a + s * d;
+    }
 }
 
 /// Σ_{j≠i} m_j / (|r_j − r_i|² + ε²)^{1/2}.
