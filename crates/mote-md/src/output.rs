@@ -108,7 +108,7 @@ impl ObservablesCsv {
             for name in flow.column_names() {
                 let unit = match name.split('_').next() {
                     Some("mass") => m,
-                    Some("charge") => "charge",
+                    Some("charge") => units.charge_label(),
                     _ => "1",
                 };
                 unit_row.push(unit.into());
@@ -208,7 +208,21 @@ impl OutflowCsv {
             "step", "time", "id", "outlet", "mass", "charge", "radius", "x", "y", "z", "vx", "vy",
             "vz",
         ];
-        let units = ["1", t, "1", "1", m, "charge", l, l, l, l, &v, &v, &v];
+        let units = [
+            "1",
+            t,
+            "1",
+            "1",
+            m,
+            units.charge_label(),
+            l,
+            l,
+            l,
+            l,
+            &v,
+            &v,
+            &v,
+        ];
         let writer = if append {
             CsvWriter::append(path, columns.len())?
         } else {

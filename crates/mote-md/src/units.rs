@@ -54,6 +54,17 @@ impl UnitSystem {
         }
     }
 
+    /// The label of the charge unit: C in SI; in reduced units the charge
+    /// q* = q/√(4πε₀σε); in astronomical units the charge whose Coulomb
+    /// energy k q²/r is in Msun AU²/d² for the scene's k.
+    pub fn charge_label(self) -> &'static str {
+        match self {
+            UnitSystem::Si => "C",
+            UnitSystem::Lj => "(4*pi*eps0*sigma*epsilon)^(1/2)",
+            UnitSystem::Astro => "(Msun*AU^3/d^2/k)^(1/2)",
+        }
+    }
+
     /// Unit labels for (length, time, mass, energy).
     pub fn labels(self) -> [&'static str; 4] {
         match self {

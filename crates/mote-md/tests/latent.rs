@@ -173,6 +173,64 @@ fn latent_image_matches_the_fourier_series() {
     }
 }
 
+/// The copies summed as two progressions of products (one logarithm
+/// each) give the copy-by-copy sum's field to round-off: the toning nip's
+/// geometry (L = 2.3 h) and periods down to 0.23 h (q = e^{−πL/h} = 0.48),
+/// from just above the charged surface to just under the shell, over a
+/// whole period and with the belt moved.
+#[test]
+fn image_copies_by_progressions_match_copy_by_copy() {
+    for (gap, period, height, patches) in [
+        (
+            2.58e-4,
+            6.0e-4,
+            8.0e-6,
+            vec![[0.0, 1.5e-4, 6.6e-4], [3.0e-4, 4.5e-4, 6.6e-4]],
+        ),
+        (1.0, 1.2, 0.08, vec![[0.2, 0.7, 1.1]]),
+        (1.0, 0.5, 0.08, vec![[-0.1, 0.3, -1.0], [0.35, 0.45, 2.0]]),
+        (1.0, 0.23, 0.05, vec![[0.0, 0.2, 1.0]]),
+    ] {
+        let img = LatentImage {
+            k: 8.9875517923e9,
+            gap,
+            height,
+            period,
+            speed: 0.3,
+            background: 1.1e-4,
+            patches: patches
+                .iter()
+                .map(|&[start, end, density]| Patch {
+                    start,
+                    end,
+                    density,
+                })
+                .collect(),
+        };
+        img.check().unwrap();
+        let mut worst: f64 = 0.0;
+        for i in 0..=40 {
+            for z in [
+                1.0001,
+                1.01,
+                1.5,
+                4.0,
+                0.5 * gap / height,
+                0.999 * gap / height,
+            ] {
+                let (x, z) = (period * (i as f64 / 40.0 - 0.3), z * height);
+                for t in [0.0, 1.7e-4] {
+                    let (ex, ez) = img.field(x, z, t);
+                    let (rx, rz) = img.field_copy_by_copy(x, z, t);
+                    let scale = rx.hypot(rz);
+                    worst = worst.max((ex - rx).hypot(ez - rz) / scale);
+                }
+            }
+        }
+        assert!(worst < 1e-12, "L = {period}, h = {gap}: {worst:.2e}");
+    }
+}
+
 #[test]
 fn latent_image_limits_and_motion() {
     let mut img = LatentImage {

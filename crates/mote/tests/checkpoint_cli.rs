@@ -388,6 +388,11 @@ fn a_flow_resumed_as_it_ran(
         outflow.lines().filter(|l| !l.starts_with('#')).count() > left,
         "too few left"
     );
+    // The charge column's unit is the unit system's (C in SI, the reduced
+    // charge in LJ units), not a word.
+    let units = outflow.lines().find(|l| l.starts_with("# units:")).unwrap();
+    let charge = units.split(',').nth(5).unwrap();
+    assert!(charge == "C" || charge.starts_with("(4*pi*eps0"), "{units}");
     for file in ["observables.csv", "outflow.csv", "trajectory.xyz"] {
         assert!(
             same_file(dir, file),

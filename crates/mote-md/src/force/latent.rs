@@ -35,7 +35,10 @@
 //! two forms of ln((ζ − ζ̄′)/(ζ − ζ′)) that agree at s = 0 and never
 //! overflow. The whole plane gives the uniform field E_z = 4πkσ d/h. The
 //! periodic copies of a strip along x, at distance s, add e^{−π|s|/h}: they
-//! are summed until that is below 10⁻¹⁷.
+//! are summed until that is below 10⁻¹⁷. The copies on either side of a
+//! point are each a geometric progression in e^{∓us} of ratio q = e^{−uL},
+//! so each side's logarithms are the logarithm of one product (one ln and
+//! one atan2 for all its copies; copy by copy where q ≥ ½).
 
 use glam::DVec3;
 
@@ -112,6 +115,22 @@ fn log_one_minus(a: f64, theta: f64) -> (f64, f64) {
     (0.5 * (re * re + im * im).ln(), im.atan2(re))
 }
 
+/// Σ_{k<count} ln(1 − A qᵏ e^{iθ}) as (re, im), 0 ≤ A ≤ 1, 0 ≤ q < ½,
+/// given (sin θ, cos θ): the logarithm of the product — one logarithm and
+/// one arctangent for the progression instead of one each a term. The
+/// first factor turns by less than π/2 (its real part 1 − A cos θ ≥ 0), the
+/// others (k ≥ 1) each by at most arcsin qᵏ, together less than 1.02, so the
+/// product's argument is the sum of theirs (no turn of 2π lost).
+fn log_progression(a: f64, q: f64, (s, c): (f64, f64), count: usize) -> (f64, f64) {
+    let (mut re, mut im, mut x) = (1.0, 0.0, a);
+    for _ in 0..count {
+        let (fr, fi) = (1.0 - x * c, -x * s);
+        (re, im) = (re * fr - im * fi, re * fi + im * fr);
+        x *= q;
+    }
+    (0.5 * (re * re + im * im).ln(), im.atan2(re))
+}
+
 impl LatentImage {
     /// Checks the geometry: 0 < d < h, L > 0, patches inside one period.
     pub fn check(&self) -> Result<(), String> {
@@ -148,17 +167,87 @@ impl LatentImage {
         }
     }
 
+    /// Σ_{n=−R}^{R} Λ(s + nL) at height z as (re, im), given (sin, cos)
+    /// of θ₁ and θ₂: the copies with s + nL ≤ 0 and those beyond are each a
+    /// progression in e^{∓u(s + nL)} of ratio q = e^{−uL}
+    /// ([`log_progression`]).
+    fn lambda_copies(
+        &self,
+        s: f64,
+        reach: i64,
+        q: f64,
+        theta1: (f64, f64),
+        theta2: (f64, f64),
+    ) -> (f64, f64) {
+        let (l, u) = (self.period, std::f64::consts::PI / self.gap);
+        // The last copy at or before the edge: s + nL ≤ 0 for n ≤ last.
+        let last = ((-s / l).floor() as i64).clamp(-reach - 1, reach);
+        let conjugate = |(sin, cos): (f64, f64)| (-sin, cos);
+        let (mut re, mut im) = (0.0, 0.0);
+        let before = (last + reach + 1) as usize;
+        if before > 0 {
+            // e^{u(s + nL)} for n = last, last − 1, …, −R.
+            let b = (u * (s + last as f64 * l)).exp();
+            let a1 = log_progression(b, q, conjugate(theta1), before);
+            let a2 = log_progression(b, q, conjugate(theta2), before);
+            (re, im) = (a1.0 - a2.0, a1.1 - a2.1);
+        }
+        let after = (reach - last) as usize;
+        if after > 0 {
+            // e^{−u(s + nL)} for n = last + 1, …, R.
+            let a = (-u * (s + (last + 1) as f64 * l)).exp();
+            let a1 = log_progression(a, q, theta1, after);
+            let a2 = log_progression(a, q, theta2, after);
+            re += a1.0 - a2.0;
+            im += a1.1 - a2.1 - after as f64 * 2.0 * u * self.height;
+        }
+        (re, im)
+    }
+
     /// The field (E_x, E_z) at (x, z), d < z < h, at time t.
     pub fn field(&self, x: f64, z: f64, t: f64) -> (f64, f64) {
         let (l, u) = (self.period, std::f64::consts::PI / self.gap);
+        let q = (-u * l).exp();
+        if q >= 0.5 {
+            // A period under 0.22 h: copy by copy.
+            return self.field_copy_by_copy(x, z, t);
+        }
+        let theta1 = (u * (z + self.height)).sin_cos();
+        let theta2 = (u * (z - self.height)).sin_cos();
         let mut ex = 0.0;
         let mut ez = 4.0 * std::f64::consts::PI * self.k * self.background * self.height / self.gap;
-        // Copies beyond n periods add e^{−u(nL − w)}; 39.2 = ln 10¹⁷.
         for p in &self.patches {
-            let w = p.end - p.start;
-            let mid = 0.5 * (p.start + p.end) + self.speed * t - x;
-            let c = mid - (mid / l).round() * l;
-            let reach = ((39.2 / u + w) / l).ceil() as i64 + 1;
+            let (w, c, reach) = self.placed(p, x, t);
+            let a = self.lambda_copies(c + 0.5 * w, reach, q, theta1, theta2);
+            let b = self.lambda_copies(c - 0.5 * w, reach, q, theta1, theta2);
+            let scale = 2.0 * self.k * (p.density - self.background);
+            ex += scale * (a.0 - b.0);
+            ez -= scale * (a.1 - b.1);
+        }
+        (ex, ez)
+    }
+
+    /// Patch `p`'s width w, its centre's offset c from x at time t (within
+    /// half a period), and the copies ±R summed: beyond R periods a copy
+    /// adds e^{−u(RL − w)}; 39.2 = ln 10¹⁷.
+    fn placed(&self, p: &Patch, x: f64, t: f64) -> (f64, f64, i64) {
+        let (l, u) = (self.period, std::f64::consts::PI / self.gap);
+        let w = p.end - p.start;
+        let mid = 0.5 * (p.start + p.end) + self.speed * t - x;
+        let c = mid - (mid / l).round() * l;
+        let reach = ((39.2 / u + w) / l).ceil() as i64 + 1;
+        (w, c, reach)
+    }
+
+    /// [`LatentImage::field`] summing Λ copy by copy (two logarithms each):
+    /// for periods too short for the progressions, and the reference they
+    /// are tested against.
+    pub fn field_copy_by_copy(&self, x: f64, z: f64, t: f64) -> (f64, f64) {
+        let l = self.period;
+        let mut ex = 0.0;
+        let mut ez = 4.0 * std::f64::consts::PI * self.k * self.background * self.height / self.gap;
+        for p in &self.patches {
+            let (w, c, reach) = self.placed(p, x, t);
             let (mut re, mut im) = (0.0, 0.0);
             for n in -reach..=reach {
                 let s = c + n as f64 * l;
