@@ -273,3 +273,92 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
         );
     }
 }
+
+/// The moments and forces of 29 beads (three blocks of eight and a tail),
+/// some saturated, in a box periodic along x and y: the lanes give every
+/// body the bits of the loops over pairs with the scalar dipole laws.
+#[test]
+fn lanes_give_the_bits_of_the_loops_over_pairs() {
+    use mote_md::force::dipolar::{dipole_field, dipole_pair};
+    let period = [4e-4, 3e-4];
+    let alpha = InducedDipoles::polarisability(volume(20e-6), 6.0);
+    let cap = alpha * 0.068;
+    let mut model = InducedDipoles {
+        roller: roller(),
+        polarisability: vec![alpha],
+        saturation: vec![cap],
+        dipole_dipole: 1e-7,
+        iterations: 2,
+        period,
+    };
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let points: Vec<DVec3> = (0..29)
+        .map(|_| {
+            DVec3::new(
+                period[0] * uniform(),
+                period[1] * uniform(),
+                1e-4 + 1.5e-4 * uniform(),
+            )
+        })
+        .collect();
+    let b = bodies_at(&points);
+    let t = 0.0031;
+    let f = forces(&mut model, &b, t);
+
+    // The reference: the loops over pairs, one pair at a time.
+    let image = |mut d: DVec3| {
+        for a in 0..2 {
+            d[a] -= (d[a] / period[a]).round() * period[a];
+        }
+        d
+    };
+    let induce = |b: DVec3| {
+        let m = alpha * b;
+        if m.length() > cap {
+            m * (cap / m.length())
+        } else {
+            m
+        }
+    };
+    let external: Vec<DVec3> = points.iter().map(|p| model.roller.at(*p, t)).collect();
+    let mut m: Vec<DVec3> = external.iter().map(|b| induce(*b)).collect();
+    for _ in 0..2 {
+        m = (0..points.len())
+            .map(|i| {
+                let mut local = external[i];
+                for j in (0..points.len()).filter(|&j| j != i) {
+                    let d = image(points[i] - points[j]);
+                    local += dipole_field(1e-7, m[j], d, 1.0 / d.length_squared());
+                }
+                induce(local)
+            })
+            .collect();
+    }
+    let saturated = m
+        .iter()
+        .filter(|v| v.length() >= cap * (1.0 - 1e-12))
+        .count();
+    assert!(
+        saturated > 0 && saturated < m.len(),
+        "{saturated} saturated"
+    );
+    for i in 0..points.len() {
+        let (_, mut expected) = model.roller.with_gradient(points[i], m[i], t);
+        for j in (0..points.len()).filter(|&j| j != i) {
+            let d = image(points[i] - points[j]);
+            expected += dipole_pair(1e-7, d, 1.0 / d.length_squared(), m[i], m[j]).1;
+        }
+        assert_eq!(
+            f[i].to_array().map(f64::to_bits),
+            expected.to_array().map(f64::to_bits),
+            "body {i}: {} against {expected}",
+            f[i]
+        );
+    }
+}

@@ -24,15 +24,21 @@
 //! ([`crate::force::dipolar::dipole_pair`], as between permanent dipoles)
 //! (minimum image along the periodic axes); the moments are taken as
 //! isotropic, along the local field, so they exert no torque.
+//!
+//! The sums over the other moments run eight partners at a time on
+//! [`Lanes`]: each lane the scalar law's operations in their order, the
+//! eight terms then added one by one in order of the partners, so a body's
+//! field and force have the bits of the loop over pairs.
 
 use std::f64::consts::PI;
 
 use glam::DVec3;
+use mote_geom::lanes::{Lanes, LANES, V3};
 use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
-use crate::force::dipolar::{dipole_field, dipole_pair};
+use crate::force::dipolar::{dipole_field_lanes, dipole_pair_force_lanes};
 
 /// μ₀ in SI.
 pub const MU0: f64 = 4.0e-7 * PI;
@@ -110,15 +116,44 @@ impl InducedDipoles {
         3.0 * volume * (permeability - 1.0) / (permeability + 2.0) / MU0
     }
 
-    fn separation(&self, d: DVec3) -> DVec3 {
-        let mut d = d;
-        for a in 0..2 {
-            let l = self.period[a];
+    /// d with its minimum image along the periodic axes, lane by lane:
+    /// d_a − round(d_a/L_a) L_a.
+    #[inline(always)]
+    fn separation(&self, mut d: V3<Lanes>) -> V3<Lanes> {
+        for (a, l) in [(&mut d.x, self.period[0]), (&mut d.y, self.period[1])] {
             if l > 0.0 {
-                d[a] -= (d[a] / l).round() * l;
+                *a = *a - a.map(|x| (x / l).round()) * l;
             }
         }
         d
+    }
+
+    /// `start` + Σ_{j≠i} term(d_ij, 1/d_ij², block) over the bodies at
+    /// `at` in order of j (d_ij = x_i − x_j, its minimum image; `block`
+    /// the first partner of the lanes): the terms of eight partners at a
+    /// time, added one by one.
+    #[inline(always)]
+    fn row_sum(
+        &self,
+        at: &Places,
+        i: usize,
+        start: DVec3,
+        term: impl Fn(V3<Lanes>, Lanes, usize) -> V3<Lanes>,
+    ) -> DVec3 {
+        let xi = V3::splat(at.position(i));
+        let mut sum = start;
+        for block in (0..at.len()).step_by(LANES) {
+            let live = (at.len() - block).min(LANES);
+            let d = self.separation(xi.sub(at.lanes(&at.position, block, live)));
+            let inv_r2 = Lanes::splat(1.0) / d.dot(d);
+            let t = term(d, inv_r2, block);
+            for l in 0..live {
+                if block + l != i {
+                    sum += t.lane(l);
+                }
+            }
+        }
+        sum
     }
 
     /// The magnetic bodies, their positions and moments at time t.
@@ -151,32 +186,67 @@ impl InducedDipoles {
             .enumerate()
             .map(|(k, b)| induce(*b, k))
             .collect();
-        if self.dipole_dipole > 0.0 {
+        let k = self.dipole_dipole;
+        if k > 0.0 {
+            let mut at = Places::of(&x);
             for _ in 0..self.iterations {
-                let next: Vec<DVec3> = (0..x.len())
+                at.set_moments(&m);
+                // The field at x_i of the moments m_j:
+                // k [3 d(m_j·d)/d⁵ − m_j/d³], d = x_i − x_j.
+                m = (0..x.len())
                     .into_par_iter()
                     .map(|i| {
-                        let mut local = external[i];
-                        for j in 0..x.len() {
-                            if j != i {
-                                local += self.dipole_field(x[i] - x[j], m[j]);
-                            }
-                        }
+                        let local = self.row_sum(&at, i, external[i], |d, inv_r2, j| {
+                            let mj = at.lanes(&at.moment, j, LANES.min(at.len() - j));
+                            dipole_field_lanes(k, mj, d, inv_r2)
+                        });
                         induce(local, i)
                     })
                     .collect();
-                m = next;
             }
         }
         (index, x, m)
     }
+}
 
-    /// The field at separation d = x − x_j of the moment m_j:
-    /// k [3 d(m·d)/d⁵ − m/d³].
-    #[inline]
-    fn dipole_field(&self, d: DVec3, m: DVec3) -> DVec3 {
-        let d = self.separation(d);
-        dipole_field(self.dipole_dipole, m, d, 1.0 / d.length_squared())
+/// The magnetic bodies' places and moments by component, for the lanes.
+struct Places {
+    position: [Vec<f64>; 3],
+    moment: [Vec<f64>; 3],
+}
+
+impl Places {
+    fn of(x: &[DVec3]) -> Self {
+        Self {
+            position: [0, 1, 2].map(|a| x.iter().map(|p| p[a]).collect()),
+            moment: Default::default(),
+        }
+    }
+
+    fn set_moments(&mut self, m: &[DVec3]) {
+        self.moment = [0, 1, 2].map(|a| m.iter().map(|v| v[a]).collect());
+    }
+
+    fn len(&self) -> usize {
+        self.position[0].len()
+    }
+
+    fn position(&self, i: usize) -> DVec3 {
+        DVec3::new(
+            self.position[0][i],
+            self.position[1][i],
+            self.position[2][i],
+        )
+    }
+
+    /// Entries `start..start + live` of `v`, one per lane (zeros after).
+    #[inline(always)]
+    fn lanes(&self, v: &[Vec<f64>; 3], start: usize, live: usize) -> V3<Lanes> {
+        V3 {
+            x: Lanes::load(&v[0], start, live),
+            y: Lanes::load(&v[1], start, live),
+            z: Lanes::load(&v[2], start, live),
+        }
     }
 }
 
@@ -189,21 +259,20 @@ impl BodyInteraction for InducedDipoles {
         let t = view.step.time;
         let (index, x, m) = self.moments(view, t);
         let k = self.dipole_dipole;
+        let mut at = Places::of(&x);
+        at.set_moments(&m);
         let force: Vec<DVec3> = (0..x.len())
             .into_par_iter()
             .map(|i| {
-                let mi = m[i];
-                let (_, mut f) = self.roller.with_gradient(x[i], mi, t);
-                if k > 0.0 {
-                    for j in 0..x.len() {
-                        if j == i {
-                            continue;
-                        }
-                        let d = self.separation(x[i] - x[j]);
-                        f += dipole_pair(k, d, 1.0 / d.length_squared(), mi, m[j]).1;
-                    }
+                let (_, f) = self.roller.with_gradient(x[i], m[i], t);
+                if k == 0.0 {
+                    return f;
                 }
-                f
+                let mi = V3::splat(m[i]);
+                self.row_sum(&at, i, f, |d, inv_r2, j| {
+                    let mj = at.lanes(&at.moment, j, LANES.min(at.len() - j));
+                    dipole_pair_force_lanes(k, d, inv_r2, mi, mj)
+                })
             })
             .collect();
         for (&i, f) in index.iter().zip(&force) {

@@ -59,6 +59,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use glam::{DMat3, DVec3};
+use mote_geom::lanes::{Lane, V3};
 use mote_geom::simd::{isa, Isa};
 use rayon::prelude::*;
 
@@ -132,6 +133,33 @@ pub fn dipole_pair(
     let torque_i = mi.cross(d) * (3.0 * mj_r * inv_r5) - mi_x_mj * inv_r3;
     let torque_j = mj.cross(d) * (3.0 * mi_r * inv_r5) + mi_x_mj * inv_r3;
     (energy, force, torque_i, torque_j)
+}
+
+/// [`dipole_field`] of a lane of moments at a lane of separations, each
+/// lane its operations in its order: every lane gets the scalar law's bits.
+#[inline(always)]
+pub fn dipole_field_lanes<L: Lane>(k: f64, m: V3<L>, d: V3<L>, inv_r2: L) -> V3<L> {
+    let inv_r3 = inv_r2 * k * inv_r2.sqrt();
+    let along = m.dot(d) * 3.0 * inv_r3 * inv_r2;
+    d.scale(along).sub(m.scale(inv_r3))
+}
+
+/// The force on i of [`dipole_pair`], lane by lane in its operations and
+/// their order (the scalar law's bits in every lane).
+#[inline(always)]
+pub fn dipole_pair_force_lanes<L: Lane>(
+    k: f64,
+    d: V3<L>,
+    inv_r2: L,
+    mi: V3<L>,
+    mj: V3<L>,
+) -> V3<L> {
+    let inv_r3 = inv_r2.sqrt() * k * inv_r2;
+    let inv_r5 = inv_r3 * inv_r2;
+    let (mi_r, mj_r, mimj) = (mi.dot(d), mj.dot(d), mi.dot(mj));
+    let radial = mimj * 3.0 * inv_r5 - mi_r * 15.0 * mj_r * inv_r5 * inv_r2;
+    d.scale(radial)
+        .add(mi.scale(mj_r).add(mj.scale(mi_r)).scale(inv_r5 * 3.0))
 }
 
 /// The Lennard-Jones part fused into the dipolar pair loop (004 Eq. 9 when
