@@ -132,6 +132,7 @@ fn one_bead_is_pulled_up_the_field_gradient() {
         dipole_dipole: 1e-7,
         iterations: 3,
         period: [0.0, 0.0],
+        cutoff: f64::INFINITY,
     };
     let p = DVec3::new(0.0021, 0.0, 0.0003);
     let b = bodies_at(&[p]);
@@ -178,6 +179,7 @@ fn two_beads_along_the_field_induce_each_other() {
         dipole_dipole: k,
         iterations: 60,
         period: [0.0, 0.0],
+        cutoff: f64::INFINITY,
     };
     let b = bodies_at(&[
         DVec3::new(-0.5 * d, 0.0, 0.0),
@@ -213,6 +215,7 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
         dipole_dipole: 1e-7,
         iterations: 2,
         period: [4e-4, 2e-4],
+        cutoff: f64::INFINITY,
     };
     let points = [
         DVec3::new(0.0, 0.0, 0.0002),
@@ -261,6 +264,7 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
     let moved = bodies_at(&[points[0], points[1] - DVec3::new(4e-4, 0.0, 0.0)]);
     let mut open = InducedDipoles {
         period: [0.0, 0.0],
+        cutoff: f64::INFINITY,
         ..model.clone()
     };
     let (a, b) = (forces(&mut model, &pair, t), forces(&mut open, &moved, t));
@@ -276,9 +280,20 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
 
 /// The moments and forces of 29 beads (three blocks of eight and a tail),
 /// some saturated, in a box periodic along x and y: the lanes give every
-/// body the bits of the loops over pairs with the scalar dipole laws.
+/// body the bits of the loops over pairs with the scalar dipole laws —
+/// over all pairs, and with a cut-off over the pairs within it (the
+/// loops then skip the others), found through the cells.
 #[test]
 fn lanes_give_the_bits_of_the_loops_over_pairs() {
+    // All pairs; a cut-off beyond every pair (one cell: the same bits);
+    // cut-offs that keep some pairs and not others (cells fewer than
+    // three along x and y, then four along x and three along y).
+    for cutoff in [f64::INFINITY, 1e-3, 1.49e-4, 0.9e-4] {
+        loops_over_pairs(cutoff);
+    }
+}
+
+fn loops_over_pairs(cutoff: f64) {
     use mote_md::force::dipolar::{dipole_field, dipole_pair};
     let period = [4e-4, 3e-4];
     let alpha = InducedDipoles::polarisability(volume(20e-6), 6.0);
@@ -290,6 +305,7 @@ fn lanes_give_the_bits_of_the_loops_over_pairs() {
         dipole_dipole: 1e-7,
         iterations: 2,
         period,
+        cutoff,
     };
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut uniform = || {
@@ -318,6 +334,28 @@ fn lanes_give_the_bits_of_the_loops_over_pairs() {
         }
         d
     };
+    // The pairs the sums take: within the cut-off, minimum image.
+    let (mut kept, mut left) = (0, 0);
+    let near = |i: usize, j: usize| {
+        let d = image(points[i] - points[j]);
+        j != i && d.length_squared() < cutoff * cutoff
+    };
+    for i in 0..points.len() {
+        for j in 0..points.len() {
+            if j != i {
+                if near(i, j) {
+                    kept += 1;
+                } else {
+                    left += 1;
+                }
+            }
+        }
+    }
+    if cutoff < 1e-3 {
+        assert!(kept > 0 && left > 0, "{kept} pairs kept, {left} left out");
+    } else {
+        assert_eq!(left, 0, "the cut-off {cutoff} leaves out pairs");
+    }
     let induce = |b: DVec3| {
         let m = alpha * b;
         if m.length() > cap {
@@ -332,7 +370,7 @@ fn lanes_give_the_bits_of_the_loops_over_pairs() {
         m = (0..points.len())
             .map(|i| {
                 let mut local = external[i];
-                for j in (0..points.len()).filter(|&j| j != i) {
+                for j in (0..points.len()).filter(|&j| near(i, j)) {
                     let d = image(points[i] - points[j]);
                     local += dipole_field(1e-7, m[j], d, 1.0 / d.length_squared());
                 }
@@ -350,14 +388,14 @@ fn lanes_give_the_bits_of_the_loops_over_pairs() {
     );
     for i in 0..points.len() {
         let (_, mut expected) = model.roller.with_gradient(points[i], m[i], t);
-        for j in (0..points.len()).filter(|&j| j != i) {
+        for j in (0..points.len()).filter(|&j| near(i, j)) {
             let d = image(points[i] - points[j]);
             expected += dipole_pair(1e-7, d, 1.0 / d.length_squared(), m[i], m[j]).1;
         }
         assert_eq!(
             f[i].to_array().map(f64::to_bits),
             expected.to_array().map(f64::to_bits),
-            "body {i}: {} against {expected}",
+            "body {i}, cut-off {cutoff}: {} against {expected}",
             f[i]
         );
     }

@@ -353,3 +353,32 @@ steps = 1
         }
     }
 }
+
+/// `[rigid.roller] cutoff`: taken in the flowing nip's scene; one longer
+/// than half the shorter period (the minimum image) is refused at the
+/// roller's line.
+#[test]
+fn a_roller_cutoff_past_half_a_period_is_refused_at_its_line() {
+    let text = example("toning-nip-flow.toml");
+    let with = |rc: &str| text.replace("iterations = 2", &format!("iterations = 2\ncutoff = {rc}"));
+    let ok = with("5.9e-5");
+    RigidScene::parse(&ok, "nip.toml")
+        .unwrap()
+        .build(&ok, "nip.toml", None)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for bad in ["6.1e-5", "0.0", "-1e-5"] {
+        let text = with(bad);
+        let e = RigidScene::parse(&text, "nip.toml")
+            .unwrap()
+            .build(&text, "nip.toml", None)
+            .err()
+            .unwrap();
+        let line = text.lines().position(|l| l == "[rigid.roller]").unwrap() + 1;
+        assert_eq!(e.line, line, "{e}");
+        assert!(
+            e.to_string()
+                .contains("cutoff must be > 0 and at most half the shorter period"),
+            "{e}"
+        );
+    }
+}

@@ -29,6 +29,14 @@
 //! [`Lanes`]: each lane the scalar law's operations in their order, the
 //! eight terms then added one by one in order of the partners, so a body's
 //! field and force have the bits of the loop over pairs.
+//!
+//! **Cut-off.** The sums run over all pairs (cost N² a pass), or with
+//! `cutoff` r_c over the moments within r_c (minimum image), found through
+//! cells of side ≥ r_c each step, each body's partners in increasing order:
+//! a cut-off beyond every pair gives the bits of all pairs. Truncating the
+//! dipole sum leaves out the field of the moments beyond r_c (in the nip's
+//! slab, the chains' far field, which falls off as 1/r³ and partly
+//! cancels); docs/toning-nip.md measures what it changes.
 
 use std::f64::consts::PI;
 
@@ -108,6 +116,9 @@ pub struct InducedDipoles {
     pub iterations: u32,
     /// Periods along x and y (0: open).
     pub period: [f64; 2],
+    /// Moments farther apart than this do not see each other (∞: all
+    /// pairs); at most half a period.
+    pub cutoff: f64,
 }
 
 impl InducedDipoles {
@@ -128,36 +139,152 @@ impl InducedDipoles {
         d
     }
 
-    /// `start` + Σ_{j≠i} term(d_ij, 1/d_ij², block) over the bodies at
-    /// `at` in order of j (d_ij = x_i − x_j, its minimum image; `block`
-    /// the first partner of the lanes): the terms of eight partners at a
-    /// time, added one by one.
+    /// `start` + Σ_j term(d_ij, 1/d_ij², m_j) over the partners of body i
+    /// in their order (all j ≠ i, or `partners`, increasing; d_ij = x_i −
+    /// x_j, its minimum image): the terms of eight partners at a time,
+    /// added one by one.
     #[inline(always)]
     fn row_sum(
         &self,
         at: &Places,
         i: usize,
+        partners: Option<&[u32]>,
         start: DVec3,
-        term: impl Fn(V3<Lanes>, Lanes, usize) -> V3<Lanes>,
+        term: impl Fn(V3<Lanes>, Lanes, V3<Lanes>) -> V3<Lanes>,
     ) -> DVec3 {
         let xi = V3::splat(at.position(i));
         let mut sum = start;
-        for block in (0..at.len()).step_by(LANES) {
-            let live = (at.len() - block).min(LANES);
-            let d = self.separation(xi.sub(at.lanes(&at.position, block, live)));
+        let mut add = |xj: V3<Lanes>, mj: V3<Lanes>, live: usize, skip: usize| {
+            let d = self.separation(xi.sub(xj));
             let inv_r2 = Lanes::splat(1.0) / d.dot(d);
-            let t = term(d, inv_r2, block);
-            for l in 0..live {
-                if block + l != i {
-                    sum += t.lane(l);
+            let t = term(d, inv_r2, mj);
+            for l in (0..live).filter(|&l| l != skip) {
+                sum += t.lane(l);
+            }
+        };
+        match partners {
+            None => {
+                for block in (0..at.len()).step_by(LANES) {
+                    let live = (at.len() - block).min(LANES);
+                    let (xj, mj) = (
+                        at.lanes(&at.position, block, live),
+                        at.lanes(&at.moment, block, live),
+                    );
+                    add(xj, mj, live, i.wrapping_sub(block));
+                }
+            }
+            Some(list) => {
+                for block in list.chunks(LANES) {
+                    let (xj, mj) = (at.gather(&at.position, block), at.gather(&at.moment, block));
+                    add(xj, mj, block.len(), LANES);
                 }
             }
         }
         sum
     }
 
+    /// Each magnetic body's partners within the cut-off (minimum image),
+    /// increasing, found through cells of side ≥ r_c; `None` without a
+    /// cut-off.
+    fn partners(&self, x: &[DVec3]) -> Option<Vec<Vec<u32>>> {
+        let rc = self.cutoff;
+        if !rc.is_finite() || x.is_empty() {
+            return None;
+        }
+        let lo = x.iter().fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
+        let hi = x
+            .iter()
+            .fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
+        // Cells along each axis: a periodic axis's period, an open one the
+        // bodies' extent, cut into cells of at least r_c.
+        let axis = |a: usize| {
+            let l = if a < 2 { self.period[a] } else { 0.0 };
+            let (origin, length) = if l > 0.0 {
+                (0.0, l)
+            } else {
+                (lo[a], hi[a] - lo[a])
+            };
+            let cells = ((length / rc).floor() as usize).clamp(1, 1 << 10);
+            (origin, length / cells as f64, cells, l > 0.0)
+        };
+        let axes = [axis(0), axis(1), axis(2)];
+        let cell_of = |p: DVec3| -> [usize; 3] {
+            std::array::from_fn(|a| {
+                let (origin, side, cells, periodic) = axes[a];
+                let c = ((p[a] - origin) / side).floor();
+                if periodic {
+                    (c as i64).rem_euclid(cells as i64) as usize
+                } else {
+                    (c.max(0.0) as usize).min(cells - 1)
+                }
+            })
+        };
+        let index = |c: [usize; 3]| (c[2] * axes[1].2 + c[1]) * axes[0].2 + c[0];
+        let count = axes[0].2 * axes[1].2 * axes[2].2;
+        let mut members: Vec<Vec<u32>> = vec![Vec::new(); count];
+        for (j, p) in x.iter().enumerate() {
+            members[index(cell_of(*p))].push(j as u32);
+        }
+        // The cells around c along one axis, each once (all of them where
+        // the axis has fewer than three).
+        let around = |a: usize, c: usize| -> Vec<usize> {
+            let (_, _, cells, periodic) = axes[a];
+            if cells < 3 {
+                return (0..cells).collect();
+            }
+            [c as i64 - 1, c as i64, c as i64 + 1]
+                .into_iter()
+                .filter_map(|k| match periodic {
+                    true => Some(k.rem_euclid(cells as i64) as usize),
+                    false => (0..cells as i64).contains(&k).then_some(k as usize),
+                })
+                .collect()
+        };
+        let rc2 = rc * rc;
+        Some(
+            (0..x.len())
+                .into_par_iter()
+                .map(|i| {
+                    let c = cell_of(x[i]);
+                    let mut near = Vec::new();
+                    for cz in around(2, c[2]) {
+                        for cy in around(1, c[1]) {
+                            for cx in around(0, c[0]) {
+                                for &j in &members[index([cx, cy, cz])] {
+                                    let mut d = x[i] - x[j as usize];
+                                    for a in 0..2 {
+                                        let l = self.period[a];
+                                        if l > 0.0 {
+                                            d[a] -= (d[a] / l).round() * l;
+                                        }
+                                    }
+                                    if j as usize != i && d.length_squared() < rc2 {
+                                        near.push(j);
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    near.sort_unstable();
+                    near
+                })
+                .collect(),
+        )
+    }
+
     /// The magnetic bodies, their positions and moments at time t.
     pub fn moments(&self, view: &BodyView<'_>, t: f64) -> (Vec<usize>, Vec<DVec3>, Vec<DVec3>) {
+        let (index, x, m, _) = self.moments_and_partners(view, t);
+        (index, x, m)
+    }
+
+    /// [`InducedDipoles::moments`] and the partners the sums ran over.
+    #[allow(clippy::type_complexity)]
+    fn moments_and_partners(
+        &self,
+        view: &BodyView<'_>,
+        t: f64,
+    ) -> (Vec<usize>, Vec<DVec3>, Vec<DVec3>, Option<Vec<Vec<u32>>>) {
         let b = view.bodies;
         let index: Vec<usize> = (0..b.len())
             .filter(|&i| self.polarisability[b.kind[i] as usize] > 0.0)
@@ -187,6 +314,7 @@ impl InducedDipoles {
             .map(|(k, b)| induce(*b, k))
             .collect();
         let k = self.dipole_dipole;
+        let partners = (k > 0.0).then(|| self.partners(&x)).flatten();
         if k > 0.0 {
             let mut at = Places::of(&x);
             for _ in 0..self.iterations {
@@ -196,8 +324,8 @@ impl InducedDipoles {
                 m = (0..x.len())
                     .into_par_iter()
                     .map(|i| {
-                        let local = self.row_sum(&at, i, external[i], |d, inv_r2, j| {
-                            let mj = at.lanes(&at.moment, j, LANES.min(at.len() - j));
+                        let near = partners.as_ref().map(|p| p[i].as_slice());
+                        let local = self.row_sum(&at, i, near, external[i], |d, inv_r2, mj| {
                             dipole_field_lanes(k, mj, d, inv_r2)
                         });
                         induce(local, i)
@@ -205,7 +333,7 @@ impl InducedDipoles {
                     .collect();
             }
         }
-        (index, x, m)
+        (index, x, m, partners)
     }
 }
 
@@ -248,6 +376,21 @@ impl Places {
             z: Lanes::load(&v[2], start, live),
         }
     }
+
+    /// Entries `index` (at most eight) of `v`, one per lane (zeros after).
+    #[inline(always)]
+    fn gather(&self, v: &[Vec<f64>; 3], index: &[u32]) -> V3<Lanes> {
+        let lane = |c: &Vec<f64>| {
+            Lanes(std::array::from_fn(|l| {
+                index.get(l).map_or(0.0, |&j| c[j as usize])
+            }))
+        };
+        V3 {
+            x: lane(&v[0]),
+            y: lane(&v[1]),
+            z: lane(&v[2]),
+        }
+    }
 }
 
 impl BodyInteraction for InducedDipoles {
@@ -257,7 +400,7 @@ impl BodyInteraction for InducedDipoles {
 
     fn add_wrenches(&mut self, view: &BodyView<'_>, wrench: &mut [DE]) {
         let t = view.step.time;
-        let (index, x, m) = self.moments(view, t);
+        let (index, x, m, partners) = self.moments_and_partners(view, t);
         let k = self.dipole_dipole;
         let mut at = Places::of(&x);
         at.set_moments(&m);
@@ -269,8 +412,8 @@ impl BodyInteraction for InducedDipoles {
                     return f;
                 }
                 let mi = V3::splat(m[i]);
-                self.row_sum(&at, i, f, |d, inv_r2, j| {
-                    let mj = at.lanes(&at.moment, j, LANES.min(at.len() - j));
+                let near = partners.as_ref().map(|p| p[i].as_slice());
+                self.row_sum(&at, i, near, f, |d, inv_r2, mj| {
                     dipole_pair_force_lanes(k, d, inv_r2, mi, mj)
                 })
             })

@@ -91,6 +91,7 @@
 //! x = 2e-4                     # x of the axis (default: the box's centre)
 //! dipole_dipole = 1e-7         # μ0/4π: forces between the induced moments (off if absent)
 //! iterations = 2               # passes of mutual induction
+//! cutoff = 1e-4                # moments farther apart do not see each other (default: all pairs)
 //! magnetic = [{ template = "carrier", permeability = 6.0, saturation = 3.3e5 }]
 //!
 //! [rigid.nip]                  # toning-nip observables in nip.csv (the crate mote-nip)

@@ -36,6 +36,8 @@ pub struct RollerSettings {
     pub dipole_dipole: f64,
     #[serde(default)]
     pub iterations: u32,
+    /// Moments farther apart do not see each other (absent: all pairs).
+    pub cutoff: Option<f64>,
     pub magnetic: Vec<MagneticSpec>,
 }
 
@@ -180,6 +182,14 @@ fn induced_dipoles(
             "[rigid.roller] needs field > 0, radius > 0 and an even number of poles".into(),
         );
     }
+    let period = [hi.x - lo.x, hi.y - lo.y];
+    let cutoff = rs.cutoff.unwrap_or(f64::INFINITY);
+    let half = 0.5 * period[0].min(period[1]);
+    if rs.cutoff.is_some_and(|rc| !positive(rc) || rc > half) {
+        return Err(format!(
+            "[rigid.roller] cutoff must be > 0 and at most half the shorter period ({half}) for the minimum image"
+        ));
+    }
     let n = bodies.templates.len();
     let (mut polarisability, mut saturation) = (vec![0.0; n], vec![f64::INFINITY; n]);
     for m in &rs.magnetic {
@@ -217,7 +227,8 @@ fn induced_dipoles(
         saturation,
         dipole_dipole: rs.dipole_dipole,
         iterations: rs.iterations,
-        period: [hi.x - lo.x, hi.y - lo.y],
+        period,
+        cutoff,
     })
 }
 
