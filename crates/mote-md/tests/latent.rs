@@ -365,3 +365,78 @@ steps = 1
         .unwrap();
     assert!(e.to_string().contains("needs [rigid.planes]"), "{e}");
 }
+
+/// `[rigid.latent_image] period`: a patch repeating every 300 µm is the
+/// flowing nip's two patches in its 600 µm box (to round-off), and the
+/// scene refuses a period that does not divide the box's length.
+#[test]
+fn a_period_that_divides_the_box_repeats_the_patches() {
+    let image = |period: f64, patches: &[[f64; 3]]| LatentImage {
+        k: 8.9875517923e9,
+        gap: 2.58e-4,
+        height: 8.0e-6,
+        period,
+        speed: 0.3,
+        background: 1.1e-4,
+        patches: patches
+            .iter()
+            .map(|&[start, end, density]| Patch {
+                start,
+                end,
+                density,
+            })
+            .collect(),
+    };
+    let one = image(3.0e-4, &[[0.0, 1.5e-4, 6.6e-4]]);
+    let two = image(6.0e-4, &[[0.0, 1.5e-4, 6.6e-4], [3.0e-4, 4.5e-4, 6.6e-4]]);
+    for i in 0..=60 {
+        for z in [1.2e-5, 6e-5, 2.5e-4] {
+            let x = 6.0e-4 * i as f64 / 60.0;
+            let (a, b) = (one.field(x, z, 1.3e-4), two.field(x, z, 1.3e-4));
+            let scale = b.0.hypot(b.1);
+            assert!(
+                (a.0 - b.0).hypot(a.1 - b.1) < 1e-12 * scale,
+                "{a:?} against {b:?}"
+            );
+        }
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/rigid/toning-nip-flow.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let with = |period: &str| {
+        text.replace(
+            "background = 1.1e-4",
+            &format!("background = 1.1e-4\nperiod = {period}"),
+        )
+    };
+    use mote_md::rigid::scene::RigidScene;
+    for (period, ok) in [
+        ("3.0e-4", true),
+        ("6.0e-4", true),
+        ("2.5e-4", false),
+        ("0.0", false),
+        ("7e-4", false),
+    ] {
+        let text = with(period);
+        let built = RigidScene::parse(&text, "nip.toml")
+            .unwrap()
+            .build(&text, "nip.toml", None);
+        match (built, ok) {
+            (Ok(_), true) => {}
+            (Err(e), false) => {
+                let line = text
+                    .lines()
+                    .position(|l| l == "[rigid.latent_image]")
+                    .unwrap()
+                    + 1;
+                assert_eq!(e.line, line, "{e}");
+                assert!(
+                    e.to_string().contains("must divide the box's length"),
+                    "{e}"
+                );
+            }
+            (Ok(_), false) => panic!("period {period} taken"),
+            (Err(e), true) => panic!("period {period} refused: {e}"),
+        }
+    }
+}

@@ -285,8 +285,8 @@ fn pair_forces_cancel_and_periodic_images_are_nearest() {
 /// loops then skip the others), found through the cells.
 #[test]
 fn lanes_give_the_bits_of_the_loops_over_pairs() {
-    // All pairs; a cut-off beyond every pair (one cell: the same bits);
-    // cut-offs that keep some pairs and not others (cells fewer than
+    // All pairs; a cut-off beyond every pair (the same bits); cut-offs
+    // that keep some pairs and not others (the list's cells fewer than
     // three along x and y, then four along x and three along y).
     for cutoff in [f64::INFINITY, 1e-3, 1.49e-4, 0.9e-4] {
         loops_over_pairs(cutoff);
@@ -314,7 +314,7 @@ fn loops_over_pairs(cutoff: f64) {
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
-    let points: Vec<DVec3> = (0..29)
+    let mut points: Vec<DVec3> = (0..29)
         .map(|_| {
             DVec3::new(
                 period[0] * uniform(),
@@ -323,6 +323,9 @@ fn loops_over_pairs(cutoff: f64) {
             )
         })
         .collect();
+    // Two bodies outside the box, a period along x and y away.
+    points[3].x += period[0];
+    points[17].y -= period[1];
     let b = bodies_at(&points);
     let t = 0.0031;
     let f = forces(&mut model, &b, t);

@@ -24,6 +24,8 @@ use mote_io::csv::CsvWriter;
 use mote_io::Provenance;
 use mote_run::Observer;
 
+use mote_md::boundary::Boundary;
+use mote_md::neighbor::VerletList;
 use mote_md::rigid::run::{RigidDynamics, RigidSample};
 use mote_md::rigid::{RigidBodies, WorldFrame};
 use mote_md::MdError;
@@ -191,11 +193,25 @@ impl NipProbe {
             i
         }
         let [lx, ly] = self.period();
+        // The sphere pairs within reach of touching, each once and in
+        // increasing order (a half list; no pair within one carrier), then
+        // those that touch joined in that order: the pairs of the loop over
+        // all pairs, without its N² cost.
+        let r_max = spheres.iter().fold(0.0f64, |r, s| r.max(s.2));
+        let mut list = VerletList::half(1.02 * 2.0 * r_max, 0.0);
+        list.set_groups(&spheres.iter().map(|s| s.0 as u32).collect::<Vec<_>>());
+        let centres: Vec<DVec3> = spheres.iter().map(|s| s.1).collect();
+        list.build(
+            &centres,
+            &Boundary {
+                lo: DVec3::new(0.0, 0.0, f64::NEG_INFINITY),
+                hi: DVec3::new(lx, ly, f64::INFINITY),
+                periodic: [true, true, false],
+            },
+        );
         for (a, &(ka, ca, ra)) in spheres.iter().enumerate() {
-            for &(kb, cb, rb) in &spheres[a + 1..] {
-                if ka == kb {
-                    continue;
-                }
+            for &b in list.of(a) {
+                let (kb, cb, rb) = spheres[b as usize];
                 let mut d = ca - cb;
                 d.x -= (d.x / lx).round() * lx;
                 d.y -= (d.y / ly).round() * ly;
@@ -207,12 +223,10 @@ impl NipProbe {
         }
         // Per cluster: lowest bottom, highest top.
         let mut extent = vec![(f64::INFINITY, f64::NEG_INFINITY); carriers.len()];
-        let mut r_max: f64 = 0.0;
         for &(k, c, r) in &spheres {
             let g = root(&mut parent, k);
             extent[g].0 = extent[g].0.min(c.z - r);
             extent[g].1 = extent[g].1.max(c.z + r);
-            r_max = r_max.max(r);
         }
         let (mut reach, mut rooted) = (0.0, 0);
         for k in 0..carriers.len() {

@@ -31,9 +31,10 @@
 //! field and force have the bits of the loop over pairs.
 //!
 //! **Cut-off.** The sums run over all pairs (cost N² a pass), or with
-//! `cutoff` r_c over the moments within r_c (minimum image), found through
-//! cells of side ≥ r_c each step, each body's partners in increasing order:
-//! a cut-off beyond every pair gives the bits of all pairs. Truncating the
+//! `cutoff` r_c over the moments within r_c (minimum image), found each
+//! step by a [`VerletList`] without skin, each body's partners in
+//! increasing order: a cut-off beyond every pair gives the bits of all
+//! pairs. Truncating the
 //! dipole sum leaves out the field of the moments beyond r_c (in the nip's
 //! slab, the chains' far field, which falls off as 1/r³ and partly
 //! cancels); docs/toning-nip.md measures what it changes.
@@ -46,7 +47,9 @@ use mote_geom::DE;
 use rayon::prelude::*;
 
 use super::interaction::{BodyInteraction, BodyView};
+use crate::boundary::Boundary;
 use crate::force::dipolar::{dipole_field_lanes, dipole_pair_force_lanes};
+use crate::neighbor::VerletList;
 
 /// μ₀ in SI.
 pub const MU0: f64 = 4.0e-7 * PI;
@@ -183,93 +186,22 @@ impl InducedDipoles {
         sum
     }
 
-    /// Each magnetic body's partners within the cut-off (minimum image),
-    /// increasing, found through cells of side ≥ r_c; `None` without a
-    /// cut-off.
-    fn partners(&self, x: &[DVec3]) -> Option<Vec<Vec<u32>>> {
-        let rc = self.cutoff;
-        if !rc.is_finite() || x.is_empty() {
+    /// Each magnetic body's partners within the cut-off (minimum image
+    /// along the periodic axes), increasing: a full Verlet list without
+    /// skin, built anew; `None` without a cut-off.
+    fn partners(&self, x: &[DVec3]) -> Option<VerletList> {
+        if !self.cutoff.is_finite() {
             return None;
         }
-        let lo = x.iter().fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
-        let hi = x
-            .iter()
-            .fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
-        // Cells along each axis: a periodic axis's period, an open one the
-        // bodies' extent, cut into cells of at least r_c.
-        let axis = |a: usize| {
-            let l = if a < 2 { self.period[a] } else { 0.0 };
-            let (origin, length) = if l > 0.0 {
-                (0.0, l)
-            } else {
-                (lo[a], hi[a] - lo[a])
-            };
-            let cells = ((length / rc).floor() as usize).clamp(1, 1 << 10);
-            (origin, length / cells as f64, cells, l > 0.0)
+        let [lx, ly] = self.period;
+        let boundary = Boundary {
+            lo: DVec3::new(0.0, 0.0, f64::NEG_INFINITY),
+            hi: DVec3::new(lx, ly, f64::INFINITY),
+            periodic: [lx > 0.0, ly > 0.0, false],
         };
-        let axes = [axis(0), axis(1), axis(2)];
-        let cell_of = |p: DVec3| -> [usize; 3] {
-            std::array::from_fn(|a| {
-                let (origin, side, cells, periodic) = axes[a];
-                let c = ((p[a] - origin) / side).floor();
-                if periodic {
-                    (c as i64).rem_euclid(cells as i64) as usize
-                } else {
-                    (c.max(0.0) as usize).min(cells - 1)
-                }
-            })
-        };
-        let index = |c: [usize; 3]| (c[2] * axes[1].2 + c[1]) * axes[0].2 + c[0];
-        let count = axes[0].2 * axes[1].2 * axes[2].2;
-        let mut members: Vec<Vec<u32>> = vec![Vec::new(); count];
-        for (j, p) in x.iter().enumerate() {
-            members[index(cell_of(*p))].push(j as u32);
-        }
-        // The cells around c along one axis, each once (all of them where
-        // the axis has fewer than three).
-        let around = |a: usize, c: usize| -> Vec<usize> {
-            let (_, _, cells, periodic) = axes[a];
-            if cells < 3 {
-                return (0..cells).collect();
-            }
-            [c as i64 - 1, c as i64, c as i64 + 1]
-                .into_iter()
-                .filter_map(|k| match periodic {
-                    true => Some(k.rem_euclid(cells as i64) as usize),
-                    false => (0..cells as i64).contains(&k).then_some(k as usize),
-                })
-                .collect()
-        };
-        let rc2 = rc * rc;
-        Some(
-            (0..x.len())
-                .into_par_iter()
-                .map(|i| {
-                    let c = cell_of(x[i]);
-                    let mut near = Vec::new();
-                    for cz in around(2, c[2]) {
-                        for cy in around(1, c[1]) {
-                            for cx in around(0, c[0]) {
-                                for &j in &members[index([cx, cy, cz])] {
-                                    let mut d = x[i] - x[j as usize];
-                                    for a in 0..2 {
-                                        let l = self.period[a];
-                                        if l > 0.0 {
-                                            d[a] -= (d[a] / l).round() * l;
-                                        }
-                                    }
-                                    if j as usize != i && d.length_squared() < rc2 {
-                                        near.push(j);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    near.sort_unstable();
-                    near
-                })
-                .collect(),
-        )
+        let mut list = VerletList::new(self.cutoff, 0.0);
+        list.build(x, &boundary);
+        Some(list)
     }
 
     /// The magnetic bodies, their positions and moments at time t.
@@ -284,7 +216,7 @@ impl InducedDipoles {
         &self,
         view: &BodyView<'_>,
         t: f64,
-    ) -> (Vec<usize>, Vec<DVec3>, Vec<DVec3>, Option<Vec<Vec<u32>>>) {
+    ) -> (Vec<usize>, Vec<DVec3>, Vec<DVec3>, Option<VerletList>) {
         let b = view.bodies;
         let index: Vec<usize> = (0..b.len())
             .filter(|&i| self.polarisability[b.kind[i] as usize] > 0.0)
@@ -324,7 +256,7 @@ impl InducedDipoles {
                 m = (0..x.len())
                     .into_par_iter()
                     .map(|i| {
-                        let near = partners.as_ref().map(|p| p[i].as_slice());
+                        let near = partners.as_ref().map(|p| p.of(i));
                         let local = self.row_sum(&at, i, near, external[i], |d, inv_r2, mj| {
                             dipole_field_lanes(k, mj, d, inv_r2)
                         });
@@ -412,7 +344,7 @@ impl BodyInteraction for InducedDipoles {
                     return f;
                 }
                 let mi = V3::splat(m[i]);
-                let near = partners.as_ref().map(|p| p[i].as_slice());
+                let near = partners.as_ref().map(|p| p.of(i));
                 self.row_sum(&at, i, near, f, |d, inv_r2, mj| {
                     dipole_pair_force_lanes(k, d, inv_r2, mi, mj)
                 })

@@ -82,6 +82,7 @@
 //! speed = 0.3                  # belt speed along x
 //! background = 0.0             # charge density outside the patches
 //! patches = [[1e-4, 3e-4, -5e-4]]  # [start, end, density]: x-intervals at t = 0
+//! period = 4e-4                # the image repeats every period (default: the box's length, which it divides)
 //!
 //! [rigid.roller]               # magnetic roller inside the upper plane (the shell)
 //! field = 0.08                 # B₀ (T) at the shell's surface

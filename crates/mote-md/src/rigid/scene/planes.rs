@@ -63,6 +63,9 @@ pub struct LatentSettings {
     pub background: f64,
     #[serde(default)]
     pub patches: Vec<[f64; 3]>,
+    /// The image repeats along x every this (default: the box's length,
+    /// which it must divide).
+    pub period: Option<f64>,
 }
 
 /// `[rigid.planes]`: the box's faces z = box_lo.z and z = box_hi.z are
@@ -126,11 +129,23 @@ impl Section<Clumps> for LatentSettings {
             ));
         };
         let ls = self;
+        let length = planes.lateral[0];
+        let period = ls.period.unwrap_or(length);
+        let copies = length / period;
+        if !(period > 0.0
+            && copies.round() >= 1.0
+            && (copies - copies.round()).abs() < 1e-9 * copies)
+        {
+            return Err(b.error(
+                span,
+                format!("[rigid.latent_image] period {period} must divide the box's length along x ({length}) a whole number of times"),
+            ));
+        }
         let image = LatentImage {
             k: planes.k,
             gap: planes.gap,
             height: ls.height,
-            period: planes.lateral[0],
+            period,
             speed: ls.speed,
             background: ls.background,
             patches: ls
