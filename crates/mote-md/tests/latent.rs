@@ -191,22 +191,7 @@ fn image_copies_by_progressions_match_copy_by_copy() {
         (1.0, 0.5, 0.08, vec![[-0.1, 0.3, -1.0], [0.35, 0.45, 2.0]]),
         (1.0, 0.23, 0.05, vec![[0.0, 0.2, 1.0]]),
     ] {
-        let img = LatentImage {
-            k: 8.9875517923e9,
-            gap,
-            height,
-            period,
-            speed: 0.3,
-            background: 1.1e-4,
-            patches: patches
-                .iter()
-                .map(|&[start, end, density]| Patch {
-                    start,
-                    end,
-                    density,
-                })
-                .collect(),
-        };
+        let img = belt_image(gap, height, period, &patches);
         img.check().unwrap();
         let mut worst: f64 = 0.0;
         for i in 0..=40 {
@@ -371,22 +356,7 @@ steps = 1
 /// scene refuses a period that does not divide the box's length.
 #[test]
 fn a_period_that_divides_the_box_repeats_the_patches() {
-    let image = |period: f64, patches: &[[f64; 3]]| LatentImage {
-        k: 8.9875517923e9,
-        gap: 2.58e-4,
-        height: 8.0e-6,
-        period,
-        speed: 0.3,
-        background: 1.1e-4,
-        patches: patches
-            .iter()
-            .map(|&[start, end, density]| Patch {
-                start,
-                end,
-                density,
-            })
-            .collect(),
-    };
+    let image = |period: f64, patches: &[[f64; 3]]| belt_image(2.58e-4, 8.0e-6, period, patches);
     let one = image(3.0e-4, &[[0.0, 1.5e-4, 6.6e-4]]);
     let two = image(6.0e-4, &[[0.0, 1.5e-4, 6.6e-4], [3.0e-4, 4.5e-4, 6.6e-4]]);
     for i in 0..=60 {
@@ -438,5 +408,26 @@ fn a_period_that_divides_the_box_repeats_the_patches() {
             (Ok(_), false) => panic!("period {period} taken"),
             (Err(e), true) => panic!("period {period} refused: {e}"),
         }
+    }
+}
+
+/// A latent image of the nip's belt (k of SI, 0.3 m/s, background
+/// 1.1·10⁻⁴ C/m²) with `patches` [start, end, density].
+fn belt_image(gap: f64, height: f64, period: f64, patches: &[[f64; 3]]) -> LatentImage {
+    LatentImage {
+        k: 8.9875517923e9,
+        gap,
+        height,
+        period,
+        speed: 0.3,
+        background: 1.1e-4,
+        patches: patches
+            .iter()
+            .map(|&[start, end, density]| Patch {
+                start,
+                end,
+                density,
+            })
+            .collect(),
     }
 }
