@@ -34,10 +34,10 @@
 //! `cutoff` r_c over the moments within r_c (minimum image), found each
 //! step by a [`VerletList`] without skin, each body's partners in
 //! increasing order: a cut-off beyond every pair gives the bits of all
-//! pairs. Truncating the
-//! dipole sum leaves out the field of the moments beyond r_c (in the nip's
-//! slab, the chains' far field, which falls off as 1/r³ and partly
-//! cancels); docs/toning-nip.md measures what it changes.
+//! pairs. Truncating the dipole sum leaves out the field of the moments
+//! beyond r_c (in the nip's slab, the chains' far field, which falls off
+//! as 1/r³ and partly cancels); docs/toning-nip.md measures what it
+//! changes.
 
 use std::f64::consts::PI;
 
