@@ -198,6 +198,9 @@ impl NipProbe {
         // those that touch joined in that order: the pairs of the loop over
         // all pairs, without its N² cost.
         let r_max = spheres.iter().fold(0.0f64, |r, s| r.max(s.2));
+        if spheres.is_empty() {
+            return;
+        }
         let mut list = VerletList::half(1.02 * 2.0 * r_max, 0.0);
         list.set_groups(&spheres.iter().map(|s| s.0 as u32).collect::<Vec<_>>());
         let centres: Vec<DVec3> = spheres.iter().map(|s| s.1).collect();

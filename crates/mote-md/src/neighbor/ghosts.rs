@@ -522,8 +522,9 @@ pub(crate) fn within(
 }
 
 /// [`within`] eight points at a time on [`Lanes`] (where neither AVX-512
-/// nor AVX2 is built for): the distances of eight in lanes, the kept ones left-packed into `out`
-/// ([`lanes::pack_indices`]), then `exclude` taken out where it was kept.
+/// nor AVX2 is built for): the distances of eight in lanes, the kept ones
+/// left-packed into `out` ([`lanes::pack_indices`]), then `exclude` taken
+/// out where it was kept.
 #[inline]
 fn within_lanes(
     at: (f64, f64, f64),
