@@ -511,20 +511,13 @@ pub(crate) fn within(
         // SAFETY: AVX-512F and VL are present; the slices were checked above.
         return unsafe { within_avx512(at, reach2, (x, y, z), first, exclude, out) };
     }
-    #[cfg(all(
-        target_arch = "x86_64",
-        target_feature = "avx2",
-        target_feature = "fma"
-    ))]
-    return within_avx2(at, reach2, (x, y, z), first, exclude, out);
-    #[allow(unreachable_code)]
     within_lanes(at, reach2, (x, y, z), first, exclude, out)
 }
 
-/// [`within`] eight points at a time on [`Lanes`] (where neither AVX-512
-/// nor AVX2 is built for): the distances of eight in lanes, the kept ones
-/// left-packed into `out` ([`lanes::pack_indices`]), then `exclude` taken
-/// out where it was kept.
+/// [`within`] eight points at a time on [`Lanes`]: the distances of eight
+/// in lanes, r² fused as the AVX-512 kernel takes it (so both levels keep
+/// the same points), the kept ones left-packed into `out`
+/// ([`lanes::pack_indices`]), then `exclude` taken out where it was kept.
 #[inline]
 fn within_lanes(
     at: (f64, f64, f64),
@@ -555,75 +548,6 @@ fn within_lanes(
             out.copy_within(p + 1..kept, p);
             kept -= 1;
         }
-    }
-    kept
-}
-
-/// [`within`] eight points at a time in two AVX2 registers of four: the
-/// distance as the AVX-512 kernel takes it (r² = dz² + (dy² + dx²) by
-/// fused multiply-adds, so both levels keep the same points), the two
-/// halves' compare masks joined into eight bits and the kept indices
-/// left-packed by [`lanes::pack_indices`]. The build's x86-64-v3 target
-/// has AVX2 and FMA on every CPU it runs on: no run-time check.
-#[cfg(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    target_feature = "fma"
-))]
-#[inline]
-fn within_avx2(
-    at: (f64, f64, f64),
-    reach2: f64,
-    (x, y, z): (&[f64], &[f64], &[f64]),
-    first: usize,
-    exclude: usize,
-    out: &mut [u32],
-) -> usize {
-    use std::arch::x86_64::*;
-    // SAFETY (every intrinsic below): AVX2 and FMA are enabled for the
-    // whole build; each load reads four f64 that `four` is given.
-    let (ax, ay, az, limit) = unsafe {
-        (
-            _mm256_set1_pd(at.0),
-            _mm256_set1_pd(at.1),
-            _mm256_set1_pd(at.2),
-            _mm256_set1_pd(reach2),
-        )
-    };
-    // Bit l set where point l of the four at x, y, z is within reach.
-    let four = |x: &[f64], y: &[f64], z: &[f64]| -> u32 {
-        assert!(x.len() >= 4 && y.len() >= 4 && z.len() >= 4);
-        unsafe {
-            let dx = _mm256_sub_pd(ax, _mm256_loadu_pd(x.as_ptr()));
-            let dy = _mm256_sub_pd(ay, _mm256_loadu_pd(y.as_ptr()));
-            let dz = _mm256_sub_pd(az, _mm256_loadu_pd(z.as_ptr()));
-            let r2 = _mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx)));
-            _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(r2, limit)) as u32
-        }
-    };
-    let eight =
-        |x: &[f64], y: &[f64], z: &[f64]| four(x, y, z) | four(&x[4..], &y[4..], &z[4..]) << 4;
-    let n = x.len();
-    let mut kept = 0;
-    let mut m = 0;
-    while m < n {
-        let mut bits = if n - m >= LANES {
-            eight(&x[m..], &y[m..], &z[m..])
-        } else {
-            // The tail, padded with NaN (never within reach).
-            let pad = |v: &[f64]| {
-                let mut p = [f64::NAN; LANES];
-                p[..n - m].copy_from_slice(&v[m..]);
-                p
-            };
-            let (px, py, pz) = (pad(x), pad(y), pad(z));
-            eight(&px, &py, &pz)
-        };
-        if (m..m + LANES).contains(&(exclude.wrapping_sub(first))) {
-            bits &= !(1 << (exclude - first - m));
-        }
-        kept += lanes::pack_indices(bits as u8, (first + m) as u32, &mut out[kept..]);
-        m += LANES;
     }
     kept
 }
@@ -836,14 +760,7 @@ mod tests {
         let first = 100;
         type Kernel =
             fn((f64, f64, f64), f64, (&[f64], &[f64], &[f64]), usize, usize, &mut [u32]) -> usize;
-        let mut kernels: Vec<(&str, Kernel)> =
-            vec![("lanes", within_lanes), ("dispatched", within)];
-        #[cfg(all(
-            target_arch = "x86_64",
-            target_feature = "avx2",
-            target_feature = "fma"
-        ))]
-        kernels.push(("avx2", within_avx2));
+        let kernels: Vec<(&str, Kernel)> = vec![("lanes", within_lanes), ("dispatched", within)];
         for len in 0..=x.len() {
             for exclude in [
                 first + len / 2,
