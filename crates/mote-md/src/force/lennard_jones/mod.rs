@@ -211,28 +211,36 @@ fn row_lanes<const ENERGY: bool>(
     let [xi, yi, zi, _] = position[k].0;
     let zero = Lanes::splat(0.0);
     let (mut fx, mut fy, mut fz, mut w, mut u) = (zero, zero, zero, zero, zero);
-    lanes::in_eights(row, k as u32, |index, pad| {
-        let [xj, yj, zj] = lanes::gather_xyz(records, index);
-        let (dx, dy, dz) = (
-            Lanes::splat(xi) - xj,
-            Lanes::splat(yi) - yj,
-            Lanes::splat(zi) - zj,
-        );
-        let d2 = dx * dx + dy * dy + dz * dz;
-        let r2 = d2 + pad;
-        let inside = r2.select_below(c.cutoff2, 1.0, 0.0);
-        let inv = Lanes::splat(1.0) / r2;
-        let s2 = inv * c.sigma2;
-        let s6 = s2 * s2 * s2;
-        let f = inv * s6 * (s6 * c.eps48 - c.eps24) * inside;
-        fx = fx + f * dx;
-        fy = fy + f * dy;
-        fz = fz + f * dz;
-        if ENERGY {
-            w = w + f * d2;
-            u = u + (s6 * (s6 * c.eps4 - c.eps4) - c.shift) * inside;
-        }
-    });
+    // The law inlined into the row's loop (its sums then stay in
+    // registers): 6 % of the LJ melt on an AVX2 CPU. The larger dipolar
+    // and P3M rows lost a third the same way, so they keep their calls.
+    lanes::in_eights(
+        row,
+        k as u32,
+        #[inline(always)]
+        |index, pad| {
+            let [xj, yj, zj] = lanes::gather_xyz(records, index);
+            let (dx, dy, dz) = (
+                Lanes::splat(xi) - xj,
+                Lanes::splat(yi) - yj,
+                Lanes::splat(zi) - zj,
+            );
+            let d2 = dx * dx + dy * dy + dz * dz;
+            let r2 = d2 + pad;
+            let inside = r2.select_below(c.cutoff2, 1.0, 0.0);
+            let inv = Lanes::splat(1.0) / r2;
+            let s2 = inv * c.sigma2;
+            let s6 = s2 * s2 * s2;
+            let f = inv * s6 * (s6 * c.eps48 - c.eps24) * inside;
+            fx = fx + f * dx;
+            fy = fy + f * dy;
+            fz = fz + f * dz;
+            if ENERGY {
+                w = w + f * d2;
+                u = u + (s6 * (s6 * c.eps4 - c.eps4) - c.shift) * inside;
+            }
+        },
+    );
     RowSum {
         force: DVec3::new(fx.sum(), fy.sum(), fz.sum()),
         virial: w.sum(),
