@@ -20,7 +20,9 @@ fn main() {
             let eq: f64 = a.get(6).map(|s| s.parse().unwrap()).unwrap_or(0.0);
             let seed: u64 = a.get(7).map(|s| s.parse().unwrap()).unwrap_or(1);
             let text = format!(
-                "dimension = {dim}\nn = {n}\npacking_fraction = {eta}\ntime = {t}\nequilibrate = {eq}\n"
+                "[event_driven]\ndimension = {dim}\nn = {n}\npacking_fraction = {eta}\n\
+                 [run]\nequilibrate = {eq}\nuntil = {}\n",
+                eq + t
             );
             let scene = Scene::parse(&text, "bench").unwrap();
             if dim == 2 {
@@ -34,7 +36,8 @@ fn main() {
             let frames: usize = a.get(3).map(|s| s.parse().unwrap()).unwrap_or(40);
             let r = 1.0 / ((30.0 * std::f64::consts::PI).powf(1.0 / 3.0) * nbs as f64);
             let text = format!(
-                "n = {}\nbox = [1.0, 1.0, 1.0]\nboundary = \"wall\"\nradius = {r}\nplacement = \"cubic\"\nspeed = 1.0\n",
+                "[box]\nhi = [1.0, 1.0, 1.0]\nperiodic = [false, false, false]\n\
+                 [event_driven]\nn = {}\nradius = {r}\nplacement = \"cubic\"\nspeed = 1.0\n",
                 nbs * nbs * nbs
             );
             let scene = Scene::parse(&text, "cube").unwrap();

@@ -12,7 +12,7 @@
 
 use std::arch::x86_64::*;
 
-pub(crate) use crate::system::Probe;
+pub(crate) use crate::system::{Probe, TwoEarliest};
 
 /// Whether this CPU can run [`earliest`].
 pub(crate) fn available() -> bool {
@@ -64,8 +64,8 @@ fn dot<const D: usize>(a: &[__m512d; D], b: &[__m512d; D]) -> __m512d {
     s
 }
 
-/// The earliest contact time with the particles of `list` (records in
-/// `records`, 8 doubles each) and its position in `list`, or (+∞, None).
+/// The two earliest contact times with the particles of `list` (records in
+/// `records`, 8 doubles each) and their positions in `list`.
 ///
 /// # Safety
 /// The CPU must have AVX-512F; every index in `list` and `own` must be a
@@ -76,7 +76,7 @@ pub(crate) unsafe fn earliest<const D: usize, const GROW: bool>(
     own: usize,
     list: &[u32],
     probe: &Probe<D>,
-) -> (f64, Option<usize>) {
+) -> TwoEarliest {
     let inf = _mm512_set1_pd(f64::INFINITY);
     let zero = _mm512_setzero_pd();
     let now = _mm512_set1_pd(probe.now);
@@ -88,8 +88,7 @@ pub(crate) unsafe fn earliest<const D: usize, const GROW: bool>(
     let minus_half = probe.half.map(|h| _mm512_set1_pd(-h));
     let g = _mm512_set1_pd(probe.g);
     let delta = _mm512_set1_pd(probe.delta);
-    let mut best = f64::INFINITY;
-    let mut at = None;
+    let mut two = TwoEarliest::NONE;
     for (block, chunk) in list.chunks(8).enumerate() {
         let m = chunk.len();
         let mut rows = [zero; 8];
@@ -134,14 +133,12 @@ pub(crate) unsafe fn earliest<const D: usize, const GROW: bool>(
             approach_root(dot(&v, &v), dot(&r, &v), c)
         };
         let t = _mm512_mask_mov_pd(inf, ((1u32 << m) - 1) as u8, t);
-        let tmin = _mm512_reduce_min_pd(t);
-        if tmin < best {
-            let first = _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(t, _mm512_set1_pd(tmin)).trailing_zeros();
-            best = tmin;
-            at = Some(8 * block + first as usize);
-        }
+        let mut times = [0.0; 8];
+        // SAFETY: `times` holds eight doubles.
+        unsafe { _mm512_storeu_pd(times.as_mut_ptr(), t) };
+        two.offer_block(&times, 8 * block);
     }
-    (best, at)
+    two
 }
 
 /// The scalar `approach_root`, lane by lane.

@@ -129,6 +129,19 @@ impl<const D: usize> Cells<D> {
         });
     }
 
+    /// Asks the CPU for the cells [`Cells::near`] would visit (their list
+    /// positions and indices), ahead of a list build: a hint, no effect on
+    /// results.
+    pub fn prefetch_near(&self, x: &[f64; D], rho: f64) {
+        self.grids.for_each_cell_near(x, rho, |f| {
+            let base = f * self.cap;
+            prefetch(&self.len[f]);
+            prefetch(&self.pos[base]);
+            prefetch(&self.pos[base + 2]);
+            prefetch(&self.id[base]);
+        });
+    }
+
     /// Particle index and list position in slot `s`.
     #[inline]
     pub fn entry(&self, s: usize) -> (u32, ListPos<D>) {

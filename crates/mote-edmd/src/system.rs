@@ -70,23 +70,100 @@ enum Kind {
     Wall,
 }
 
+/// A particle's scheduled event, and for a collision what comes next if
+/// it turns out stale: a light form of DynamO's per-particle event lists
+/// (Bannerman, Sargant & Lue, J. Comput. Chem. 32, 3329 (2011), Sec. 3.2).
+///
+/// When the partner collides first, the prediction of every other listed
+/// pair still holds (their trajectories did not change, or they changed and
+/// were predicted again with this particle among their neighbours, so their
+/// own events come no later than their contact with it). The next event is
+/// then the earlier of the list's second-earliest contact — if that
+/// partner's counter has not moved either — and the skin or wall event: no
+/// scan of the list is needed.
 #[derive(Debug, Clone, Copy)]
 struct Event {
     kind: Kind,
-    partner: u32,
+    /// The wall of a `Wall` event (also of a wall fallback).
     axis: u8,
     up: bool,
+    /// What follows a stale collision: `Collision` (with `later`),
+    /// `Rebuild` or `Wall` at `later_time`; `None`: scan the list again.
+    fallback: Kind,
+    partner: u32,
     /// The partner's collision counter when the event was predicted.
     partner_count: u32,
+    later: u32,
+    later_count: u32,
+    later_time: f64,
 }
 
 const NO_EVENT: Event = Event {
     kind: Kind::None,
-    partner: u32::MAX,
     axis: 0,
     up: false,
+    fallback: Kind::None,
+    partner: u32::MAX,
     partner_count: 0,
+    later: u32::MAX,
+    later_count: 0,
+    later_time: f64::INFINITY,
 };
+
+/// The two earliest contact times of a list scan and their positions in
+/// the list (`u32::MAX`: none), ties to the first in the list: what every
+/// scan (scalar, `Lanes`, AVX-512) keeps, offered each time in list order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TwoEarliest {
+    pub t: [f64; 2],
+    pub at: [u32; 2],
+}
+
+impl TwoEarliest {
+    pub const NONE: Self = TwoEarliest {
+        t: [f64::INFINITY; 2],
+        at: [u32::MAX; 2],
+    };
+
+    /// Takes the time `t` of list position `at`, by selects (a NaN is never
+    /// earlier).
+    #[inline(always)]
+    pub fn offer(&mut self, t: f64, at: u32) {
+        let first = t < self.t[0];
+        let second = !first & (t < self.t[1]);
+        self.t[1] = if first {
+            self.t[0]
+        } else if second {
+            t
+        } else {
+            self.t[1]
+        };
+        self.at[1] = if first {
+            self.at[0]
+        } else if second {
+            at
+        } else {
+            self.at[1]
+        };
+        self.t[0] = if first { t } else { self.t[0] };
+        self.at[0] = if first { at } else { self.at[0] };
+    }
+
+    /// Offers a block of eight times from list position `base` on (lanes
+    /// past the list's end hold +∞); skipped whole when none is earlier
+    /// than the second.
+    #[inline(always)]
+    pub fn offer_block(&mut self, t: &[f64; 8], base: usize) {
+        let min = t
+            .iter()
+            .fold(f64::INFINITY, |m, &x| if x < m { x } else { m });
+        if min < self.t[1] {
+            for (l, &x) in t.iter().enumerate() {
+                self.offer(x, (base + l) as u32);
+            }
+        }
+    }
+}
 
 const NONE: u32 = u32::MAX;
 
@@ -333,20 +410,20 @@ pub(crate) struct Probe<const D: usize> {
     pub delta: f64,
 }
 
-/// The earliest contact time with the particles of `list` and its position
-/// in `list`, or (+∞, None): the scalar scan of `System::predict` eight
+/// The two earliest contact times with the particles of `list` and their
+/// positions in `list`: the scalar scan of `System::predict` eight
 /// neighbours at a time on [`Lanes`] (every CPU; AVX2 on the x86-64-v3
 /// build), each lane the scalar loop's operations in its order (no fused
 /// multiply–adds, the same selects), so every time is the scalar's to the
-/// bit and the earliest is the same partner, ties to the first in the list.
+/// bit and the earliest are the same partners, ties to the first in the
+/// list.
 fn earliest_lanes<const D: usize, const GROW: bool>(
     p: &[Particle<D>],
     list: &[u32],
     own: usize,
     probe: &Probe<D>,
-) -> (f64, Option<usize>) {
-    let mut best = f64::INFINITY;
-    let mut at = None;
+) -> TwoEarliest {
+    let mut two = TwoEarliest::NONE;
     for (block, chunk) in list.chunks(LANES).enumerate() {
         let m = chunk.len();
         // Lanes past the list's end read the particle's own record; their
@@ -387,18 +464,9 @@ fn earliest_lanes<const D: usize, const GROW: bool>(
         };
         let mut t = t.0;
         t[m..].fill(f64::INFINITY);
-        // The first lane of the smallest time (NaN is never earlier).
-        let (k, tmin) =
-            t.iter().enumerate().fold(
-                (0, f64::INFINITY),
-                |(k, b), (l, &x)| if x < b { (l, x) } else { (k, b) },
-            );
-        if tmin < best {
-            best = tmin;
-            at = Some(LANES * block + k);
-        }
+        two.offer_block(&t, LANES * block);
     }
-    (best, at)
+    two
 }
 
 /// [`approach_root`] lane by lane, with selects.
@@ -1081,15 +1149,13 @@ impl<const D: usize> System<D> {
                     best = dt;
                     ev = Event {
                         kind: Kind::Wall,
-                        partner: NONE,
                         axis: d as u8,
                         up,
-                        partner_count: 0,
+                        ..NO_EVENT
                     };
                 }
             }
         }
-        let mut partner = NONE;
         let base = i * self.cap;
         let size = self.simbox.size;
         let periodic = self.simbox.boundary.map(|b| b == Boundary::Periodic);
@@ -1114,7 +1180,7 @@ impl<const D: usize> System<D> {
         let list = &self.nbr[base..base + nn];
         // The vector scans, where they run: AVX-512, else eight at a time
         // on `Lanes`; the same bits as the scalar loop below.
-        let mut scanned = None;
+        let mut scanned: Option<TwoEarliest> = None;
         #[cfg(target_arch = "x86_64")]
         if self.simd {
             // SAFETY: `simd` is set only where AVX-512F exists; list entries
@@ -1126,15 +1192,10 @@ impl<const D: usize> System<D> {
         if scanned.is_none() && self.lanes {
             scanned = Some(earliest_lanes::<D, GROW>(&self.p, list, i, &probe));
         }
-        if let Some((t, k)) = scanned {
-            if let Some(k) = k {
-                if t < best {
-                    best = t;
-                    partner = list[k];
-                }
-            }
-            return self.schedule(i, best, ev, partner);
+        if let Some(two) = scanned {
+            return self.schedule(i, best, ev, two);
         }
+        let mut two = TwoEarliest::NONE;
         // Branch-free: every listed pair's time is computed (no early outs,
         // whose outcome is a coin toss for the branch predictor and which
         // chain each pair's test to the previous pair's division) and the
@@ -1170,28 +1231,65 @@ impl<const D: usize> System<D> {
                     dot(&r, &r) - (ri + pj.r) * (ri + pj.r),
                 )
             };
-            let earlier = dt < best;
-            best = if earlier { dt } else { best };
-            partner = if earlier { j } else { partner };
+            two.offer(dt, k as u32);
         }
-        self.schedule(i, best, ev, partner)
+        self.schedule(i, best, ev, two)
     }
 
-    /// Files the event `ev` of `i` (a collision with `partner` if that is
-    /// not `NONE`) at `now + dt`.
+    /// Files the next event of `i`: the earliest listed contact of `two`
+    /// if it comes before `dt` (the skin or wall event `ev`), else `ev`, at
+    /// `now` plus its time; a collision keeps the earlier of the second
+    /// contact and `ev` as its fallback.
     #[inline(always)]
-    fn schedule(&mut self, i: usize, dt: f64, mut ev: Event, partner: u32) {
-        if partner != NONE {
+    fn schedule(&mut self, i: usize, dt: f64, mut ev: Event, two: TwoEarliest) {
+        let now = self.now;
+        let mut t = now + dt;
+        if two.t[0] < dt {
+            let base = i * self.cap;
+            let j = self.nbr[base + two.at[0] as usize];
+            let (fallback, later, later_count, later_time) = if two.t[1] < dt {
+                let k = self.nbr[base + two.at[1] as usize];
+                (Kind::Collision, k, self.count[k as usize], now + two.t[1])
+            } else {
+                (ev.kind, NONE, 0, t)
+            };
             ev = Event {
                 kind: Kind::Collision,
-                partner,
-                axis: 0,
-                up: false,
-                partner_count: self.count[partner as usize],
+                fallback,
+                partner: j,
+                partner_count: self.count[j as usize],
+                later,
+                later_count,
+                later_time,
+                ..ev
             };
+            t = now + two.t[0];
         }
         self.events[i] = ev;
-        self.queue.update(i, self.now + dt);
+        self.queue.update(i, t);
+    }
+
+    /// The next event of `i` after its collision turned out stale (the
+    /// partner collided first): its fallback where that still holds (see
+    /// [`Event`]), else a new scan of its list.
+    fn fall_back(&mut self, i: usize, ev: Event) {
+        let holds = match ev.fallback {
+            Kind::Collision => self.count[ev.later as usize] == ev.later_count,
+            Kind::Rebuild | Kind::Wall => true,
+            Kind::None => false,
+        };
+        if holds {
+            self.events[i] = Event {
+                kind: ev.fallback,
+                fallback: Kind::None,
+                partner: ev.later,
+                partner_count: ev.later_count,
+                ..ev
+            };
+            self.queue.update(i, ev.later_time);
+        } else {
+            self.predict(i);
+        }
     }
 
     /// Turns the vector neighbour scans (AVX-512 where the CPU has it, else
@@ -1311,7 +1409,8 @@ impl<const D: usize> System<D> {
         // now and look up the event after it, so that its particle's data
         // are fetched while this event is worked on.
         self.queue.pop();
-        let next = self.queue.min().map(|(_, k)| k);
+        let next_event = self.queue.min();
+        let next = next_event.map(|(_, k)| k);
         if let Some(k) = next {
             prefetch(&self.events[k]);
             prefetch(&self.p[k]);
@@ -1328,7 +1427,7 @@ impl<const D: usize> System<D> {
                 let j = ev.partner as usize;
                 if self.count[j] != ev.partner_count {
                     self.counters.invalid += 1;
-                    self.predict(i);
+                    self.fall_back(i, ev);
                 } else {
                     self.collide(i, j);
                     self.predict(i);
@@ -1366,6 +1465,13 @@ impl<const D: usize> System<D> {
                 prefetch(&self.mass[j]);
                 prefetch(&self.xn[j]);
                 prefetch(&self.nbr[j * self.cap]);
+            } else if e.kind == Kind::Rebuild {
+                // the cells its list build will scan, around where it
+                // will be then
+                let (t, _) = next_event.unwrap_or((self.now, k));
+                let q = &self.p[k];
+                let x = add_scaled(&q.x, &q.v, t - q.t);
+                self.cells.prefetch_near(&x, self.xn[k].r);
             }
         }
         true
