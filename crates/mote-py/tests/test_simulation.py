@@ -618,7 +618,14 @@ def test_a_packing_steps_from_python_with_the_bits_of_mote_run(tmp_path):
     assert seen[0] == 13 and seen[-1] == p.steps
     windows = p.windows
     assert len(windows["phi"]) == p.steps
-    assert np.all(np.diff(windows["phi"]) >= 0) and windows["phi"][-1] == pytest.approx(p.phi)
+    # φ never falls, to round-off: where the packer restarts its system
+    # (a new epoch, or growth stopped near jamming) the radii are re-based,
+    # r ← r(0)(1 + δt) rounded, and φ summed again from their cubes moves
+    # by some ulps either way while the packing stands still (12 ulps,
+    # 1.3e-15, seen at 200 disks).
+    phi = windows["phi"]
+    assert np.all(np.diff(phi) >= -1e-12 * phi[1:]), np.diff(phi).min()
+    assert phi[-1] == pytest.approx(p.phi)
     # mote run of the same scene: the same packing and windows, bit for bit.
     scene = tmp_path / "p.toml"
     scene.write_text(PACKING)
