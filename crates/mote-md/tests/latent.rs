@@ -174,7 +174,7 @@ fn latent_image_matches_the_fourier_series() {
 }
 
 /// The copies summed as two progressions of products (one logarithm
-/// each) give the copy-by-copy sum's field to round-off: the toning nip's
+/// each, or one for the ratio of the two) give the copy-by-copy sum's field to round-off: the toning nip's
 /// geometry (L = 2.3 h) and periods down to 0.23 h (q = e^{−πL/h} = 0.48),
 /// from just above the charged surface to just under the shell, over a
 /// whole period and with the belt moved.
@@ -190,6 +190,9 @@ fn image_copies_by_progressions_match_copy_by_copy() {
         (1.0, 1.2, 0.08, vec![[0.2, 0.7, 1.1]]),
         (1.0, 0.5, 0.08, vec![[-0.1, 0.3, -1.0], [0.35, 0.45, 2.0]]),
         (1.0, 0.23, 0.05, vec![[0.0, 0.2, 1.0]]),
+        // q = 0.323, just inside the bound under which each side's two
+        // progressions are summed as one ratio.
+        (1.0, 0.36, 0.02, vec![[0.0, 0.2, 1.0]]),
     ] {
         let img = belt_image(gap, height, period, &patches);
         img.check().unwrap();

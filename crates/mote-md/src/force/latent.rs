@@ -38,7 +38,9 @@
 //! are summed until that is below 10⁻¹⁷. The copies on either side of a
 //! point are each a geometric progression in e^{∓us} of ratio q = e^{−uL},
 //! so each side's logarithms are the logarithm of one product (one ln and
-//! one atan2 for all its copies; copy by copy where q ≥ ½).
+//! one atan2 for all its copies; copy by copy where q ≥ ½), and the two
+//! products of a side (θ₁ and θ₂) one ratio where its argument cannot
+//! pass ±π (ud + πq/(1 − q) < π/2: one ln and one atan2 for the side).
 
 use glam::DVec3;
 
@@ -131,7 +133,45 @@ fn log_progression(a: f64, q: f64, (s, c): (f64, f64), count: usize) -> (f64, f6
     (0.5 * (re * re + im * im).ln(), im.atan2(re))
 }
 
+/// Σ_{k<count} [ln(1 − A qᵏ e^{iθ₁}) − ln(1 − A qᵏ e^{iθ₂})] as (re, im),
+/// given (sin θ, cos θ) of both: [`log_progression`] of θ₁ less that of θ₂,
+/// as the logarithm of the ratio of the two products — one logarithm and
+/// one arctangent for both. The arctangent of P₁P̄₂ gives arg P₁ − arg P₂
+/// only within (−π, π]; the caller takes this form where that interval
+/// holds the difference ([`LatentImage::ratio_holds`]).
+fn log_ratio_progression(
+    a: f64,
+    q: f64,
+    (s1, c1): (f64, f64),
+    (s2, c2): (f64, f64),
+    count: usize,
+) -> (f64, f64) {
+    let (mut re1, mut im1, mut re2, mut im2, mut x) = (1.0, 0.0, 1.0, 0.0, a);
+    for _ in 0..count {
+        let (fr1, fi1) = (1.0 - x * c1, -x * s1);
+        let (fr2, fi2) = (1.0 - x * c2, -x * s2);
+        (re1, im1) = (re1 * fr1 - im1 * fi1, re1 * fi1 + im1 * fr1);
+        (re2, im2) = (re2 * fr2 - im2 * fi2, re2 * fi2 + im2 * fr2);
+        x *= q;
+    }
+    // P₁P̄₂ and |P₁|²/|P₂|².
+    let (re, im) = (re1 * re2 + im1 * im2, im1 * re2 - re1 * im2);
+    let ratio = (re1 * re1 + im1 * im1) / (re2 * re2 + im2 * im2);
+    (0.5 * ratio.ln(), im.atan2(re))
+}
+
 impl LatentImage {
+    /// Whether the two progressions of a side of [`LatentImage::field`]
+    /// may be summed as one ratio ([`log_ratio_progression`]): their first
+    /// factors turn by angles in [−ud, π/2] (or [−π/2, ud]) for d < z < h,
+    /// u = π/h, and the later ones each by at most arcsin qᵏ ≤ (π/2) qᵏ,
+    /// so the difference of the two arguments stays within
+    /// π/2 + ud + π q/(1 − q), which is below π where this holds.
+    fn ratio_holds(&self, q: f64) -> bool {
+        let u = std::f64::consts::PI / self.gap;
+        u * self.height + std::f64::consts::PI * q / (1.0 - q) < std::f64::consts::FRAC_PI_2
+    }
+
     /// Checks the geometry: 0 < d < h, L > 0, patches inside one period.
     pub fn check(&self) -> Result<(), String> {
         if !(self.gap > 0.0 && self.height > 0.0 && self.height < self.gap) {
@@ -178,28 +218,36 @@ impl LatentImage {
         q: f64,
         theta1: (f64, f64),
         theta2: (f64, f64),
+        ratio: bool,
     ) -> (f64, f64) {
         let (l, u) = (self.period, std::f64::consts::PI / self.gap);
         // The last copy at or before the edge: s + nL ≤ 0 for n ≤ last.
         let last = ((-s / l).floor() as i64).clamp(-reach - 1, reach);
         let conjugate = |(sin, cos): (f64, f64)| (-sin, cos);
         let (mut re, mut im) = (0.0, 0.0);
+        // Each side's two progressions: as one ratio where that holds.
+        let side = |a: f64, t1: (f64, f64), t2: (f64, f64), count: usize| {
+            if ratio {
+                log_ratio_progression(a, q, t1, t2, count)
+            } else {
+                let a1 = log_progression(a, q, t1, count);
+                let a2 = log_progression(a, q, t2, count);
+                (a1.0 - a2.0, a1.1 - a2.1)
+            }
+        };
         let before = (last + reach + 1) as usize;
         if before > 0 {
             // e^{u(s + nL)} for n = last, last − 1, …, −R.
             let b = (u * (s + last as f64 * l)).exp();
-            let a1 = log_progression(b, q, conjugate(theta1), before);
-            let a2 = log_progression(b, q, conjugate(theta2), before);
-            (re, im) = (a1.0 - a2.0, a1.1 - a2.1);
+            (re, im) = side(b, conjugate(theta1), conjugate(theta2), before);
         }
         let after = (reach - last) as usize;
         if after > 0 {
             // e^{−u(s + nL)} for n = last + 1, …, R.
             let a = (-u * (s + (last + 1) as f64 * l)).exp();
-            let a1 = log_progression(a, q, theta1, after);
-            let a2 = log_progression(a, q, theta2, after);
-            re += a1.0 - a2.0;
-            im += a1.1 - a2.1 - after as f64 * 2.0 * u * self.height;
+            let (r, i) = side(a, theta1, theta2, after);
+            re += r;
+            im += i - after as f64 * 2.0 * u * self.height;
         }
         (re, im)
     }
@@ -214,12 +262,13 @@ impl LatentImage {
         }
         let theta1 = (u * (z + self.height)).sin_cos();
         let theta2 = (u * (z - self.height)).sin_cos();
+        let ratio = self.ratio_holds(q);
         let mut ex = 0.0;
         let mut ez = 4.0 * std::f64::consts::PI * self.k * self.background * self.height / self.gap;
         for p in &self.patches {
             let (w, c, reach) = self.placed(p, x, t);
-            let a = self.lambda_copies(c + 0.5 * w, reach, q, theta1, theta2);
-            let b = self.lambda_copies(c - 0.5 * w, reach, q, theta1, theta2);
+            let a = self.lambda_copies(c + 0.5 * w, reach, q, theta1, theta2, ratio);
+            let b = self.lambda_copies(c - 0.5 * w, reach, q, theta1, theta2, ratio);
             let scale = 2.0 * self.k * (p.density - self.background);
             ex += scale * (a.0 - b.0);
             ez -= scale * (a.1 - b.1);
