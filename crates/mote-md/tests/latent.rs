@@ -174,8 +174,9 @@ fn latent_image_matches_the_fourier_series() {
 }
 
 /// The copies summed as two progressions of products (one logarithm
-/// each, or one for the ratio of the two) give the copy-by-copy sum's field to round-off: the toning nip's
-/// geometry (L = 2.3 h) and periods down to 0.23 h (q = e^{−πL/h} = 0.48),
+/// each, or one for the ratio of the two) give the copy-by-copy sum's
+/// field to round-off: the toning nip's geometry (L = 2.3 h) and periods
+/// down to 0.23 h (q = e^{−πL/h} = 0.48),
 /// from just above the charged surface to just under the shell, over a
 /// whole period and with the belt moved.
 #[test]

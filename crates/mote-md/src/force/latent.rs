@@ -166,7 +166,8 @@ impl LatentImage {
     /// factors turn by angles in [−ud, π/2] (or [−π/2, ud]) for d < z < h,
     /// u = π/h, and the later ones each by at most arcsin qᵏ ≤ (π/2) qᵏ,
     /// so the difference of the two arguments stays within
-    /// π/2 + ud + π q/(1 − q), which is below π where this holds.
+    /// π/2 + ud + π q/(1 − q), which is below π where this holds (the
+    /// caller also asks d < z < h, where those angles hold).
     fn ratio_holds(&self, q: f64) -> bool {
         let u = std::f64::consts::PI / self.gap;
         u * self.height + std::f64::consts::PI * q / (1.0 - q) < std::f64::consts::FRAC_PI_2
@@ -262,7 +263,7 @@ impl LatentImage {
         }
         let theta1 = (u * (z + self.height)).sin_cos();
         let theta2 = (u * (z - self.height)).sin_cos();
-        let ratio = self.ratio_holds(q);
+        let ratio = self.ratio_holds(q) && z > self.height && z < self.gap;
         let mut ex = 0.0;
         let mut ez = 4.0 * std::f64::consts::PI * self.k * self.background * self.height / self.gap;
         for p in &self.patches {
