@@ -146,6 +146,9 @@ fn log_ratio_progression(
     (s2, c2): (f64, f64),
     count: usize,
 ) -> (f64, f64) {
+    // The two products in one loop, not two calls of one product's loop:
+    // the two chains of multiplications then overlap (the same bits; two
+    // loops measured 5–8 % slower on the whole nip).
     let (mut re1, mut im1, mut re2, mut im2, mut x) = (1.0, 0.0, 1.0, 0.0, a);
     for _ in 0..count {
         let (fr1, fi1) = (1.0 - x * c1, -x * s1);
