@@ -4,7 +4,12 @@
 atoms of ../shared/bench/data.cloud10k sorted along a Morton (Z-order)
 curve of cells of one diameter (4 mm) and renumbered in that order, and
 DIR/settle-sorted.toml and DIR/settle-file.toml, bench/settle.toml
-reading the sorted file and the file as it is.
+reading the sorted file and the file as it is, both with `[granular]
+order = "file"` (stored as read: the experiment of stop 64). Since stop
+65 mote sorts a granular scene's particles itself (`order = "space"`, the
+default), so bench/settle.toml beside settle-file.toml measures that:
+
+    mote -q --threads 1 run bench/settle.toml -o /tmp/sfc/space
 
     python3 bench/space-order.py /tmp/sfc
     mote -q --threads 1 run /tmp/sfc/settle-file.toml -o /tmp/sfc/file
@@ -38,5 +43,8 @@ body = [" ".join([str(k + 1)] + a[1:]) for k, a in enumerate(atoms)]
 scene = (bench / "settle.toml").read_text()
 name = "../../shared/bench/data.cloud10k"
 assert name in scene
+skin = "skin = 0.001"
+assert skin in scene
+scene = scene.replace(skin, 'order = "file"      # stored as read\n' + skin, 1)
 (out / "settle-sorted.toml").write_text(scene.replace(name, str(out / "data.sorted")))
 (out / "settle-file.toml").write_text(scene.replace(name, str(data)))

@@ -21,6 +21,8 @@ pub fn resume_state(
     sim: &mut mote_md::Simulation,
     label: &str,
 ) -> Result<(), FrontError> {
+    sim.check_order(cp)
+        .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
     // Particles that came and went: the checkpoint's set first.
     sim.restore_flow(cp)
         .map_err(|m| FrontError::request(format!("{label}: {m}")))?;
@@ -58,7 +60,9 @@ pub fn resume_state(
     let keys = forces.carried_keys();
     let interactions_only = Checkpoint {
         carried: (cp.carried.iter())
-            .filter(|(k, _)| k != mote_md::simulation::FLOW_KEY)
+            .filter(|(k, _)| {
+                k != mote_md::simulation::FLOW_KEY && k != mote_md::simulation::ORDER_KEY
+            })
             .cloned()
             .collect(),
         ..Checkpoint::default()

@@ -20,6 +20,7 @@ pub mod integrate;
 pub mod magnetic;
 pub mod neighbor;
 pub mod observe;
+pub mod order;
 pub mod output;
 pub mod particles;
 pub mod rigid;

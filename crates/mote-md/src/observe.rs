@@ -237,7 +237,11 @@ impl Observables {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Probe {
     pub quantity: ProbeQuantity,
+    /// The particle's number in the scene.
     pub particle: usize,
+    /// Its row in the system (the number, unless the particles are stored
+    /// in space order).
+    pub row: usize,
 }
 
 /// What a [`Probe`] reads.
@@ -283,7 +287,11 @@ impl Probe {
             "kinetic" => ProbeQuantity::Kinetic,
             _ => return Err(err()),
         };
-        Ok(Self { quantity, particle })
+        Ok(Self {
+            quantity,
+            particle,
+            row: particle,
+        })
     }
 
     pub fn label(&self) -> String {
@@ -303,7 +311,7 @@ impl Probe {
 
     pub fn read(&self, sys: &System) -> f64 {
         let p = &sys.particles;
-        let (r, v) = (p.position[self.particle], p.velocity[self.particle]);
+        let (r, v) = (p.position[self.row], p.velocity[self.row]);
         match self.quantity {
             ProbeQuantity::X => r.x,
             ProbeQuantity::Y => r.y,
@@ -313,7 +321,7 @@ impl Probe {
             ProbeQuantity::Vz => v.z,
             ProbeQuantity::R => r.length(),
             ProbeQuantity::Speed => v.length(),
-            ProbeQuantity::Kinetic => 0.5 * p.mass[self.particle] * v.length_squared(),
+            ProbeQuantity::Kinetic => 0.5 * p.mass[self.row] * v.length_squared(),
         }
     }
 }

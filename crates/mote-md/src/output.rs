@@ -324,7 +324,7 @@ pub fn frame_of(sys: &System) -> Frame {
     } else {
         Frame::bounding_cell(&positions, &p.radius, 0.0)
     };
-    Frame {
+    let frame = Frame {
         time: sys.time,
         cell,
         origin,
@@ -339,10 +339,31 @@ pub fn frame_of(sys: &System) -> Frame {
         radii: p.radius.clone(),
         masses: p.mass.clone(),
         // Ids where particles come and go (written from 1).
-        ids: sys.id.iter().map(|id| id + 1).collect(),
+        ids: (0..sys.id.len()).map(|i| sys.number_of(i) + 1).collect(),
         angular_velocities: nonzero(&p.angular_velocity),
         dipoles: nonzero(&p.dipole),
         ..Frame::default()
+    };
+    match sys.rows_by_number() {
+        Some(rows) => in_rows(frame, &rows),
+        None => frame,
+    }
+}
+
+/// The frame's particles in the order of `rows` (the particles stored in
+/// space order, written in the scene's).
+fn in_rows(frame: Frame, rows: &[usize]) -> Frame {
+    use crate::order::gathered;
+    Frame {
+        species: gathered(&frame.species, rows),
+        positions: gathered(&frame.positions, rows),
+        velocities: gathered(&frame.velocities, rows),
+        radii: gathered(&frame.radii, rows),
+        masses: gathered(&frame.masses, rows),
+        ids: gathered(&frame.ids, rows),
+        angular_velocities: gathered(&frame.angular_velocities, rows),
+        dipoles: gathered(&frame.dipoles, rows),
+        ..frame
     }
 }
 

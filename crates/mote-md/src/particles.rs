@@ -95,6 +95,22 @@ impl Particles {
     pub fn rotates(&self, i: usize) -> bool {
         self.inertia[i] > 0.0 && self.mobility[i] != DVec3::ZERO
     }
+
+    /// Puts the particles in another order: row k becomes the particle
+    /// that was at row `order[k]` (`order` a permutation of the rows).
+    pub fn reorder(&mut self, order: &[usize]) {
+        use crate::order::gathered;
+        self.position = gathered(&self.position, order);
+        self.velocity = gathered(&self.velocity, order);
+        self.mass = gathered(&self.mass, order);
+        self.charge = gathered(&self.charge, order);
+        self.radius = gathered(&self.radius, order);
+        self.color = gathered(&self.color, order);
+        self.mobility = gathered(&self.mobility, order);
+        self.angular_velocity = gathered(&self.angular_velocity, order);
+        self.inertia = gathered(&self.inertia, order);
+        self.dipole = gathered(&self.dipole, order);
+    }
 }
 
 /// The state of a run: particles, simulated time and step count.
@@ -118,6 +134,12 @@ pub struct System {
     /// i has id i). Ids stay with particles where particles come and go
     /// ([`crate::flow`]): the next inserted takes the next unused one.
     pub id: Vec<u64>,
+    /// The scene's number of the particle with id k, where the particles
+    /// are stored in another order than the scene gave them (space order,
+    /// [`crate::order`]): files, probes and messages name particles by it.
+    /// Empty: every particle's number is its id; ids past its end
+    /// (particles inserted during the run) are their own numbers too.
+    pub number: std::sync::Arc<[u64]>,
 }
 
 impl System {
@@ -131,6 +153,7 @@ impl System {
             carried_angular_acceleration: Vec::new(),
             species: Vec::new(),
             id: Vec::new(),
+            number: Default::default(),
         }
     }
 
@@ -145,6 +168,7 @@ impl System {
             carried_angular_acceleration: Vec::new(),
             species: Vec::new(),
             id: Vec::new(),
+            number: self.number.clone(),
         }
     }
 
@@ -152,6 +176,30 @@ impl System {
     #[inline]
     pub fn id_of(&self, i: usize) -> u64 {
         self.id.get(i).copied().unwrap_or(i as u64)
+    }
+
+    /// The scene's number of particle i (its id where the particles are
+    /// stored as the scene gave them).
+    #[inline]
+    pub fn number_of(&self, i: usize) -> u64 {
+        self.number_of_id(self.id_of(i))
+    }
+
+    /// The scene's number of the particle with id `id`.
+    #[inline]
+    pub fn number_of_id(&self, id: u64) -> u64 {
+        self.number.get(id as usize).copied().unwrap_or(id)
+    }
+
+    /// The rows in the order of the particles' scene numbers, or `None`
+    /// where that is the rows' own order: the order files are written in.
+    pub fn rows_by_number(&self) -> Option<Vec<usize>> {
+        if self.number.is_empty() {
+            return None;
+        }
+        let mut rows: Vec<usize> = (0..self.particles.len()).collect();
+        rows.sort_unstable_by_key(|&i| self.number_of(i));
+        Some(rows)
     }
 
     /// Keeps the particles where `keep` is true, in order, with all they

@@ -143,6 +143,40 @@ impl Simulation {
     /// Makes the freshly built system hold the particles a checkpoint's
     /// flow state names ([`crate::flow::Flow::restore`]), before its
     /// positions and velocities are put in; nothing without a flow.
+    /// Checks that the checkpoint stores the particles in the order this
+    /// build does: both in the scene's, or both in the same space order.
+    pub fn check_order(&self, cp: &mote_io::checkpoint::Checkpoint) -> Result<(), String> {
+        let saved = cp.carried.iter().find(|(k, _)| k == ORDER_KEY);
+        let number = &self.system.number;
+        match saved {
+            None if number.is_empty() => Ok(()),
+            None => Err(
+                "the checkpoint stores the particles in the scene's order, and this \
+                 build stores them in space order: resume it with [granular] order = \"file\""
+                    .into(),
+            ),
+            Some(_) if number.is_empty() => Err("the checkpoint stores the particles in space \
+                 order, and this build in the scene's: remove [granular] order = \"file\""
+                .into()),
+            Some((_, saved)) => {
+                let same = saved.len() == number.len()
+                    && saved
+                        .iter()
+                        .zip(number.iter())
+                        .all(|(a, b)| *a == *b as f64);
+                if same {
+                    Ok(())
+                } else {
+                    Err(
+                        "the checkpoint stores the particles in another space order than \
+                         this build: it was written from another scene"
+                            .into(),
+                    )
+                }
+            }
+        }
+    }
+
     pub fn restore_flow(&mut self, cp: &mote_io::checkpoint::Checkpoint) -> Result<(), String> {
         let carried = cp.carried.iter().find(|(k, _)| k == FLOW_KEY);
         match (&mut self.flow, carried) {
@@ -243,8 +277,9 @@ impl mote_run::Propagator for Simulation {
             (i, format!("{what} ({} / {})", p.position[i], p.velocity[i]))
         });
         let Some(domain) = &self.forces.domain else {
-            // Named by its id (its index unless particles came and went).
-            return found.map(|(i, what)| (self.system.id_of(i) as usize, what));
+            // Named by its number (its index unless particles came and
+            // went, or are stored in space order).
+            return found.map(|(i, what)| (self.system.number_of(i) as usize, what));
         };
         let found = found.map(|(i, what)| (domain.halo().id[i] as usize, what));
         let least = -domain
@@ -254,12 +289,13 @@ impl mote_run::Propagator for Simulation {
             return None;
         }
         let id = least as usize;
-        Some(found.filter(|f| f.0 == id).unwrap_or_else(|| {
+        let (_, what) = found.filter(|f| f.0 == id).unwrap_or_else(|| {
             (
                 id,
                 "a non-finite position or velocity (on another rank)".into(),
             )
-        }))
+        });
+        Some((self.system.number_of_id(id as u64) as usize, what))
     }
 
     fn most(&self, x: f64) -> f64 {
@@ -299,11 +335,15 @@ impl mote_run::Propagator for Simulation {
             // them, does not run decomposed).
             return Vec::new();
         }
-        sys.carried_acceleration
-            .iter()
+        let forces: Vec<[f64; 3]> = (sys.carried_acceleration.iter())
             .zip(&sys.particles.mass)
             .map(|(a, m)| (*a * *m).to_array())
-            .collect()
+            .collect();
+        // In the frame's order: the scene's.
+        match sys.rows_by_number() {
+            Some(rows) => crate::order::gathered(&forces, &rows),
+            None => forces,
+        }
     }
 
     fn walls(&self) -> Vec<mote_run::WallGeometry> {
@@ -423,6 +463,10 @@ impl mote_run::Propagator for Simulation {
 /// ([`crate::flow::Flow::carried_state`]) beside the interactions'.
 pub const FLOW_KEY: &str = "flow";
 
+/// The checkpoint's key of the particles' scene numbers, by id, where they
+/// are stored in space order ([`crate::particles::System::number`]).
+pub const ORDER_KEY: &str = "order";
+
 /// Puts `sys` and what its interactions carry into `cp`: positions,
 /// velocities, the accelerations leap-frog carries (and the angular ones
 /// with ω when the particles turn).
@@ -439,6 +483,10 @@ fn write_state(
         .map(|(w, a)| [w.x, w.y, w.z, a.x, a.y, a.z])
         .collect();
     cp.carried = carried;
+    if !sys.number.is_empty() {
+        let number = sys.number.iter().map(|&k| k as f64).collect();
+        cp.carried.push((ORDER_KEY.to_string(), number));
+    }
     cp.time = sys.time;
     cp.step = sys.step;
     cp.positions = p.position.iter().map(|r| r.to_array()).collect();

@@ -444,8 +444,8 @@ fn resume_scene(text: &str, cp: &mote_io::checkpoint::Checkpoint) -> Simulation 
 }
 
 /// Puts a checkpoint's state into `sim`, as the front's resume does
-/// (positions, velocities, spins, the carried accelerations and what each
-/// interaction carries, by its key).
+/// (the particles' order checked; positions, velocities, spins, the
+/// carried accelerations and what each interaction carries, by its key).
 fn restore(mut sim: Simulation, cp: &mote_io::checkpoint::Checkpoint) -> Simulation {
     let sys = &mut sim.system;
     sys.time = cp.time;
@@ -461,8 +461,12 @@ fn restore(mut sim: Simulation, cp: &mote_io::checkpoint::Checkpoint) -> Simulat
         sys.carried_angular_acceleration
             .push(DVec3::new(a[3], a[4], a[5]));
     }
+    sim.check_order(cp).unwrap();
     let keys = sim.forces.carried_keys();
     for (key, values) in &cp.carried {
+        if key == mote_md::simulation::ORDER_KEY {
+            continue;
+        }
         let k = keys.iter().position(|x| x == key).unwrap();
         sim.forces.interactions[k]
             .restore_carried_state(values)

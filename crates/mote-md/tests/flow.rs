@@ -159,6 +159,7 @@ fn a_stream_holds_its_rate_lands_clear_and_balances_in_out_and_held() {
 /// an outlet: taken out at the first event, it leaves the pair's motion,
 /// whose friction carries a shear history, bit for bit as in the scene
 /// without it (the history follows the pair's ids through the removal).
+/// Stored as the scene gives them, so that the far one is row 0.
 #[test]
 fn a_removal_leaves_the_other_contacts_and_their_histories_as_they_were() {
     let pair = r#"
@@ -175,6 +176,7 @@ poisson = 0.3
 restitution = 0.5
 friction = 0.5
 skin = 0.001
+order = "file"   # the far one stays particle 0
 
 [[wall]]
 kind = "plane"
@@ -572,4 +574,31 @@ every = 25
 fn s_finite(sim: &Simulation) -> bool {
     let p = &sim.system.particles;
     p.position.iter().chain(&p.velocity).all(|v| v.is_finite())
+}
+
+/// Stored in space order, a particle that leaves is named in outflow.csv
+/// by the scene's number: the scene's first particle, far off in an
+/// outlet, is stored last and leaves as particle 0.
+#[test]
+fn a_departure_in_space_order_is_named_by_the_scenes_number() {
+    use mote_md::output::Departures;
+    use mote_run::Propagator;
+    let scene = "[run]\nintegrator = \"leapfrog\"\ndt = 1e-5\n\
+        [granular]\nyoung = 1e6\npoisson = 0.3\nrestitution = 0.5\nfriction = 0.5\n\
+        [[particle]]\nposition = [0.5, 0.5, 0.5]\nradius = 0.002\ndensity = 2500.0\n\
+        [[particle]]\nposition = [0.0, 0.0, 0.002]\nradius = 0.002\ndensity = 2500.0\n\
+        [[particle]]\nposition = [0.01, 0.0, 0.002]\nradius = 0.002\ndensity = 2500.0\n\
+        [[outlet]]\nlo = [0.4, 0.4, 0.4]\nevery = 50\n";
+    let mut sim = build(scene, 1);
+    assert_eq!(sim.system.number_of(2), 0, "the far one is stored last");
+    sim.prime(&mut |_| {}).unwrap();
+    for _ in 0..50 {
+        sim.advance().unwrap();
+    }
+    let gone: Vec<u64> = sim.departed().iter().map(|d| d.id).collect();
+    assert_eq!(gone, [0]);
+    assert_eq!(sim.system.particles.len(), 2);
+    let frame = mote_md::output::frame_of(&sim.system);
+    assert_eq!(frame.ids, [2, 3]);
+    assert_eq!(frame.positions[0][0], 0.0);
 }

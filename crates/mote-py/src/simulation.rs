@@ -310,6 +310,14 @@ simulation_class! {
         Ok(self.engine()?.species().to_vec())
     }
 
+    /// The scene's number of each row of the arrays (0 from the first).
+    /// Granular scenes store their particles in space order
+    /// (`[granular] order`): row k is particle `numbers[k]` of the scene.
+    #[getter]
+    fn numbers<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u64>>> {
+        Ok(PyArray1::from_vec(py, self.engine()?.numbers()))
+    }
+
     /// The observables measured so far (the columns of `mote run`'s
     /// observables.csv) as numpy arrays: time, kinetic, potential, total,
     /// rotational, kT, pressure, momentum (n, 3), angular_momentum (n, 3),

@@ -228,6 +228,26 @@ def test_views_are_mote_memory_and_writes_reach_the_next_step():
         sim.velocities = "fast"
 
 
+def test_a_granular_scene_in_space_order_numbers_its_rows():
+    """A granular scene stores its particles in space order; `numbers`
+    names the scene's particle of each row, and the rows in that order are
+    the particles as stored with `order = "file"`."""
+    scene = lambda order: {
+        "run": {"integrator": "leapfrog", "dt": 2e-5, "steps": 10},
+        "granular": {"young": 1e6, "poisson": 0.3, "restitution": 0.5,
+                     "friction": 0.5, "order": order},
+        "cloud": [{"n": 80, "min": [0.0, 0.0, 0.0], "max": [0.02, 0.02, 0.02],
+                   "radius": 0.001, "density": 2500.0}],
+    }
+    space = mote.Simulation.from_dict(scene("space"), seed=3)
+    file = mote.Simulation.from_dict(scene("file"), seed=3)
+    assert np.array_equal(file.numbers, np.arange(80))
+    assert not np.array_equal(space.numbers, np.arange(80))
+    assert np.array_equal(np.sort(space.numbers), np.arange(80))
+    rows = np.argsort(space.numbers)
+    assert np.array_equal(space.positions[rows], file.positions)
+
+
 def test_the_gil_is_released_while_mote_computes():
     sim = mote.Simulation.from_toml(LJ.replace("[4, 4, 4]", "[7, 7, 7]"))
     worker = threading.Thread(target=sim.run, kwargs={"steps": 300})

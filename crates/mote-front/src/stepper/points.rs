@@ -296,6 +296,13 @@ impl Points {
         &self.sim().system.species
     }
 
+    /// The scene's number of each row (0 from the first): the rows' own
+    /// order unless the particles are stored in space order.
+    pub fn numbers(&self) -> Vec<u64> {
+        let sys = &self.sim().system;
+        (0..sys.particles.len()).map(|i| sys.number_of(i)).collect()
+    }
+
     /// A per-particle vector array. Its memory stays where it is for the
     /// life of the run (a time-stepped system keeps its particles).
     pub fn vectors(&self, which: Vectors) -> &[DVec3] {

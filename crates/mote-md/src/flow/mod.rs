@@ -441,7 +441,7 @@ impl Flow {
             self.departed.push(Departure {
                 step,
                 time,
-                id: sys.id_of(i),
+                id: sys.number_of(i),
                 outlet: k,
                 species: sys.species.get(i).cloned().unwrap_or_else(|| "X".into()),
                 mass: p.mass[i],

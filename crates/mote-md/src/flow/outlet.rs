@@ -63,6 +63,8 @@ pub fn take(outlets: &mut [Outlet], x: DVec3, mass: f64, charge: f64) -> Option<
 pub struct Departure {
     pub step: u64,
     pub time: f64,
+    /// Its number: its id, or the scene's number where the particles are
+    /// stored in space order ([`crate::particles::System::number_of`]).
     pub id: u64,
     /// The outlet it left through.
     pub outlet: usize,

@@ -48,6 +48,23 @@ pub struct GranularSettings {
     pub wall_poisson: Option<f64>,
     /// Friction with the walls (default: `friction`).
     pub wall_friction: Option<f64>,
+    /// How the particles are stored: `space` (default) sorts them along a
+    /// Morton curve once the scene is built, so that contact partners are
+    /// near in memory ([`crate::order`]); `file` keeps the scene's order.
+    /// Files, probes and messages use the scene's numbering either way.
+    #[serde(default)]
+    pub order: ParticleOrder,
+}
+
+/// How a scene's particles are stored (`[granular] order`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ParticleOrder {
+    /// Along a Morton curve of cells one diameter wide.
+    #[default]
+    Space,
+    /// As the scene gave them.
+    File,
 }
 
 pub(crate) fn exact() -> String {

@@ -281,7 +281,12 @@ impl Scene {
             }
         }
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let made = particles::make(self, src, &mut rng)?;
+        let mut made = particles::make(self, src, &mut rng)?;
+        let in_space_order = self
+            .granular
+            .as_ref()
+            .is_some_and(|g| g.get_ref().order == granular::ParticleOrder::Space);
+        let number = in_space_order.then(|| made.to_space_order());
         let boundary = run::boundary(&self.bounds, made.fcc_box, src)?;
         let mut b = Build {
             src,
@@ -311,9 +316,15 @@ impl Scene {
         let thermostat = bath::thermostat(&self.thermostat, src)?;
         let (integrator, dt, length) = run::schedule(&self.run, src)?;
         run::refuse_event_driven_output(&self.output, src)?;
-        let probes = run::probes(&self.output, src, b.particles.len())?;
+        let mut probes = run::probes(&self.output, src, b.particles.len())?;
         let mut system = System::new(b.particles);
         system.species = made.species;
+        if let Some(number) = number {
+            // Probes name particles by the scene's numbers; they read rows.
+            let rows = crate::order::new_rows(&number);
+            probes.iter_mut().for_each(|p| p.row = rows[p.particle]);
+            system.number = number.iter().map(|&i| i as u64).collect();
+        }
         system.boundary = b.boundary;
         system.wrap_positions();
         if self.run.centre_of_mass.as_ref().is_some_and(|c| c.value) {

@@ -574,6 +574,22 @@ pub struct Made {
     pub fcc_box: Option<Boundary>,
 }
 
+impl Made {
+    /// Stores the particles in space order ([`crate::order`]), with their
+    /// species and springs; returns the order (row k was row `order[k]`).
+    pub fn to_space_order(&mut self) -> Vec<usize> {
+        let p = &mut self.particles;
+        let order = crate::order::space_order(&p.position, &p.radius);
+        p.reorder(&order);
+        self.species = crate::order::gathered(&self.species, &order);
+        let rows = crate::order::new_rows(&order);
+        for s in &mut self.springs {
+            (s.i, s.j) = (rows[s.i], rows[s.j]);
+        }
+        order
+    }
+}
+
 /// Bytes per particle, a lower bound while a scene is built: the particle
 /// arrays (six vectors, four scalars, a colour: 200 B), the generators'
 /// staging copy (about as much) and the integrator's carried accelerations.

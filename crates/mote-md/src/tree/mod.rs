@@ -13,7 +13,7 @@ mod avx512;
 mod barnes_hut;
 mod coulomb;
 mod gravity;
-mod morton;
+pub(crate) mod morton;
 mod multipole;
 mod octree;
 mod plummer;

@@ -88,6 +88,10 @@ class Simulation:
     @property
     def species(self) -> list[str]:
         """Species names of the particles."""
+    @property
+    def numbers(self) -> npt.NDArray[np.uint64]:
+        """The scene's number of each row (from 0); granular scenes store
+        their particles in space order, so row k is particle numbers[k]."""
     def render(self, output: Optional[Path] = None, width: int = 800, height: int = 600) -> Optional[npt.NDArray[np.uint8]]:
         """Ray-traces the current state: a (height, width, 3) image, or a PNG
         written to ``output``."""
