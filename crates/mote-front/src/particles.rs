@@ -169,6 +169,9 @@ impl EngineRun for PointsRun {
     /// `--steps` or `--until`, else the scene's), the checkpoint's state
     /// put in when resuming.
     fn build(&mut self, seed: u64, resumed: Option<&Checkpoint>) -> Result<Simulation, FrontError> {
+        if let Some(cp) = resumed {
+            self.scene.keep_order_of(cp);
+        }
         let (args, label) = (&self.args, &self.input.label);
         let built = self.scene.build(&self.input.text, label, seed)?;
         let Some(length) = built.length else {

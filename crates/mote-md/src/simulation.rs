@@ -140,9 +140,6 @@ impl Simulation {
         Ok(())
     }
 
-    /// Makes the freshly built system hold the particles a checkpoint's
-    /// flow state names ([`crate::flow::Flow::restore`]), before its
-    /// positions and velocities are put in; nothing without a flow.
     /// Checks that the checkpoint stores the particles in the order this
     /// build does: both in the scene's, or both in the same space order.
     pub fn check_order(&self, cp: &mote_io::checkpoint::Checkpoint) -> Result<(), String> {
@@ -152,11 +149,11 @@ impl Simulation {
             None if number.is_empty() => Ok(()),
             None => Err(
                 "the checkpoint stores the particles in the scene's order, and this \
-                 build stores them in space order: resume it with [granular] order = \"file\""
+                 build in space order ([granular] order)"
                     .into(),
             ),
             Some(_) if number.is_empty() => Err("the checkpoint stores the particles in space \
-                 order, and this build in the scene's: remove [granular] order = \"file\""
+                 order, and this build in the scene's ([granular] order = \"file\")"
                 .into()),
             Some((_, saved)) => {
                 let same = saved.len() == number.len()
@@ -177,6 +174,9 @@ impl Simulation {
         }
     }
 
+    /// Makes the freshly built system hold the particles a checkpoint's
+    /// flow state names ([`crate::flow::Flow::restore`]), before its
+    /// positions and velocities are put in; nothing without a flow.
     pub fn restore_flow(&mut self, cp: &mote_io::checkpoint::Checkpoint) -> Result<(), String> {
         let carried = cp.carried.iter().find(|(k, _)| k == FLOW_KEY);
         match (&mut self.flow, carried) {

@@ -519,6 +519,15 @@ fn space_order_keeps_the_scenes_numbering() {
     assert!(worst < 1e-12, "the orders part by {worst} m");
     let touching = a.positions.iter().filter(|p| p[2] < 0.001).count();
     assert!(touching > 10, "{touching} spheres press on the floor");
+    // The live viewer's forces come in the frame's order too.
+    let (fa, fb) = (space.simulation.forces(), file.simulation.forces());
+    let scale = fb.iter().map(|f| f[2].abs()).fold(0.0, f64::max);
+    for (p, q) in fa.iter().zip(&fb) {
+        assert!(
+            (0..3).all(|k| (p[k] - q[k]).abs() <= 1e-9 * scale),
+            "{p:?} against {q:?}"
+        );
+    }
     // A probe reads the particle the scene numbers, in either order.
     for (p, q) in space.probes.iter().zip(&file.probes) {
         assert_eq!(p.particle, q.particle);
@@ -535,9 +544,9 @@ fn space_order_keeps_the_scenes_numbering() {
 }
 
 /// A checkpoint names the order its particles are stored in, and a build
-/// that stores them in another refuses it (a checkpoint of a mote that
-/// kept the scene's order, or of another scene), never reading one
-/// particle's state into another.
+/// that stores them in another refuses it, never reading one particle's
+/// state into another; a checkpoint of a mote that kept the scene's order
+/// resumes in that order.
 #[test]
 fn a_checkpoint_in_another_order_is_refused() {
     use mote_md::scene::Scene;
@@ -563,10 +572,29 @@ fn a_checkpoint_in_another_order_is_refused() {
     assert!(build("space", 1).check_order(&space).is_ok());
     assert!(build("file", 1).check_order(&file).is_ok());
     let e = build("space", 1).check_order(&file).unwrap_err();
-    assert!(e.contains("order = \"file\""), "{e}");
+    assert!(
+        e.contains("the scene's order, and this build in space order"),
+        "{e}"
+    );
     let e = build("file", 1).check_order(&space).unwrap_err();
-    assert!(e.contains("space order"), "{e}");
+    assert!(
+        e.contains("in space order, and this build in the scene's"),
+        "{e}"
+    );
     // Another cloud, another order.
     let e = build("space", 2).check_order(&space).unwrap_err();
     assert!(e.contains("another space order"), "{e}");
+    // A checkpoint that names no order (written before granular scenes
+    // were stored in space order) resumes in the scene's order, as the
+    // front readies the scene for it.
+    let text = scene("space", 60);
+    let mut resuming = Scene::parse(&text, "s.toml").unwrap();
+    resuming.keep_order_of(&file);
+    let sim = resuming.build(&text, "s.toml", 1).unwrap().simulation;
+    assert!(sim.system.number.is_empty());
+    assert!(sim.check_order(&file).is_ok());
+    let mut resuming = Scene::parse(&text, "s.toml").unwrap();
+    resuming.keep_order_of(&space);
+    let sim = resuming.build(&text, "s.toml", 1).unwrap().simulation;
+    assert!(sim.check_order(&space).is_ok() && !sim.system.number.is_empty());
 }

@@ -96,7 +96,21 @@ impl Points {
         seed: Option<u64>,
         output: Option<&std::path::Path>,
     ) -> Result<Self, FrontError> {
-        let scene = Scene::parse(text, label)?;
+        Self::resuming(text, label, seed, output, None)
+    }
+
+    /// [`Points::from_text`], readied to resume `cp` where one is given.
+    fn resuming(
+        text: &str,
+        label: &str,
+        seed: Option<u64>,
+        output: Option<&std::path::Path>,
+        cp: Option<&Checkpoint>,
+    ) -> Result<Self, FrontError> {
+        let mut scene = Scene::parse(text, label)?;
+        if let Some(cp) = cp {
+            scene.keep_order_of(cp);
+        }
         let (seed, _) = crate::seed::resolve(seed, scene.seed);
         let built = scene.build(text, label, seed)?;
         if built.simulation.flow.is_some() {
@@ -172,7 +186,13 @@ impl Points {
                 cp.option("engine").unwrap_or_default()
             )));
         }
-        let mut run = Self::from_text(&cp.input_text, &cp.input_label, Some(cp.seed), None)?;
+        let mut run = Self::resuming(
+            &cp.input_text,
+            &cp.input_label,
+            Some(cp.seed),
+            None,
+            Some(cp),
+        )?;
         if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
             run.sim_mut().dt = dt;
         }

@@ -245,6 +245,19 @@ impl Scene {
     }
 
     /// Builds the simulation. `text` and `file` locate errors; `seed` overrides the scene's.
+    /// Readies the scene to resume `cp`: a checkpoint that names no order
+    /// of its particles (written before granular scenes were stored in
+    /// space order) resumes in the scene's order, the one it was written in.
+    pub fn keep_order_of(&mut self, cp: &mote_io::checkpoint::Checkpoint) {
+        let named = cp
+            .carried
+            .iter()
+            .any(|(k, _)| k == crate::simulation::ORDER_KEY);
+        if let (false, Some(g)) = (named, &mut self.granular) {
+            g.get_mut().order = granular::ParticleOrder::File;
+        }
+    }
+
     pub fn build(&self, text: &str, file: &str, seed: u64) -> Result<Built, ParseError> {
         let src = Source::new(file, text);
         if let Some(r) = &self.rigid {
