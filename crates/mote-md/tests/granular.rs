@@ -514,8 +514,9 @@ fn space_order_keeps_the_scenes_numbering() {
         .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max));
     let worst = moved.fold(0.0, f64::max);
     // The cloud falls 4 mm onto the floor and the spheres collide; the
-    // springs (ω ≈ 2200 /s, ten periods) pull the same pairs, or the runs
-    // would part by millimetres.
+    // springs (ω = √(k/μ) ≈ 3100 /s for the pair's reduced mass, some
+    // fifteen periods in 0.03 s) pull the same pairs, or the runs would
+    // part by millimetres.
     assert!(worst < 1e-12, "the orders part by {worst} m");
     let touching = a.positions.iter().filter(|p| p[2] < 0.001).count();
     assert!(touching > 10, "{touching} spheres press on the floor");
