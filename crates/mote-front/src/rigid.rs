@@ -114,6 +114,9 @@ impl EngineRun for RigidRun {
     ) -> Result<RigidDynamics, FrontError> {
         let (text, label) = (&self.input.text, &self.input.label);
         let options = &self.options;
+        if let Some(cp) = resumed {
+            self.scene.keep_order_of(cp);
+        }
         let built = self.scene.build(text, label, Some(seed))?;
         self.nip = mote_nip::probe(&self.scene, text, label)?;
         if resumed.is_none() {

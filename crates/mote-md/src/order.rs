@@ -4,14 +4,30 @@
 //! cache lines, not from the whole system (LAMMPS's `atom_modify sort`,
 //! done once, when a scene is built).
 //!
+//! The rigid engine sorts its bodies the same way, on cells one largest
+//! bounding diameter wide, and so the spheres its contacts sweep.
+//!
 //! The rows' order is the particles' ids, which fix the order of every sum
 //! (one process, threads and ranks alike); the scene's numbering is kept
 //! beside them ([`crate::particles::System::number`]) for files, probes
 //! and messages.
 
 use glam::DVec3;
+use serde::Deserialize;
 
 use crate::tree::morton;
+
+/// How a scene's particles or bodies are stored (`[granular] order`,
+/// `[rigid] order`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ParticleOrder {
+    /// Along a Morton curve of cells one diameter wide.
+    #[default]
+    Space,
+    /// As the scene gave them.
+    File,
+}
 
 /// The rows in space order: row k of the sorted particles is row
 /// `order[k]` of the given ones. Cells are one largest diameter wide

@@ -352,7 +352,7 @@ pub fn frame_of(sys: &System) -> Frame {
 
 /// The frame's particles in the order of `rows` (the particles stored in
 /// space order, written in the scene's).
-fn in_rows(frame: Frame, rows: &[usize]) -> Frame {
+pub(crate) fn in_rows(frame: Frame, rows: &[usize]) -> Frame {
     use crate::order::gathered;
     Frame {
         species: gathered(&frame.species, rows),
@@ -363,6 +363,8 @@ fn in_rows(frame: Frame, rows: &[usize]) -> Frame {
         ids: gathered(&frame.ids, rows),
         angular_velocities: gathered(&frame.angular_velocities, rows),
         dipoles: gathered(&frame.dipoles, rows),
+        bodies: gathered(&frame.bodies, rows),
+        orientations: gathered(&frame.orientations, rows),
         ..frame
     }
 }

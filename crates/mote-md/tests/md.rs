@@ -31,6 +31,7 @@ mod rigid_field;
 mod rigid_flow;
 mod rigid_free_flight;
 mod rigid_mass;
+mod rigid_order;
 mod rigid_pair;
 mod rigid_scene;
 mod rigid_scene_values;

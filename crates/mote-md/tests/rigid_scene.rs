@@ -82,9 +82,18 @@ fn frames_carry_bodies_and_orientations() {
     let f = mote_md::rigid::scene::sphere_frame(b);
     let n = f.positions.len();
     assert_eq!((f.bodies.len(), f.orientations.len()), (n, n));
+    // The frame lists the bodies by their scene numbers (the bodies are
+    // stored in space order: row k is body number_of(k)).
+    assert!((0..b.len()).any(|k| b.number_of(k) != k as u64));
+    let row_of: std::collections::HashMap<u64, usize> =
+        (0..b.len()).map(|k| (b.number_of(k), k)).collect();
+    assert!(
+        f.bodies.windows(2).all(|w| w[0] <= w[1]),
+        "spheres body after body in the scene's numbering"
+    );
     let mut next = vec![0usize; b.position.len()];
     for i in 0..n {
-        let k = f.bodies[i] as usize;
+        let k = row_of[&f.bodies[i]];
         let [w, x, y, z] = f.orientations[i];
         assert!(((w * w + x * x + y * y + z * z) - 1.0).abs() < 1e-14);
         let q = glam::DQuat::from_xyzw(x, y, z, w);
@@ -291,18 +300,22 @@ fn ewald_dipoles_between_bodies_are_the_point_particles() {
     let w = frbi.wrenches(&built.bodies, 0.0, 0.0).to_vec();
     let scale = force.iter().map(|f| f.length()).fold(0.0, f64::max);
     assert!(scale > 0.0 && point_energy != 0.0, "the dipoles interact");
-    for i in 0..n {
+    // The bodies are stored in space order: body row i is scene body
+    // number_of(i), the point particle of that row.
+    assert_eq!(w.len(), n);
+    for (i, w) in w.iter().enumerate() {
+        let k = built.bodies.number_of(i) as usize;
         assert!(
-            (w[i].v - force[i]).length() <= 1e-12 * scale,
-            "force {i}: {} vs {}",
-            w[i].v,
-            force[i]
+            (w.v - force[k]).length() <= 1e-12 * scale,
+            "force {k}: {} vs {}",
+            w.v,
+            force[k]
         );
         assert!(
-            (w[i].omega - torque[i]).length() <= 1e-12 * scale,
-            "torque {i}: {} vs {}",
-            w[i].omega,
-            torque[i]
+            (w.omega - torque[k]).length() <= 1e-12 * scale,
+            "torque {k}: {} vs {}",
+            w.omega,
+            torque[k]
         );
     }
     let energy = frbi.energies(&built.bodies).potential;

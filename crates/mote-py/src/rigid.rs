@@ -177,8 +177,17 @@ simulation_class! {
         Ok(PyArray1::from_vec(py, self.engine()?.masses()))
     }
 
-    /// The spheres in the world: dict of positions (M, 3), velocities
-    /// (M, 3), radii (M,), body (M,) index of the body of each.
+    /// The scene's number of each body row of the arrays (0 from the
+    /// first). Rigid scenes store their bodies in space order (`[rigid]
+    /// order`): row k is body `numbers[k]` of the scene.
+    #[getter]
+    fn numbers<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u64>>> {
+        Ok(PyArray1::from_vec(py, self.engine()?.numbers()))
+    }
+
+    /// The spheres in the world, body after body in the scene's numbering:
+    /// dict of positions (M, 3), velocities (M, 3), radii (M,), body (M,)
+    /// the scene number of the body of each (see `numbers`).
     fn spheres<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let f = self.engine()?.spheres();
         let m = f.positions.len();

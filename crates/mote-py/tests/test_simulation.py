@@ -492,6 +492,27 @@ def test_rigid_clumps_step_from_python_with_the_bits_of_mote_run(tmp_path):
     assert np.array_equal(sim.rotations, again.rotations)
 
 
+def test_a_rigid_scene_in_space_order_numbers_its_bodies():
+    """A rigid scene stores its bodies in space order; `numbers` names the
+    scene's body of each row, the rows in that order are the bodies as
+    stored with `order = "file"`, and the spheres come body after body in
+    the scene's numbering either way."""
+    here = __import__("pathlib").Path(__file__).resolve().parents[3]
+    text = (here / "examples/rigid/clumps-settling.toml").read_text()
+    text = text.replace("until = 0.5", "steps = 2")
+    space = mote.RigidSimulation.from_toml(text)
+    file = mote.RigidSimulation.from_toml(text.replace("[rigid]\n", "[rigid]\norder = \"file\"\n", 1))
+    n = len(space)
+    assert np.array_equal(file.numbers, np.arange(n))
+    assert not np.array_equal(space.numbers, np.arange(n))
+    rows = np.argsort(space.numbers)
+    assert np.array_equal(space.positions[rows], file.positions)
+    assert np.array_equal(space.rotations[rows], file.rotations)
+    a, b = space.spheres(), file.spheres()
+    assert np.array_equal(a["body"], b["body"])
+    assert np.array_equal(a["positions"], b["positions"])
+
+
 def test_pack_gives_the_packing_of_a_packing_scene(tmp_path):
     ase_io = pytest.importorskip("ase.io")
     p = mote.pack(300, phi=0.55, seed=3, output=tmp_path / "p")

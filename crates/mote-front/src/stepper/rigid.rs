@@ -60,7 +60,16 @@ impl Rigid {
                 "{label}: not a rigid scene (no [rigid] table): use mote.Simulation or mote.run"
             )));
         }
-        let scene = RigidScene::parse(text, label)?;
+        Self::build_scene(RigidScene::parse(text, label)?, text, label, seed)
+    }
+
+    /// The run of a parsed rigid scene.
+    fn build_scene(
+        scene: RigidScene,
+        text: &str,
+        label: &str,
+        seed: Option<u64>,
+    ) -> Result<Self, FrontError> {
         let built = scene.build(text, label, seed)?;
         if built.flow.is_some() {
             // The views are mote's arrays, which insertion reallocates.
@@ -90,7 +99,12 @@ impl Rigid {
                 "{path}: not a checkpoint of a rigid run"
             )));
         }
-        let mut run = Self::build(&cp.input_text, &cp.input_label, Some(cp.seed))?;
+        let (text, label) = (&cp.input_text, &cp.input_label);
+        // A checkpoint written before bodies were stored in space order
+        // resumes in the scene's.
+        let mut scene = RigidScene::parse(text, label)?;
+        scene.keep_order_of(cp);
+        let mut run = Self::build_scene(scene, text, label, Some(cp.seed))?;
         let state = &mut run.stepper.state;
         if let Some(dt) = cp.option("dt").and_then(mote_io::checkpoint::unhex) {
             state.dt = dt;
@@ -175,6 +189,14 @@ impl Rigid {
 
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// Each body's scene number, in the order of the arrays: the bodies
+    /// are stored in space order unless the scene says `[rigid] order =
+    /// "file"` (then row i is body i).
+    pub fn numbers(&self) -> Vec<u64> {
+        let b = &self.dynamics().bodies;
+        (0..b.len()).map(|i| b.number_of(i)).collect()
     }
 
     /// A per-body vector array; its memory stays where it is for the life

@@ -30,6 +30,11 @@ pub struct RigidBodies {
     /// Each body's id where bodies come and go (`rigid::flow`): increasing
     /// along the bodies, a removed body's never reused. Empty: the index.
     pub id: Vec<u64>,
+    /// The scene's number of the body with id k, where the bodies are
+    /// stored in space order ([`RigidBodies::reorder`]): files, messages
+    /// and Python show it. Empty: every body's number is its id; ids past
+    /// its end (bodies inserted during the run) are their own numbers too.
+    pub number: Arc<[u64]>,
 }
 
 /// Observables of a set of bodies (momenta about the master frame's origin).
@@ -80,6 +85,42 @@ impl RigidBodies {
     /// The id of body i ([`RigidBodies::id`]).
     pub fn id_of(&self, i: usize) -> u64 {
         self.id.get(i).copied().unwrap_or(i as u64)
+    }
+
+    /// The scene's number of body i ([`RigidBodies::number`]).
+    pub fn number_of(&self, i: usize) -> u64 {
+        let id = self.id_of(i);
+        self.number.get(id as usize).copied().unwrap_or(id)
+    }
+
+    /// The rows in the order of the bodies' scene numbers, or `None`
+    /// where that is the rows' own order (no space order).
+    pub fn rows_by_number(&self) -> Option<Vec<usize>> {
+        if self.number.is_empty() {
+            return None;
+        }
+        let mut rows: Vec<usize> = (0..self.len()).collect();
+        rows.sort_unstable_by_key(|&i| self.number_of(i));
+        Some(rows)
+    }
+
+    /// Stores the bodies in space order ([`crate::order::space_order`] of
+    /// their centres on cells one largest bounding diameter wide), the
+    /// scene's numbering kept in [`RigidBodies::number`]. Done once, where
+    /// the scene has placed its bodies and before they get ids.
+    pub fn to_space_order(&mut self) {
+        use crate::order::{gathered, space_order};
+        assert!(self.id.is_empty(), "bodies are ordered before they get ids");
+        let radius: Vec<f64> = (0..self.len())
+            .map(|i| self.template(i).props.bounding_radius)
+            .collect();
+        let order = space_order(&self.position, &radius);
+        self.kind = gathered(&self.kind, &order);
+        self.rotation = gathered(&self.rotation, &order);
+        self.position = gathered(&self.position, &order);
+        self.omega = gathered(&self.omega, &order);
+        self.velocity = gathered(&self.velocity, &order);
+        self.number = order.iter().map(|&k| k as u64).collect();
     }
 
     /// Keeps the bodies with `keep[i]`, in order.

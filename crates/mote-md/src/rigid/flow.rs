@@ -240,7 +240,7 @@ impl BodyFlow {
             self.departed.push(Departure {
                 step,
                 time,
-                id: bodies.id_of(i),
+                id: bodies.number_of(i),
                 outlet: k,
                 species: self.species(bodies.kind[i]),
                 mass: t.mass(),

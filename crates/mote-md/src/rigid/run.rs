@@ -17,7 +17,7 @@ use super::contacts::RigidContacts;
 use super::flow::BodyFlow;
 use super::frbi::Frbi;
 use crate::error::MdError;
-use crate::simulation::FLOW_KEY;
+use crate::simulation::{FLOW_KEY, ORDER_KEY};
 
 /// Rigid bodies moved by the FRBI with a fixed step.
 pub struct RigidDynamics {
@@ -140,7 +140,7 @@ impl Propagator for RigidDynamics {
     }
 
     /// The first body with a non-finite placement, velocity or spin, by
-    /// its id (its index unless bodies came and went).
+    /// its scene number ([`RigidBodies::number_of`]).
     fn unstable(&self) -> Option<(usize, String)> {
         let b = &self.bodies;
         let (column, i) =
@@ -151,7 +151,7 @@ impl Propagator for RigidDynamics {
             "a non-finite spin",
         ][column];
         Some((
-            b.id_of(i) as usize,
+            b.number_of(i) as usize,
             format!(
                 "{what} (x {}, v {}, ω {})",
                 b.position[i], b.velocity[i], b.omega[i]
@@ -182,18 +182,15 @@ impl Propagator for RigidDynamics {
     }
 
     /// The force on each sphere's body at the last step's midpoint (each
-    /// sphere of a body shows its body's).
+    /// sphere of a body shows its body's), in the frame's order.
     fn forces(&self) -> Vec<[f64; 3]> {
+        let b = &self.bodies;
         let w = self.frbi.last_wrenches();
-        if w.len() != self.bodies.len() {
+        if w.len() != b.len() {
             return Vec::new();
         }
-        let mut world = super::interaction::WorldFrame::default();
-        world.update(&self.bodies);
-        world
-            .sphere_body
-            .iter()
-            .map(|&k| w[k as usize].v.to_array())
+        scene_rows(b)
+            .flat_map(|k| std::iter::repeat_n(w[k].v.to_array(), b.template(k).sphere_count()))
             .collect()
     }
 
@@ -244,6 +241,10 @@ impl Propagator for RigidDynamics {
             cp.carried
                 .push((FLOW_KEY.to_string(), flow.carried_state(&self.bodies)));
         }
+        if !b.number.is_empty() {
+            let number = b.number.iter().map(|&k| k as f64).collect();
+            cp.carried.push((ORDER_KEY.to_string(), number));
+        }
         Ok(())
     }
 }
@@ -252,6 +253,7 @@ impl RigidDynamics {
     /// Puts a checkpoint's state into freshly built bodies and integrator.
     pub fn resume(&mut self, cp: &Checkpoint, label: &str) -> Result<(), MdError> {
         let malformed = |m: String| ParseError::new(label, 0, format!("checkpoint: {m}"));
+        self.check_order(cp).map_err(malformed)?;
         let carried = cp.carried.iter().find(|(k, _)| k == FLOW_KEY);
         match (&mut self.flow, carried) {
             (Some(flow), Some((_, state))) => flow
@@ -295,7 +297,7 @@ impl RigidDynamics {
         self.step = cp.step;
         let interactions = Checkpoint {
             carried: (cp.carried.iter())
-                .filter(|(k, _)| k != FLOW_KEY)
+                .filter(|(k, _)| k != FLOW_KEY && k != ORDER_KEY)
                 .cloned()
                 .collect(),
             ..Checkpoint::default()
@@ -304,6 +306,40 @@ impl RigidDynamics {
             .restore_carried_state(&interactions)
             .map_err(malformed)?;
         Ok(())
+    }
+
+    /// Checks that the checkpoint stores the bodies in the order this
+    /// build does: both in the scene's, or both in the same space order.
+    pub fn check_order(&self, cp: &Checkpoint) -> Result<(), String> {
+        let saved = cp.carried.iter().find(|(k, _)| k == ORDER_KEY);
+        let number = &self.bodies.number;
+        match saved {
+            None if number.is_empty() => Ok(()),
+            None => Err(
+                "the checkpoint stores the bodies in the scene's order, and this \
+                 build in space order ([rigid] order)"
+                    .into(),
+            ),
+            Some(_) if number.is_empty() => Err("the checkpoint stores the bodies in space \
+                 order, and this build in the scene's ([rigid] order = \"file\")"
+                .into()),
+            Some((_, saved)) => {
+                let same = saved.len() == number.len()
+                    && saved
+                        .iter()
+                        .zip(number.iter())
+                        .all(|(a, b)| *a == *b as f64);
+                if same {
+                    Ok(())
+                } else {
+                    Err(
+                        "the checkpoint stores the bodies in another space order than \
+                         this build: it was written from another scene"
+                            .into(),
+                    )
+                }
+            }
+        }
     }
 }
 
@@ -436,9 +472,8 @@ impl RigidDynamics {
 /// stick out), and the frame's cell and `pbc` are the box's.
 pub fn sphere_frame_in(b: &RigidBodies, boundary: &crate::boundary::Boundary) -> Frame {
     let mut frame = sphere_frame(b);
-    // Each body's shift for each of its spheres (the frame's `bodies`
-    // column holds the bodies' ids).
-    let shift = (0..b.len()).flat_map(|i| {
+    // Each body's shift for each of its spheres, in the frame's order.
+    let shift = scene_rows(b).flat_map(|i| {
         let s = boundary.wrap(b.position[i]) - b.position[i];
         std::iter::repeat_n(s, b.template(i).sphere_count())
     });
@@ -459,7 +494,39 @@ pub fn sphere_frame_in(b: &RigidBodies, boundary: &crate::boundary::Boundary) ->
     frame
 }
 
+/// The bodies' rows in the order of their scene numbers (bodies stored in
+/// space order are written in the scene's).
+fn scene_rows(b: &RigidBodies) -> impl Iterator<Item = usize> {
+    b.rows_by_number()
+        .unwrap_or_else(|| (0..b.len()).collect())
+        .into_iter()
+}
+
+/// The spheres of the bodies as a frame, body after body in the order of
+/// the scene's numbers; the `bodies` column holds each sphere's body's.
 pub fn sphere_frame(b: &RigidBodies) -> Frame {
+    let frame = stored_sphere_frame(b);
+    match b.rows_by_number() {
+        Some(rows) => {
+            // Each body's spheres are one run of rows: its first sphere's
+            // row and count, taken in the bodies' scene order.
+            let mut first = Vec::with_capacity(b.len());
+            let mut at = 0;
+            for i in 0..b.len() {
+                first.push(at);
+                at += b.template(i).sphere_count();
+            }
+            let spheres: Vec<usize> = (rows.iter())
+                .flat_map(|&i| first[i]..first[i] + b.template(i).sphere_count())
+                .collect();
+            crate::output::in_rows(frame, &spheres)
+        }
+        None => frame,
+    }
+}
+
+/// The spheres as a frame in the bodies' stored order.
+fn stored_sphere_frame(b: &RigidBodies) -> Frame {
     let mut world = super::interaction::WorldFrame::default();
     world.update(b);
     let positions: Vec<[f64; 3]> = world.sphere_centre.iter().map(|c| c.to_array()).collect();
@@ -487,7 +554,7 @@ pub fn sphere_frame(b: &RigidBodies) -> Frame {
         bodies: world
             .sphere_body
             .iter()
-            .map(|&k| b.id_of(k as usize))
+            .map(|&k| b.number_of(k as usize))
             .collect(),
         angular_velocities: world
             .sphere_body

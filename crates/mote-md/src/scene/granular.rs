@@ -56,16 +56,7 @@ pub struct GranularSettings {
     pub order: ParticleOrder,
 }
 
-/// How a scene's particles are stored (`[granular] order`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ParticleOrder {
-    /// Along a Morton curve of cells one diameter wide.
-    #[default]
-    Space,
-    /// As the scene gave them.
-    File,
-}
+pub use crate::order::ParticleOrder;
 
 pub(crate) fn exact() -> String {
     "exact".into()

@@ -244,7 +244,6 @@ impl Scene {
         parse(text, file)
     }
 
-    /// Builds the simulation. `text` and `file` locate errors; `seed` overrides the scene's.
     /// Readies the scene to resume `cp`: a checkpoint that names no order
     /// of its particles (written before granular scenes were stored in
     /// space order) resumes in the scene's order, the one it was written in.
@@ -258,6 +257,7 @@ impl Scene {
         }
     }
 
+    /// Builds the simulation. `text` and `file` locate errors; `seed` overrides the scene's.
     pub fn build(&self, text: &str, file: &str, seed: u64) -> Result<Built, ParseError> {
         let src = Source::new(file, text);
         if let Some(r) = &self.rigid {

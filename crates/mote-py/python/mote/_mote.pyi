@@ -253,8 +253,13 @@ class RigidSimulation:
         """(N, 4) unit quaternions (w, x, y, z), a copy."""
     @property
     def masses(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def numbers(self) -> npt.NDArray[np.uint64]:
+        """The scene's number of each body row (from 0); rigid scenes store
+        their bodies in space order, so row k is body numbers[k]."""
     def spheres(self) -> dict[str, npt.NDArray[Any]]:
-        """positions, velocities, radii and body of every sphere."""
+        """positions, velocities, radii and body (its scene number) of
+        every sphere, body after body in the scene's numbering."""
     @property
     def observables(self) -> dict[str, npt.NDArray[np.float64]]: ...
 

@@ -7,6 +7,7 @@
 //! [rigid]
 //! free_flight = "straight"     # or "screw" (the seed's literal free step)
 //! spin_update = "keep_momentum" # or "seed"
+//! order = "space"              # bodies stored along a Morton curve; or "file"
 //!
 //! [[rigid.template]]
 //! name = "bead"
@@ -170,6 +171,13 @@ pub struct RigidSettings {
     pub free_flight: Option<Spanned<String>>,
     #[serde(default)]
     pub spin_update: Option<Spanned<String>>,
+    /// How the bodies are stored: `space` (default) sorts them along a
+    /// Morton curve once the scene has placed them, so that contact and
+    /// pair-sum partners are near in memory ([`crate::order`]); `file`
+    /// keeps the order the scene gives. Files, messages and Python's
+    /// `numbers` use the scene's numbering either way.
+    #[serde(default)]
+    pub order: crate::order::ParticleOrder,
     #[serde(default)]
     pub template: Vec<Spanned<TemplateSpec>>,
     #[serde(default)]
@@ -398,6 +406,10 @@ impl RigidScene {
                 "the scene makes no bodies: add [[rigid.body]], [[rigid.lattice]], [[rigid.random]], [[from_file]] or [[insert]]",
             ));
         }
+        // Stored in space order before any interaction sees the bodies.
+        if rigid.order == crate::order::ParticleOrder::Space {
+            b.bodies.to_space_order();
+        }
         add(&rigid.fields, self, &mut b)?;
         centres::refuse_coulomb_between_planes(self, &b)?;
         for (law, span) in self.centre_laws() {
@@ -461,6 +473,19 @@ impl RigidScene {
 }
 
 impl RigidScene {
+    /// Readies the scene to resume `cp`: a checkpoint that names no order
+    /// of its bodies (written before rigid bodies were stored in space
+    /// order) resumes in the scene's order, the one it was written in.
+    pub fn keep_order_of(&mut self, cp: &mote_io::checkpoint::Checkpoint) {
+        let named = cp
+            .carried
+            .iter()
+            .any(|(k, _)| k == crate::simulation::ORDER_KEY);
+        if let (false, Some(r)) = (named, &mut self.rigid) {
+            r.get_mut().order = crate::order::ParticleOrder::File;
+        }
+    }
+
     /// The body kind (template index) of the template named `name`:
     /// templates are numbered in the order `[[rigid.template]]` lists them.
     pub fn template_kind(&self, name: &str) -> Option<u32> {
