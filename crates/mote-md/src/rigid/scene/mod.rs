@@ -149,6 +149,7 @@ mod flow;
 mod placement;
 mod planes;
 mod point_tables;
+mod sites;
 mod templates;
 
 pub use contacts::ContactSettings;

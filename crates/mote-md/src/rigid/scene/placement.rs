@@ -12,9 +12,9 @@ use rand::Rng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use serde::Deserialize;
 
+use super::sites::random_sites;
 use super::{positive, Clumps, RigidBuild, RigidScene};
 use crate::boundary::Boundary;
-use crate::rigid::bodies::RigidBodies;
 use crate::scene::{DataSpec, Section};
 
 /// `[[rigid.body]]`.
@@ -353,46 +353,4 @@ fn fcc_sites(n: usize, lo: DVec3, hi: DVec3, spacing: f64) -> Result<Vec<DVec3>,
     });
     sites.truncate(n);
     Ok(sites)
-}
-
-/// Random sequential addition of bounding spheres (radius `bound`) with
-/// centres in [lo, hi], not overlapping each other or bodies already
-/// placed — through the nearest image along the box's periodic axes (a
-/// region spanning a periodic axis meets itself at the box's faces).
-fn random_sites(
-    n: usize,
-    lo: DVec3,
-    hi: DVec3,
-    bound: f64,
-    placed: &RigidBodies,
-    boundary: &Boundary,
-    rng: &mut Xoshiro256PlusPlus,
-) -> Result<Vec<DVec3>, String> {
-    let image = boundary.image();
-    let mut taken: Vec<(DVec3, f64)> = (0..placed.len())
-        .map(|i| (placed.position[i], placed.template(i).props.bounding_radius))
-        .collect();
-    let first = taken.len();
-    let mut tries = 0usize;
-    while taken.len() - first < n {
-        tries += 1;
-        if tries > 1000 * (n + 10) {
-            return Err(format!(
-                "could place only {} of {n} bodies without overlap: enlarge [lo, hi]",
-                taken.len() - first
-            ));
-        }
-        let x = DVec3::new(
-            rng.gen_range(lo.x..=hi.x),
-            rng.gen_range(lo.y..=hi.y),
-            rng.gen_range(lo.z..=hi.z),
-        );
-        if taken
-            .iter()
-            .all(|(y, r)| image.apply(x - *y).length_squared() >= (r + bound) * (r + bound))
-        {
-            taken.push((x, bound));
-        }
-    }
-    Ok(taken[first..].iter().map(|(x, _)| *x).collect())
 }
