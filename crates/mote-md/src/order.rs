@@ -74,6 +74,51 @@ pub fn new_rows(order: &[usize]) -> Vec<usize> {
     rows
 }
 
+/// Whether a checkpoint names the order it stores its particles or
+/// bodies in (one written before scenes were stored in space order names
+/// none, and was written in the scene's order).
+pub fn names_order(cp: &mote_io::checkpoint::Checkpoint) -> bool {
+    cp.carried
+        .iter()
+        .any(|(k, _)| k == crate::simulation::ORDER_KEY)
+}
+
+/// Checks that a checkpoint stores its `what` ("particles", "bodies") in
+/// the order a build does: both in the scene's (`number` empty, no
+/// order saved), or both in the same space order. `table` names the key
+/// that sets it (`[granular] order`).
+pub fn check_saved_order(
+    cp: &mote_io::checkpoint::Checkpoint,
+    number: &[u64],
+    what: &str,
+    table: &str,
+) -> Result<(), String> {
+    let saved = cp
+        .carried
+        .iter()
+        .find(|(k, _)| k == crate::simulation::ORDER_KEY);
+    match saved {
+        None if number.is_empty() => Ok(()),
+        None => Err(format!(
+            "the checkpoint stores the {what} in the scene's order, and this build in space order ({table})"
+        )),
+        Some(_) if number.is_empty() => Err(format!(
+            "the checkpoint stores the {what} in space order, and this build in the scene's ({table} = \"file\")"
+        )),
+        Some((_, saved)) => {
+            let same = saved.len() == number.len()
+                && saved.iter().zip(number).all(|(a, b)| *a == *b as f64);
+            if same {
+                Ok(())
+            } else {
+                Err(format!(
+                    "the checkpoint stores the {what} in another space order than this build: it was written from another scene"
+                ))
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

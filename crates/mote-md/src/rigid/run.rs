@@ -311,35 +311,7 @@ impl RigidDynamics {
     /// Checks that the checkpoint stores the bodies in the order this
     /// build does: both in the scene's, or both in the same space order.
     pub fn check_order(&self, cp: &Checkpoint) -> Result<(), String> {
-        let saved = cp.carried.iter().find(|(k, _)| k == ORDER_KEY);
-        let number = &self.bodies.number;
-        match saved {
-            None if number.is_empty() => Ok(()),
-            None => Err(
-                "the checkpoint stores the bodies in the scene's order, and this \
-                 build in space order ([rigid] order)"
-                    .into(),
-            ),
-            Some(_) if number.is_empty() => Err("the checkpoint stores the bodies in space \
-                 order, and this build in the scene's ([rigid] order = \"file\")"
-                .into()),
-            Some((_, saved)) => {
-                let same = saved.len() == number.len()
-                    && saved
-                        .iter()
-                        .zip(number.iter())
-                        .all(|(a, b)| *a == *b as f64);
-                if same {
-                    Ok(())
-                } else {
-                    Err(
-                        "the checkpoint stores the bodies in another space order than \
-                         this build: it was written from another scene"
-                            .into(),
-                    )
-                }
-            }
-        }
+        crate::order::check_saved_order(cp, &self.bodies.number, "bodies", "[rigid] order")
     }
 }
 

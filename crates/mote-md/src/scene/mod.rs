@@ -248,11 +248,7 @@ impl Scene {
     /// of its particles (written before granular scenes were stored in
     /// space order) resumes in the scene's order, the one it was written in.
     pub fn keep_order_of(&mut self, cp: &mote_io::checkpoint::Checkpoint) {
-        let named = cp
-            .carried
-            .iter()
-            .any(|(k, _)| k == crate::simulation::ORDER_KEY);
-        if let (false, Some(g)) = (named, &mut self.granular) {
+        if let (false, Some(g)) = (crate::order::names_order(cp), &mut self.granular) {
             g.get_mut().order = granular::ParticleOrder::File;
         }
     }

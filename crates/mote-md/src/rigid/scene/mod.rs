@@ -478,11 +478,7 @@ impl RigidScene {
     /// of its bodies (written before rigid bodies were stored in space
     /// order) resumes in the scene's order, the one it was written in.
     pub fn keep_order_of(&mut self, cp: &mote_io::checkpoint::Checkpoint) {
-        let named = cp
-            .carried
-            .iter()
-            .any(|(k, _)| k == crate::simulation::ORDER_KEY);
-        if let (false, Some(r)) = (named, &mut self.rigid) {
+        if let (false, Some(r)) = (crate::order::names_order(cp), &mut self.rigid) {
             r.get_mut().order = crate::order::ParticleOrder::File;
         }
     }
