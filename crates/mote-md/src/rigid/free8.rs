@@ -1,10 +1,11 @@
 //! The FRBI's free step ([`super::frbi::free_step`]), its kick and the
 //! world frame for eight bodies at once — in AVX-512 where the CPU has it,
-//! else portably (AVX2 on the x86-64-v3 build, NEON on aarch64): the kick
-//! on [`mote_geom::lanes::Lanes`], the free step and the world frame four
-//! bodies at a time (their 3 × 3 matrices of eight lanes would be eighteen
-//! AVX2 registers, and spilled, the free step ran 21 % slower; the kick
-//! gained nothing from four). The same operations
+//! else portably (AVX2 on the x86-64-v3 build, NEON on aarch64): the free
+//! step, the kick and the world frame four bodies at a time on
+//! [`mote_geom::lanes::Four`] (their 3 × 3 matrices of eight lanes would
+//! be eighteen AVX2 registers, and spilled, the free step ran 21 % slower;
+//! the kick gained 6 % from four once `Four` was one AVX register
+//! an operation). The same operations
 //! in the same order, one body per lane; no operation is fused or
 //! reassociated, so every lane gets the bits the scalar step gives, on
 //! every path (tested).
@@ -561,7 +562,7 @@ mod avx512 {
 /// below hold both paths to them).
 mod portable {
     use glam::DVec3;
-    use mote_geom::lanes::{Four, Lane, Lanes};
+    use mote_geom::lanes::{Four, Lane};
     use mote_geom::{Inertia, DE, EPSILON};
 
     use super::{Group, LANES};
@@ -750,7 +751,8 @@ mod portable {
         }
     }
 
-    /// `frbi::react` on eight lanes (all |r|² ≤ 10¹⁰⁰).
+    /// `frbi::react` on eight bodies, four lanes at a time (all |r|² ≤
+    /// 10¹⁰⁰).
     pub(super) fn react(
         inertia: [&Inertia; LANES],
         rotation: &[DVec3; LANES],
@@ -758,14 +760,18 @@ mod portable {
         velocity: &mut [DVec3; LANES],
         impulse: &[DE; LANES],
     ) {
-        let (a, _, j_inv) = principal::<Lanes>(&inertia);
-        let p = matrix(V::of(rotation)).mul(&a);
-        let angular = V::from_fn(|l| impulse[l].omega);
-        p.sandwich(j_inv, angular).add(V::of(omega)).write(omega);
-        let inverse_mass = Lanes(inertia.map(|i| 1.0 / i.mass));
-        V::of(velocity)
-            .add(V::from_fn(|l| impulse[l].v).scale(inverse_mass))
-            .write(velocity);
+        for half in 0..2 {
+            let at = 4 * half..4 * half + 4;
+            let (a, _, j_inv) = principal::<Four>(&inertia[at.clone()]);
+            let p = matrix(V::<Four>::of(&rotation[at.clone()])).mul(&a);
+            let angular = V::from_fn(|l| impulse[4 * half + l].omega);
+            (p.sandwich(j_inv, angular).add(V::of(&omega[at.clone()])))
+                .write(&mut omega[at.clone()]);
+            let inverse_mass = Four::from_fn(|l| 1.0 / inertia[4 * half + l].mass);
+            V::<Four>::of(&velocity[at.clone()])
+                .add(V::from_fn(|l| impulse[4 * half + l].v).scale(inverse_mass))
+                .write(&mut velocity[at]);
+        }
     }
 
     /// The new rotation vectors, positions and angular velocities of the
