@@ -89,10 +89,9 @@ fn space_order_keeps_the_scenes_numbering() {
             left.extend(d.flow.as_ref().unwrap().departed.iter().map(|b| b.id));
         }
     }
-    left_space.sort_unstable();
-    left_file.sort_unstable();
-    assert!(!left_file.is_empty(), "no body left");
-    assert_eq!(left_space, left_file, "the same bodies left");
+    // Each event's bodies in the scene's numbering, in either order.
+    assert!(left_file.len() > 1, "{} bodies left", left_file.len());
+    assert_eq!(left_space, left_file, "the same bodies left, listed alike");
 
     let (a, b) = (space.sphere_frame(), file.sphere_frame());
     assert_eq!(a.bodies, b.bodies);

@@ -424,7 +424,7 @@ impl Flow {
 
     /// The event at the system's step: the outlets take out what reached
     /// them (in particle order, each particle through the first outlet
-    /// that takes it), then each inserter in turn brings its stream up to
+    /// that takes it; `departed` lists them by scene number), then each inserter in turn brings its stream up to
     /// the system's time. The interactions hear of both.
     pub fn apply(&mut self, sys: &mut System, forces: &mut ForceField, seed: u64) {
         let (step, time) = (sys.step, sys.time);
@@ -451,6 +451,8 @@ impl Flow {
                 velocity: p.velocity[i],
             });
         }
+        // Written in the scene's numbering, whatever the storage order.
+        self.departed.sort_by_key(|d| d.id);
         let removed = !self.departed.is_empty();
         if removed {
             sys.retain_particles(&keep);

@@ -31,7 +31,7 @@ pub struct RigidBodies {
     /// along the bodies, a removed body's never reused. Empty: the index.
     pub id: Vec<u64>,
     /// The scene's number of the body with id k, where the bodies are
-    /// stored in space order ([`RigidBodies::reorder`]): files, messages
+    /// stored in space order ([`RigidBodies::to_space_order`]): files, messages
     /// and Python show it. Empty: every body's number is its id; ids past
     /// its end (bodies inserted during the run) are their own numbers too.
     pub number: Arc<[u64]>,

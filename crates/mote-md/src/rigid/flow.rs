@@ -223,7 +223,7 @@ impl BodyFlow {
 
     /// The event at `step`: the outlets take out the bodies whose centres
     /// reached them (in body order, each through the first outlet that
-    /// takes it), then each inserter in turn brings its stream up to the
+    /// takes it; `departed` lists them by scene number), then each inserter in turn brings its stream up to the
     /// bodies' time; the integrator's interactions hear of both.
     pub fn apply(&mut self, bodies: &mut RigidBodies, frbi: &mut Frbi, seed: u64, step: u64) {
         let time = bodies.time;
@@ -250,6 +250,8 @@ impl BodyFlow {
                 velocity: bodies.velocity[i],
             });
         }
+        // Written in the scene's numbering, whatever the storage order.
+        self.departed.sort_by_key(|d| d.id);
         let removed = !self.departed.is_empty();
         let kept_spheres: Vec<bool> = (0..n)
             .flat_map(|i| std::iter::repeat_n(keep[i], bodies.template(i).sphere_count()))
