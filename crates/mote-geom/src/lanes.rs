@@ -73,11 +73,6 @@ impl Lanes {
         self.map(f64::sqrt)
     }
 
-    #[inline(always)]
-    fn sqrt_lanes(self) -> Self {
-        self.sqrt()
-    }
-
     /// The lanes added in order 0, 1, …, 7.
     #[inline(always)]
     pub fn sum(self) -> f64 {
@@ -297,7 +292,7 @@ pub trait Lane:
 }
 
 macro_rules! lane_width {
-    ($lanes:ident, $n:expr) => {
+    ($lanes:ident, $n:expr, $sqrt:path) => {
         impl Lane for $lanes {
             const N: usize = $n;
             #[inline(always)]
@@ -318,7 +313,7 @@ macro_rules! lane_width {
             }
             #[inline(always)]
             fn sqrt(self) -> Self {
-                self.sqrt_lanes()
+                $sqrt(self)
             }
             #[inline(always)]
             fn where_positive(self, gate: Self) -> Self {
@@ -474,8 +469,8 @@ fn rsqrt_estimate(x: f64) -> f64 {
 pub fn rsqrt(x: f64) -> f64 {
     Four::splat(x).rsqrt().0[0]
 }
-lane_width!(Lanes, LANES);
-lane_width!(Four, 4);
+lane_width!(Lanes, LANES, Lanes::sqrt);
+lane_width!(Four, 4, Four::sqrt_lanes);
 
 impl Lanes {
     /// Bit l set where lane l is below `bound` (a NaN lane is not).
